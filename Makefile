@@ -1,0 +1,43 @@
+# cellsim: set-up and the two main commands.
+#   make run    set up everything, then run the default welding scenario
+#   make test   set up everything, then run the test suite
+# Set-up is idempotent: system packages are installed only when missing, the virtual
+# environment is (re)built only when pyproject.toml changes.
+
+PYTHON ?= python3
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+SCENARIO ?= bugnar_5r_weld_cycle
+OUT    ?=
+PYTEST_ARGS ?=
+
+# Debian packages that headless rendering needs (EGL on Mesa, or OSMesa).
+SYSTEM_PACKAGES := libegl1 libgl1 libosmesa6 libglu1-mesa
+
+.PHONY: run test setup system-deps bench clean
+
+run: setup
+	$(BIN)/cellsim run $(SCENARIO) $(if $(OUT),--out $(OUT),)
+
+test: setup
+	@$(BIN)/python -m pytest $(PYTEST_ARGS); rc=$$?; \
+	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
+
+bench: setup
+	$(BIN)/python benchmarks/run_all.py
+
+setup: system-deps $(VENV)/.installed
+
+system-deps:
+	@bash scripts/install-system-deps.sh $(SYSTEM_PACKAGES)
+
+$(VENV)/.installed: pyproject.toml
+	$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' || \
+	  { echo "cellsim needs Python 3.11 or newer (PYTHON=$(PYTHON))"; exit 1; }
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $@
+
+clean:
+	rm -rf $(VENV) build dist *.egg-info .pytest_cache

@@ -1,0 +1,24 @@
+"""Trajectory planners of cellsim.
+
+Joint-space piecewise polynomials through via points (4-3-4 after seed 001, 5-4-6 after
+seed 000) and Cartesian ADNIA interpolation of the tool point (seed 003). Every planner
+returns a trajectory with ``duration``, ``at(t)`` and ``sample(dt)``.
+
+Planners work in SI units: seconds, radians (joints) and metres (Cartesian).
+"""
+
+from planners.errors import (
+    InvalidBoundaryError,
+    InvalidKnotsError,
+    LimitViolationError,
+    PlannerError,
+    UnknownPlannerError,
+)
+
+__all__ = [
+    "PlannerError",
+    "InvalidKnotsError",
+    "InvalidBoundaryError",
+    "LimitViolationError",
+    "UnknownPlannerError",
+]

@@ -1,0 +1,55 @@
+"""The ``cellsim`` command line (also ``python -m sim``).
+
+Each sub-command lives in its own module under :mod:`sim.commands` with ``register(sub)``
+(adds its parser) and sets ``func(args) -> int``. User mistakes (:class:`CellsimError`,
+:class:`planners.PlannerError`) are printed as one line and exit with code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from planners.errors import PlannerError
+from sim import __version__
+from sim.errors import CellsimError
+
+#: Sub-command modules, in the order ``--help`` lists them.
+COMMANDS = ("list", "plan", "ik", "workspace", "run", "size", "render")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cellsim",
+        description="Physics simulation of industrial robot welding and pick cells on MuJoCo.",
+    )
+    parser.add_argument("--version", action="version", version=f"cellsim {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in COMMANDS:
+        try:
+            module = importlib.import_module(f"sim.commands.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"sim.commands.{name}":
+                continue  # command not built yet
+            raise
+        module.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (CellsimError, PlannerError) as exc:
+        print(f"cellsim: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("cellsim: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
