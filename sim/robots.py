@@ -19,6 +19,32 @@ from sim.resources import models_dir
 
 
 @dataclass(frozen=True)
+class Drive:
+    """Drive train of one joint (motor + gearbox), motor-side quantities.
+
+    Attributes:
+        gear_ratio: Motor turns per joint turn (> 0).
+        efficiency: Gear efficiency, 0 < eta <= 1.
+        rotor_inertia: Motor rotor inertia (plus input-side gear inertia), kg m^2, motor side.
+        rated_torque: Motor continuous (rated) torque, N m, motor side.
+        peak_torque: Motor peak torque, N m, motor side.
+        max_speed_rpm: Motor maximum speed, rpm.
+    """
+
+    gear_ratio: float
+    efficiency: float
+    rotor_inertia: float
+    rated_torque: float
+    peak_torque: float
+    max_speed_rpm: float
+
+    @property
+    def reflected_inertia(self) -> float:
+        """Rotor inertia seen at the joint, ``rotor_inertia * gear_ratio**2``, kg m^2."""
+        return self.rotor_inertia * self.gear_ratio**2
+
+
+@dataclass(frozen=True)
 class RobotSpec:
     """Static description of one robot.
 
@@ -33,6 +59,8 @@ class RobotSpec:
             l3 = J4 axis to the tool point); ``"fanuc6"``: d2, d3, d4, R4, R6 (seed 004 Table 1).
         max_speed: Joint speed limits, rad/s, shape (n_joints,).
         description: One line for ``cellsim list``.
+        drives: Default drive train per joint (documented in the model's README); the
+            MJCF ``armature`` equals each drive's reflected inertia.
     """
 
     name: str
@@ -43,6 +71,7 @@ class RobotSpec:
     dims: dict[str, float]
     max_speed: tuple[float, ...]
     description: str = ""
+    drives: tuple[Drive, ...] = ()
     joint_names: tuple[str, ...] = field(default=())
 
     @property
