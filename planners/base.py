@@ -38,7 +38,7 @@ class Trajectory(Protocol):
         ...
 
     def at(self, t: ArrayLike):
-        """State at time(s) ``t`` (s, measured from the trajectory's start time)."""
+        """State at time(s) ``t``, s, on the trajectory's own clock (that of its knot times)."""
         ...
 
     def sample(self, dt: float):
