@@ -1,0 +1,239 @@
+"""Scenario loading and validation (issue 2 section 3): shipped files, and every kind of bad
+input giving one line that names the file and the key."""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from sim.errors import CellsimError, ScenarioError, UnknownNameError
+from sim.resources import shipped_scenarios
+from sim.scenario import JointPhaseSpec, ScenarioSpec, load_scenario, parse_scenario
+
+SHIPPED = shipped_scenarios()
+DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario-format.md"
+
+GOOD = """
+name = "t"
+description = "test"
+robot = "robot_5r"
+[[phases]]
+name = "a"
+planner = "434"
+time_s = [0.0, 1.0, 2.0]
+joints_deg = [[0,0,0,0,0],[1,2,3,4,5],[2,4,6,8,10]]
+"""
+
+
+def test_required_scenarios_ship():
+    assert {"bugnar_5r_phase1", "kacso_lrmate100ib_sequence1"} <= set(SHIPPED)
+
+
+@pytest.mark.parametrize("name", sorted(SHIPPED))
+def test_shipped_scenario_loads_with_consistent_phases(name):
+    sc = load_scenario(name)
+    assert sc.name == name, "a shipped scenario's name must equal its file name"
+    for prev, phase in zip(sc.phases, sc.phases[1:]):
+        assert phase.t0 == pytest.approx(prev.t1)
+        np.testing.assert_allclose(phase.q[0], prev.q[-1], atol=1e-12)
+    for phase in sc.phases:
+        assert phase.q.shape == (phase.times.size, sc.robot.n_joints)
+
+
+def test_bugnar_phase1_is_seed001_table1_in_radians():
+    """Seed 001 Table 1 (the values chosen where eq. 3-4 disagree: q4 = -14.06, +1.40)."""
+    ph = load_scenario("bugnar_5r_phase1").phases[0]
+    np.testing.assert_allclose(ph.times, [0, 3.33, 6.67, 10])
+    np.testing.assert_allclose(np.rad2deg(ph.q[:, 3]), [0, -7.03, -14.06, 1.40])
+    np.testing.assert_allclose(np.rad2deg(ph.q[3]), [-15.2, 116.82, -1.3, 1.4, -0.206])
+
+
+def test_kacso_sequence1_is_seed000_table3():
+    """Seed 000 Table 3 at 0.208 s segments; joints 1 and 5 at zero."""
+    ph = load_scenario("kacso_lrmate100ib_sequence1").phases[0]
+    np.testing.assert_allclose(ph.times, [0, 0.208, 0.416, 0.624])
+    np.testing.assert_allclose(np.rad2deg(ph.q[:, 1]), [0, 28.79, 57.59, 86.38])
+    assert np.all(ph.q[:, [0, 4]] == 0)
+
+
+def _err(text: str) -> str:
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(text, source="x.toml")
+    msg = str(info.value)
+    assert "\n" not in msg, "errors are one line"
+    assert msg.startswith("x.toml: ")
+    return msg
+
+
+@pytest.mark.parametrize("mutation, key, fragment", [
+    (("time_s = [0.0, 1.0, 2.0]", "time_s = [0.0, 2.0]"), "phases[0].time_s", "at least 3"),
+    (("time_s = [0.0, 1.0, 2.0]", "time_s = [0.0, 1.0, 1.0]"), "phases[0].time_s", "must increase"),
+    (("time_s = [0.0, 1.0, 2.0]", "time_s = [0.0, 3.0, 2.0]"), "phases[0].time_s", "index 2"),
+    (("[1,2,3,4,5]", "[1,2,3,4]"), "phases[0].joints_deg[1]", "5 joints"),
+    (("[1,2,3,4,5]", "[1,2,nan,4,5]"), "phases[0].joints_deg[1][2]", "finite"),
+    (("[1,2,3,4,5]", "[1,2,inf,4,5]"), "phases[0].joints_deg[1][2]", "finite"),
+    (("[1,2,3,4,5]", '[1,2,"3",4,5]'), "phases[0].joints_deg[1][2]", "must be a number"),
+    (('planner = "434"', 'planner = "4343"'), "phases[0].planner", "'434' or '546'"),
+    (('robot = "robot_5r"', 'robot = "robot5r"'), "robot", "did you mean 'robot_5r'"),
+    (('time_s =', 'tim_s ='), "phases[0].tim_s", "did you mean 'time_s'"),
+    (('description = "test"', ''), "description", "missing"),
+    (("joints_deg = [[0,0,0,0,0],[1,2,3,4,5],[2,4,6,8,10]]",
+      "joints_deg = [[0,0,0,0,0],[1,2,3,4,5]]"), "phases[0].joints_deg", "one row per time"),
+    (('planner = "434"', 'planner = "434"\nstart_jerk_deg_s3 = [0,0,0,0,0]'),
+     "phases[0].start_jerk_deg_s3", "no jerk"),
+    (('planner = "434"', 'planner = "434"\nstart_velocity_deg_s = [0,0]'),
+     "phases[0].start_velocity_deg_s", "5 joints"),
+    (('joints_deg', 'joints_rad = [[0,0,0,0,0],[0,0,0,0,0],[0,0,0,0,0]]\njoints_deg'),
+     "phases[0]", "exactly one of joints_deg or joints_rad"),
+])
+def test_bad_input_names_the_key(mutation, key, fragment):
+    old, new = mutation
+    assert old in GOOD
+    msg = _err(GOOD.replace(old, new, 1))
+    assert f" {key}" in msg or f"{key}:" in msg, msg
+    assert fragment in msg, msg
+
+
+def test_malformed_toml_is_one_line():
+    msg = _err(GOOD.replace('name = "a"', 'name = "a'))
+    assert "invalid TOML" in msg
+
+
+def test_phases_must_meet():
+    second = """
+[[phases]]
+name = "b"
+planner = "546"
+time_s = [2.5, 3.0, 4.0]
+joints_deg = [[2,4,6,8,10],[2,4,6,8,10],[0,0,0,0,0]]
+"""
+    msg = _err(GOOD + second)
+    assert "phases[1].time_s" in msg and "ends at 2 s" in msg
+    msg = _err(GOOD + second.replace("2.5", "2.0").replace("[2,4,6,8,10],[2", "[2,4,6,9,10],[2", 1))
+    assert "joint j4" in msg and "phases[1]" in msg
+
+
+def test_duplicate_phase_names():
+    dup = GOOD + GOOD[GOOD.index("[[phases]]"):].replace("time_s = [0.0, 1.0, 2.0]",
+                                                          "time_s = [2.0, 3.0, 4.0]")
+    dup = dup.replace("joints_deg = [[0,0,0,0,0],[1,2,3,4,5],[2,4,6,8,10]]",
+                      "joints_deg = [[2,4,6,8,10],[1,2,3,4,5],[0,0,0,0,0]]")
+    dup = dup.replace("[[0,0,0,0,0],[1,2,3,4,5],[2,4,6,8,10]]", "[[0,0,0,0,0],[1,2,3,4,5],[2,4,6,8,10]]")
+    msg = _err(dup)
+    assert "phases[1].name" in msg and "already" in msg
+
+
+def test_unknown_scenario_lists_shipped():
+    with pytest.raises(UnknownNameError) as info:
+        load_scenario("bugnar_5r_phase")
+    assert "did you mean 'bugnar_5r_phase1'" in str(info.value)
+    assert "kacso_lrmate100ib_sequence1" in str(info.value)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ScenarioError, match="no such scenario file"):
+        load_scenario(tmp_path / "nope.toml")
+
+
+def _mutations():
+    """Random edits of a shipped scenario's parsed TOML: delete, retype or rename a key."""
+    values = st.one_of(st.none(), st.booleans(), st.integers(-5, 5), st.floats(allow_nan=True),
+                       st.text(max_size=5), st.lists(st.floats(allow_nan=True), max_size=6),
+                       st.lists(st.lists(st.integers(-200, 200), max_size=6), max_size=5))
+    return st.tuples(st.sampled_from(sorted(SHIPPED)), st.integers(0, 10_000),
+                     st.sampled_from(["delete", "set", "rename"]), values, st.text(max_size=8))
+
+
+def _dump_toml(obj, prefix=""):
+    """A tiny TOML writer for the mutation test (tables, arrays of tables, scalars, arrays)."""
+    import json
+    lines, tables = [], []
+    for k, v in obj.items():
+        if isinstance(v, dict):
+            tables.append((k, v, False))
+        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+            tables.append((k, v, True))
+        else:
+            lines.append(f"{json.dumps(k)} = {_toml_value(v)}")
+    out = "\n".join(lines) + "\n"
+    for k, v, is_array in tables:
+        name = f"{prefix}{json.dumps(k)}"
+        for item in (v if is_array else [v]):
+            out += f"\n[{'[' if is_array else ''}{name}{']' if is_array else ''}]\n"
+            out += _dump_toml(item, prefix=name + ".")
+    return out
+
+
+def _toml_value(v):
+    import json
+    import math
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else ("inf" if v == math.inf else "-inf" if v == -math.inf
+                                            else repr(v))
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{json.dumps(k)} = {_toml_value(x)}" for k, x in v.items()) + "}"
+    return '""'
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_mutations())
+def test_random_mutations_never_traceback(mutation):
+    """Property test: a mutated shipped scenario loads, or fails with a one-line CellsimError."""
+    name, pick, action, value, new_key = mutation
+    raw = tomllib.loads(SHIPPED[name].read_text())
+    # collect every (container, key) pair of the document
+    slots = []
+
+    def walk(node):
+        if isinstance(node, dict):
+            for k in list(node):
+                slots.append((node, k))
+                walk(node[k])
+        elif isinstance(node, list):
+            for i in range(len(node)):
+                slots.append((node, i))
+                walk(node[i])
+
+    walk(raw)
+    container, key = slots[pick % len(slots)]
+    if action == "delete":
+        del container[key]
+    elif action == "set" or not isinstance(container, dict):
+        if value is None:
+            value = ""
+        container[key] = value
+    else:
+        container[new_key or "x"] = container.pop(key)
+    text = _dump_toml(raw)
+    try:
+        parse_scenario(text, source="m.toml")
+    except CellsimError as exc:
+        assert "\n" not in str(exc)
+        assert str(exc).startswith("m.toml")
+
+
+def test_format_reference_documents_every_key():
+    """docs/scenario-format.md and the declared schema name the same keys."""
+    doc = DOC.read_text()
+    documented = set(re.findall(r"`([a-z][a-z0-9_]*)`", doc))
+    for model in (ScenarioSpec, JointPhaseSpec):
+        for key in model.model_fields:
+            assert key in documented, f"{model.__name__}.{key} is not in {DOC.name}"
+    declared = set(ScenarioSpec.model_fields) | set(JointPhaseSpec.model_fields)
+    table_keys = set(re.findall(r"^\| `([a-z][a-z0-9_]*)`", doc, flags=re.M))
+    table_keys |= set(re.findall(r"^\| `[a-z0-9_]+` / `([a-z][a-z0-9_]*)`", doc, flags=re.M))
+    assert table_keys <= declared, f"documented but not accepted: {table_keys - declared}"
