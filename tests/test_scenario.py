@@ -14,7 +14,19 @@ from hypothesis import strategies as st
 
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.resources import shipped_scenarios
-from sim.scenario import JointPhaseSpec, ScenarioSpec, load_scenario, parse_scenario
+from sim.scenario import (
+    ActionSpec,
+    CircularPhaseSpec,
+    DriveOverrideSpec,
+    HoldPhaseSpec,
+    JointPhaseSpec,
+    LinearPhaseSpec,
+    ScenarioSpec,
+    SimulationSpec,
+    VideoSpec,
+    load_scenario,
+    parse_scenario,
+)
 
 SHIPPED = shipped_scenarios()
 DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario-format.md"
@@ -230,10 +242,106 @@ def test_format_reference_documents_every_key():
     """docs/scenario-format.md and the declared schema name the same keys."""
     doc = DOC.read_text()
     documented = set(re.findall(r"`([a-z][a-z0-9_]*)`", doc))
-    for model in (ScenarioSpec, JointPhaseSpec):
+    models = (ScenarioSpec, JointPhaseSpec, LinearPhaseSpec, CircularPhaseSpec, HoldPhaseSpec,
+              ActionSpec, SimulationSpec, VideoSpec, DriveOverrideSpec)
+    declared = set()
+    for model in models:
         for key in model.model_fields:
             assert key in documented, f"{model.__name__}.{key} is not in {DOC.name}"
-    declared = set(ScenarioSpec.model_fields) | set(JointPhaseSpec.model_fields)
+            declared.add(key)
     table_keys = set(re.findall(r"^\| `([a-z][a-z0-9_]*)`", doc, flags=re.M))
     table_keys |= set(re.findall(r"^\| `[a-z0-9_]+` / `([a-z][a-z0-9_]*)`", doc, flags=re.M))
     assert table_keys <= declared, f"documented but not accepted: {table_keys - declared}"
+
+
+CYCLE = GOOD + """
+[[phases]]
+name = "line"
+kind = "linear"
+to_mm = [600.0, 0.0, 100.0]
+speed_mm_s = 10.0
+
+[[phases]]
+name = "arc"
+kind = "circular"
+via_mm = [650.0, 50.0, 100.0]
+to_mm = [700.0, 0.0, 100.0]
+speed_mm_s = 10.0
+
+[[phases]]
+name = "wait"
+kind = "hold"
+duration_s = 0.5
+
+[[phases]]
+name = "back"
+planner = "546"
+durations_s = [1.0, 1.0]
+joints_deg = [[1,1,1,1,1],[0,0,0,0,0]]
+
+[drives.j2]
+gear_ratio = 120.0
+"""
+
+
+def test_full_cycle_parses_in_si_units():
+    sc = parse_scenario(CYCLE, source="c.toml")
+    kinds = [p.kind for p in sc.phases]
+    assert kinds == ["joint", "linear", "circular", "hold", "joint"]
+    line, arc, hold, back = sc.phases[1:]
+    np.testing.assert_allclose(line.to, [0.6, 0.0, 0.1])
+    assert line.speed == pytest.approx(0.01) and line.orientation == "keep"
+    assert arc.orientation == "follow" and arc.via is not None
+    assert hold.duration == 0.5
+    assert back.times is None and back.starts_from_previous
+    placed = back.with_start(12.0, np.zeros(5))
+    np.testing.assert_allclose(placed.times, [12.0, 13.0, 14.0])
+    assert sc.drives == {"j2": {"gear_ratio": 120.0}}
+
+
+@pytest.mark.parametrize("old, new, key, fragment", [
+    ('kind = "hold"\nduration_s = 0.5', 'kind = "hold"\nduration_s = -1', "phases[3].duration_s",
+     "greater than 0"),
+    ('kind = "hold"', 'kind = "hodl"', "phases[3].kind", "'hold'"),
+    ("speed_mm_s = 10.0\n\n[[phases]]\nname = \"arc\"", "speed_mm_s = 0\n\n[[phases]]\nname = \"arc\"",
+     "phases[1].speed_mm_s", "greater than 0"),
+    ("to_mm = [600.0, 0.0, 100.0]", "to_mm = [600.0, 0.0]", "phases[1].to_mm", "at least 3"),
+    ("to_mm = [600.0, 0.0, 100.0]", 'seam = "s1"\nto_mm = [600.0, 0.0, 100.0]', "phases[1]",
+     "exactly one of seam or to_mm"),
+    ('via_mm = [650.0, 50.0, 100.0]\n', '', "phases[2]", "give seam, or via_mm"),
+    ("durations_s = [1.0, 1.0]", "durations_s = [1.0, 0.0]", "phases[4].durations_s[1]",
+     "positive"),
+    ("joints_deg = [[1,1,1,1,1],[0,0,0,0,0]]", "joints_deg = [[0,0,0,0,0]]", "phases[4].joints_deg",
+     "one row per segment end"),
+    ("durations_s = [1.0, 1.0]", "time_s = [9.0, 10.0, 11.0]", "phases[4].time_s",
+     "give durations_s"),
+    ("[drives.j2]", "[drives.j9]", "drives.j9", "unknown joint"),
+    ("gear_ratio = 120.0", "gear_ration = 120.0", "drives.j2.gear_ration",
+     "did you mean 'gear_ratio'"),
+])
+def test_cycle_bad_input_names_the_key(old, new, key, fragment):
+    assert old in CYCLE
+    msg = _err(CYCLE.replace(old, new, 1))
+    assert key in msg and fragment in msg, msg
+
+
+@pytest.mark.parametrize("extra, fragment", [
+    ('\n[[actions]]\naction = "arc_on"\nphase = "line"\n', "needs tool = \"mig_torch\""),
+    ('\n[[actions]]\naction = "suction_on"\ntime_s = 1.0\n', "needs tool = \"vacuum_gripper\""),
+    ('\n[[actions]]\naction = "arc_on"\n', "exactly one of time_s or phase"),
+    ('\n[[actions]]\naction = "weld"\ntime_s = 1.0\n', "actions[0].action"),
+])
+def test_action_errors(extra, fragment):
+    # actions come after the tables in TOML; put them before [drives.j2]
+    text = CYCLE.replace("[drives.j2]", extra + "\n[drives.j2]")
+    msg = _err(text)
+    assert fragment in msg, msg
+
+
+def test_action_unknown_phase_suggests():
+    text = CYCLE.replace("[drives.j2]", '[[actions]]\naction = "arc_on"\nphase = "lin"\n\n[drives.j2]')
+    text = text.replace('robot = "robot_5r"', 'robot = "robot_5r"')
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(text, source="c.toml")
+    # no tool: the tool check or the phase check fires, both one line naming actions[0]
+    assert "actions[0]" in str(info.value)
