@@ -14,6 +14,11 @@ from planners.errors import (
     PlannerError,
     UnknownPlannerError,
 )
+from planners.limits import LimitViolation, check_limits, find_limit_violations
+from planners.poly434 import plan_434
+from planners.poly546 import plan_546
+from planners.registry import PLANNERS, get_planner
+from planners.trajectory import PiecewisePolynomialTrajectory, TrajectoryExtrema
 
 __all__ = [
     "PlannerError",
@@ -21,4 +26,13 @@ __all__ = [
     "InvalidBoundaryError",
     "LimitViolationError",
     "UnknownPlannerError",
+    "plan_434",
+    "plan_546",
+    "PLANNERS",
+    "get_planner",
+    "PiecewisePolynomialTrajectory",
+    "TrajectoryExtrema",
+    "LimitViolation",
+    "check_limits",
+    "find_limit_violations",
 ]
