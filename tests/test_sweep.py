@@ -1,0 +1,210 @@
+"""Tests of sim.sweep with fake module-level runners (picklable) whose torques are known in
+closed form: peak = payload * g * L + k * s^2 (gravity of the payload on a lever L plus an
+inertial part that grows with the square of the speed scale s)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sim.errors import CellsimError, UnknownNameError
+from sim.sweep import (
+    SWEEP_COLUMNS,
+    SweepError,
+    Variant,
+    make_variants,
+    parse_float_list,
+    run_sweep,
+    scale_knot_times,
+)
+
+G, L, K = 9.81, 0.5, 3.0
+BASE_DURATION = 2.0
+JOINTS = ["j1", "j2"]
+
+
+def expected_peak(payload: float, scale: float) -> float:
+    return payload * G * L + K * scale**2
+
+
+def fake_runner(variant: Variant) -> Path:
+    """j1 holds the torque constant; j2 swings it as a sine over one whole period."""
+    run_dir = Path(variant.run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    T = BASE_DURATION / variant.speed_scale  # knot times divided by the scale
+    t = np.linspace(0.0, T, 401)  # t[100] = T/4: the crest is sampled
+    a = expected_peak(variant.payload_kg, variant.speed_scale)
+    tau = np.stack([np.full_like(t, a), a * np.sin(2 * np.pi * t / T)], axis=1)
+    qd = np.stack([np.full_like(t, 0.1), np.cos(2 * np.pi * t / T)], axis=1) * variant.speed_scale
+    np.savez(run_dir / "trajectory.npz", t=t, q_ref=0 * tau, qd_ref=qd, qdd_ref=0 * tau, q=0 * tau,
+             qd=qd, tau=tau, tau_id=0.99 * tau)
+    (run_dir / "summary.json").write_text(json.dumps(
+        {"scenario": str(variant.scenario), "joints": JOINTS, "pid": os.getpid()}))
+    time.sleep(0.05)  # long enough for the pool to hand work to every worker
+    return run_dir
+
+
+def failing_runner(variant: Variant) -> Path:
+    """Fails for the 5 kg variants with an exception whose pickling is awkward."""
+    if variant.payload_kg == 5.0:
+        raise UnknownNameError("tool", "torch9", ["mig_torch"])
+    return fake_runner(variant)
+
+
+def sizing_runner(variant: Variant) -> Path:
+    """Also writes a sizing.json, as the real runner does."""
+    run_dir = fake_runner(variant)
+    margin = 100.0 - expected_peak(variant.payload_kg, variant.speed_scale)
+    (run_dir / "sizing.json").write_text(json.dumps({"joints": [
+        {"joint": j, "pass": margin >= 0, "margin_pct": margin, "limiting": "joint_torque"}
+        for j in JOINTS]}))
+    return run_dir
+
+
+def read_csv(path: Path) -> list[dict[str, str]]:
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+PAYLOADS = [0.0, 2.5, 5.0]
+SCALES = [0.5, 1.0, 2.0]
+
+
+def test_sweep_table_matches_closed_form(tmp_path) -> None:
+    res = run_sweep("weld_demo", PAYLOADS, SCALES, fake_runner, workers=1, out_dir=tmp_path,
+                    progress=False)
+    rows = read_csv(tmp_path / "sweep.csv")
+    assert tuple(rows[0].keys()) == SWEEP_COLUMNS
+    assert len(rows) == len(PAYLOADS) * len(SCALES) * len(JOINTS)
+    seen = set()
+    for r in rows:
+        p, s = float(r["payload_kg"]), float(r["speed_scale"])
+        seen.add((p, s))
+        a = expected_peak(p, s)
+        assert float(r["peak_torque_nm"]) == pytest.approx(a, rel=1e-12)
+        assert float(r["peak_torque_id_nm"]) == pytest.approx(0.99 * a, rel=1e-12)
+        # RMS: constant -> a; sine over one whole period -> a / sqrt(2)
+        rms = a if r["joint"] == "j1" else a / math.sqrt(2)
+        assert float(r["rms_torque_nm"]) == pytest.approx(rms, rel=1e-9)
+        assert float(r["duration_s"]) == pytest.approx(BASE_DURATION / s)
+        assert Path(r["run_dir"]).is_dir()
+    assert seen == {(p, s) for p in PAYLOADS for s in SCALES}
+    assert res.failures == []
+    md = (tmp_path / "sweep.md").read_text()
+    assert "Peak |torque|" in md and "RMS torque" in md and "sweep.png" in md
+    # pivot cell: 5 kg at speed x2, joint j1
+    assert f"| 5 | 2 | {expected_peak(5, 2):.4g} |" in md
+    assert (tmp_path / "sweep.png").read_bytes().startswith(b"\x89PNG")
+    data = json.loads((tmp_path / "sweep.json").read_text())
+    assert len(data["variants"]) == 9
+
+
+def test_parallel_equals_serial(tmp_path) -> None:
+    serial = run_sweep("weld_demo", PAYLOADS, SCALES, fake_runner, workers=1,
+                       out_dir=tmp_path / "serial", progress=False)
+    parallel = run_sweep("weld_demo", PAYLOADS, SCALES, fake_runner, workers=2,
+                         out_dir=tmp_path / "parallel", progress=False)
+    assert parallel.workers == 2
+
+    def strip(rows):  # NaN (no sizing.json) compared as equal through its repr
+        return [{k: repr(v) for k, v in r.items() if k != "run_dir"} for r in rows]
+
+    assert strip(parallel.rows) == strip(serial.rows)  # same values, same order
+    a = [{k: v for k, v in r.items() if k != "run_dir"}
+         for r in read_csv(tmp_path / "serial" / "sweep.csv")]
+    b = [{k: v for k, v in r.items() if k != "run_dir"}
+         for r in read_csv(tmp_path / "parallel" / "sweep.csv")]
+    assert a == b
+    pids = {json.loads((Path(o.run_dir) / "summary.json").read_text())["pid"]
+            for o in parallel.outcomes}
+    assert os.getpid() not in pids and len(pids) == 2  # really ran in two worker processes
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_failed_variants_reported_after_writing_the_others(tmp_path, workers: int) -> None:
+    with pytest.raises(SweepError) as err:
+        run_sweep("weld_demo", [0.0, 5.0], [1.0, 2.0], failing_runner, workers=workers,
+                  out_dir=tmp_path, progress=False)
+    msg = str(err.value)
+    assert "2 of 4 sweep variants failed" in msg and "payload 5 kg" in msg and "torch9" in msg
+    assert "\n" not in msg
+    rows = read_csv(tmp_path / "sweep.csv")
+    assert {float(r["payload_kg"]) for r in rows} == {0.0}
+    assert "Failed variants" in (tmp_path / "sweep.md").read_text()
+
+
+def test_margins_copied_from_sizing_json(tmp_path) -> None:
+    run_sweep("s", [0.0, 20.0], [1.0], sizing_runner, workers=1, out_dir=tmp_path, progress=False)
+    rows = {(float(r["payload_kg"]), r["joint"]): r for r in read_csv(tmp_path / "sweep.csv")}
+    assert rows[(0.0, "j1")]["pass"] == "PASS"
+    assert float(rows[(20.0, "j1")]["margin_pct"]) == pytest.approx(100 - expected_peak(20, 1))
+    assert rows[(20.0, "j1")]["pass"] == "FAIL"
+    assert "Sizing margin" in (tmp_path / "sweep.md").read_text()
+
+
+@pytest.mark.parametrize("payloads, scales, field", [
+    ([-1.0], [1.0], "payload"),
+    ([0.0, float("nan")], [1.0], "payload"),
+    ([], [1.0], "payload"),
+    ([0.0], [0.0], "speed scale"),
+    ([0.0], [-0.5], "speed scale"),
+    ([0.0], [float("inf")], "speed scale"),
+    ([0.0], [], "speed scale"),
+])
+def test_bad_sweep_inputs_are_one_line_errors(tmp_path, payloads, scales, field) -> None:
+    with pytest.raises(CellsimError) as err:
+        run_sweep("s", payloads, scales, fake_runner, workers=1, out_dir=tmp_path, progress=False)
+    assert str(err.value).startswith(field) and "\n" not in str(err.value)
+    assert not (tmp_path / "sweep.csv").exists()
+
+
+@pytest.mark.parametrize("workers", [0, -2, 1.5, True])
+def test_bad_workers(tmp_path, workers) -> None:
+    with pytest.raises(SweepError, match="workers"):
+        run_sweep("s", [0.0], [1.0], fake_runner, workers=workers, out_dir=tmp_path)
+
+
+def test_variants_are_every_combination_payload_major(tmp_path) -> None:
+    vs = make_variants("base", [0, 2.5, 2.5], [1, 0.5], tmp_path)
+    assert [(v.payload_kg, v.speed_scale) for v in vs] == [(0, 1), (0, 0.5), (2.5, 1), (2.5, 0.5)]
+    assert [v.index for v in vs] == [0, 1, 2, 3]
+    assert len({v.run_dir for v in vs}) == 4 and all(v.scenario == "base" for v in vs)
+    assert vs[2].slug == "payload_2.5kg_speed_1x"
+
+
+def test_scale_knot_times_divides() -> None:
+    # Speed scale 2: every knot reached in half the time.
+    assert scale_knot_times([0.0, 3.335, 6.665, 10.0], 2.0) == pytest.approx(
+        [0.0, 1.6675, 3.3325, 5.0])
+    with pytest.raises(SweepError, match="speed scale"):
+        scale_knot_times([0.0, 1.0], 0.0)
+
+
+def test_parse_float_list() -> None:
+    assert parse_float_list("0,2.5,5", field="--payload") == [0.0, 2.5, 5.0]
+    assert parse_float_list(" 1 , 0.5 ", field="--speed") == [1.0, 0.5]
+    assert parse_float_list("0:10:2.5", field="--payload") == [0.0, 2.5, 5.0, 7.5, 10.0]
+    assert parse_float_list("0.5:1.1:0.2,2", field="--speed") == pytest.approx([0.5, 0.7, 0.9, 1.1, 2])
+    assert parse_float_list("1,1,2", field="--speed") == [1.0, 2.0]
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("", "empty list"),
+    ("1,,2", "empty item"),
+    ("0,abc", "'abc' is not a number"),
+    ("nan", "not a finite number"),
+    ("1:0:1", "stop < start"),
+    ("0:1:0", "positive step"),
+    ("0:1", "start:stop:step"),
+])
+def test_parse_float_list_errors(text: str, fragment: str) -> None:
+    with pytest.raises(SweepError) as err:
+        parse_float_list(text, field="--payload")
+    assert str(err.value).startswith("--payload:") and fragment in str(err.value)
