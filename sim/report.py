@@ -81,7 +81,7 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
 
 
 def csv_text(columns: Sequence[str], rows: Sequence[Mapping[str, Any]]) -> str:
-    """CSV text with a header; floats as ``%.9g``, NaN/None as empty cells."""
+    """CSV text with a header; floats in their shortest exact form, NaN/None as empty cells."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(columns)
@@ -96,7 +96,7 @@ def _cell(v: Any) -> str:
     if isinstance(v, (bool, np.bool_)):
         return "true" if v else "false"
     if isinstance(v, (float, np.floating)):
-        return f"{float(v):.9g}" if np.isfinite(v) else ""
+        return repr(float(v)) if np.isfinite(v) else ""  # shortest exact round trip
     return str(v)
 
 

@@ -346,7 +346,9 @@ def test_apply_overrides_for_every_robot(robot: str) -> None:
         assert out[-1].rotor_inertia == spec.drives[-1].rotor_inertia
         assert out[:-1] == tuple(spec.drives[:-1])
     else:
-        full = {j: dict(DRIVE.__dict__) for j in joints}
+        full = {j: {"gear_ratio": 100.0, "efficiency": 0.9, "rotor_inertia_kg_m2": 1e-4,
+                    "rated_torque_nm": 1.0, "peak_torque_nm": 3.0, "max_speed_rpm": 4000.0}
+                for j in joints}
         out = apply_overrides((), full, joints)
         assert out == (DRIVE,) * len(joints)
     with pytest.raises(UnknownNameError) as err:
@@ -359,16 +361,21 @@ def test_apply_overrides_rejects_bad_fields_and_values() -> None:
     names = ("j1", "j2")
     drives = (DRIVE, DRIVE)
     assert apply_overrides(drives, None, names) == drives
-    with pytest.raises(UnknownNameError, match="gear_ratio") as err:
+    # Keys of docs/scenario-format.md (unit-suffixed) and bare Drive field names both work.
+    out = apply_overrides(drives, {"j2": {"rated_torque_nm": 1.2, "rotor_inertia_kg_m2": 2e-4,
+                                          "peak_torque": 5.0}}, names)
+    assert (out[1].rated_torque, out[1].rotor_inertia, out[1].peak_torque) == (1.2, 2e-4, 5.0)
+    assert out[0] == DRIVE
+    with pytest.raises(UnknownNameError, match="rated_torque_nm") as err:
         apply_overrides(drives, {"j2": {"gear": 50}}, names)
-    assert "'gear'" in str(err.value)
+    assert "'gear'" in str(err.value) and "gear_ratio" in str(err.value)
     cases = [({"efficiency": 1.5}, "drives.j2.efficiency"),
              ({"efficiency": 0}, "drives.j2.efficiency"),
              ({"gear_ratio": -3}, "drives.j2.gear_ratio"),
              ({"gear_ratio": "fast"}, "drives.j2.gear_ratio"),
-             ({"rated_torque": True}, "drives.j2.rated_torque"),
-             ({"rotor_inertia": -1e-5}, "drives.j2.rotor_inertia"),
-             ({"peak_torque": 0.5}, "drives.j2.peak_torque")]
+             ({"rated_torque_nm": True}, "drives.j2.rated_torque_nm"),
+             ({"rotor_inertia_kg_m2": -1e-5}, "drives.j2.rotor_inertia_kg_m2"),
+             ({"peak_torque_nm": 0.5}, "drives.j2.peak_torque_nm")]
     for table, field in cases:
         with pytest.raises(ScenarioError, match=field.replace(".", r"\.")):
             apply_overrides(drives, {"j2": table}, names)
