@@ -1,0 +1,250 @@
+"""Analytic inverse kinematics: seed 000 Tables 2-3, FK(IK) round trips, branches, errors."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from sim.errors import KinematicsError, UnreachableError
+from sim.kinematics.closed_form import fk_5r, fk_fanuc6
+from sim.kinematics.ik import SingularityWarning, ik_5r_seed, ik_path, solve_ik
+from sim.kinematics.model import KinematicModel, closed_form_model, kinematic_model
+from sim.kinematics.rotations import euler_zyx_to_matrix, make_transform, wrap_to_pi
+from sim.robots import ROBOTS, get_robot
+
+ALL_ROBOTS = sorted(ROBOTS)
+
+# Seed 000 Table 2 (mm, deg) and Table 3 (q2, q3, q4 in deg; q1 = q5 = 0).
+TABLE2 = [(595.0, 0.0, 250.0, 0.0, 0.0, 0.0), (660.56, 0.0, 5.17, 0.0, 30.0, 0.0),
+          (599.91, 0.0, -240.68, 0.0, 60.0, 0.0), (428.36, 0.0, -426.53, 0.0, 90.0, 0.0)]
+TABLE3 = [(0.0, 0.0, 0.0), (28.79, -1.2, 2.41), (57.59, -2.41, 4.83), (86.38, -3.62, 7.24)]
+
+# Joint ranges used where a test needs them independent of the MJCF (deg):
+# 200iC after seed 004 Table 2 / the FANUC manual, the 5R robots a generous symmetric set.
+RANGES_DEG = {
+    "fanuc6": [(-170, 170), (-100, 130), (-230, 90), (-190, 190), (-120, 120), (-360, 360)],
+    "5r": [(-160, 160), (-35, 150), (-120, 120), (-180, 180), (-200, 200)],
+}
+
+
+def _model_with_ranges(name: str) -> KinematicModel:
+    m = closed_form_model(name)
+    r = np.deg2rad(np.array(RANGES_DEG[m.family]))
+    m.lower, m.upper = r[:, 0], r[:, 1]
+    return m
+
+
+def _random_in_range(m: KinematicModel, rng: np.random.Generator, n: int) -> np.ndarray:
+    lo = np.maximum(m.lower, -np.pi) if m.lower is not None else np.full(m.n_joints, -np.pi)
+    hi = np.minimum(m.upper, np.pi) if m.upper is not None else np.full(m.n_joints, np.pi)
+    return rng.uniform(lo, hi, size=(n, m.n_joints))
+
+
+def test_seed000_table3_from_table2():
+    """Seed 000: IK (eq. 13-17, eq. 14 re-derived) of Table 2 gives Table 3 within 0.35 deg.
+
+    The configurations are chosen by branch continuity from home (no knowledge of Table 3).
+    """
+    m = closed_form_model("lrmate100ib")
+    assert m.dims == {"l1": 0.150, "d1": 0.250, "l2": 0.220, "l3": 0.225}
+    poses = [make_transform(euler_zyx_to_matrix(*np.deg2rad(row[3:])), np.array(row[:3]) / 1e3)
+             for row in TABLE2]
+    Q = np.rad2deg(ik_path(m, poses, respect_limits=False))
+    np.testing.assert_allclose(Q[:, [0, 4]], 0.0, atol=1e-9)
+    np.testing.assert_allclose(Q[:, 1:4], np.array(TABLE3), atol=0.35)
+    # and the seed-style entry point gives the same front/elbow-up solution
+    for row, q in zip(TABLE2, Q):
+        sols = ik_5r_seed(np.array(row[:3]) / 1e3, np.deg2rad(row[4]), np.deg2rad(row[5]), m.dims)
+        assert np.abs(np.rad2deg(sols[0]) - q).max() < 1e-9
+
+
+def test_seed000_eq14_rederived_against_eq5():
+    """The corrected eq. (14): sin q3 from the wrist point equals sin q3 of the source config."""
+    m = closed_form_model("lrmate100ib")
+    d = m.dims
+    rng = np.random.default_rng(3)
+    for q in rng.uniform(-1.2, 1.2, size=(20, 5)):
+        R, p = fk_5r(q, d)
+        beta = q[1] + q[2] + q[3]
+        r = np.hypot(p[0], p[1]) * np.sign(np.cos(q[0]) * p[0] + np.sin(q[0]) * p[1])
+        u = r - d["l1"] - d["l3"] * np.cos(beta)
+        v = p[2] + d["l3"] * np.sin(beta)
+        s3 = (d["d1"] ** 2 + d["l2"] ** 2 - u**2 - v**2) / (2 * d["d1"] * d["l2"])
+        assert s3 == pytest.approx(np.sin(q[2]), abs=1e-12)
+
+
+@pytest.mark.parametrize("name", ALL_ROBOTS)
+def test_fk_of_ik_round_trip(name):
+    """FK(IK(pose)) = pose to 1e-9 for random in-range configurations; the source config is
+    among the solutions (modulo 2 pi)."""
+    m = _model_with_ranges(name)
+    rng = np.random.default_rng(11)
+    for q in _random_in_range(m, rng, 60):
+        T = m.fk(q)
+        sols = solve_ik(m, T, current=np.zeros(m.n_joints))
+        assert sols
+        for s in sols:
+            np.testing.assert_allclose(m.fk(s.q), T, atol=1e-9)
+        dist = min(np.abs(wrap_to_pi(s.q - q)).max() for s in sols)
+        assert dist < 1e-9
+        # the closed forms of the seeds agree with the model's forward kinematics
+        R, p = fk_5r(q, m.dims) if m.family == "5r" else fk_fanuc6(q, m.dims)
+        np.testing.assert_allclose(T[:3, :3], R, atol=1e-12)
+        np.testing.assert_allclose(T[:3, 3], p, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ALL_ROBOTS)
+def test_fk_of_ik_with_mjcf_tcp(name):
+    """Same round trip on the model whose tool frame is the MJCF ``tcp`` site."""
+    m = kinematic_model(name)
+    rng = np.random.default_rng(5)
+    for q in rng.uniform(-1.0, 1.0, size=(20, m.n_joints)):
+        T = m.fk(q)
+        for s in solve_ik(m, T, q):
+            np.testing.assert_allclose(m.fk(s.q), T, atol=1e-9)
+
+
+def test_200ic_eight_solutions_and_2pi_representations():
+    """Seed 004: 8 solutions away from singularities (shoulder x elbow x wrist flip); J4/J6
+    also in their theta +- 2 pi representation where the ranges allow it."""
+    m = closed_form_model("lrmate200ic5l")
+    m.lower = m.upper = None  # no ranges: one representation each
+    q = np.deg2rad([20.0, 10.0, -20.0, 30.0, 40.0, 50.0])
+    sols = solve_ik(m, m.fk(q), q)
+    assert len(sols) == 8
+    assert {s.branch for s in sols} == {f"{a}/{b}/{c}" for a in ("front", "back")
+                                        for b in ("up", "down") for c in ("noflip", "flip")}
+    assert np.abs(sols[0].q - q).max() < 1e-9  # the nearest to the current one is first
+    ranged = _model_with_ranges("lrmate200ic5l")
+    sols_r = solve_ik(ranged, ranged.fk(q), q)
+    assert len(sols_r) > 8
+    for s in sols_r:
+        np.testing.assert_allclose(ranged.fk(s.q), ranged.fk(q), atol=1e-9)
+    # J6 (range +-360 deg) has both representations for every branch
+    j6 = {(s.branch, round(float(s.q[5]), 9)) for s in sols_r}
+    for branch in {s.branch for s in sols_r}:
+        vals = sorted(v for b, v in j6 if b == branch)
+        assert any(abs(b - a - 2 * np.pi) < 1e-9 for a in vals for b in vals)
+    assert q.tolist() == pytest.approx(sols_r[0].q.tolist(), abs=1e-9)
+
+
+def test_ranking_prefers_within_limits_then_nearest():
+    m = _model_with_ranges("lrmate200ic5l")
+    q = np.deg2rad([10.0, 20.0, -30.0, 100.0, 50.0, 200.0])
+    current = np.deg2rad([0.0, 0.0, 0.0, 170.0, 0.0, 0.0])
+    sols = solve_ik(m, m.fk(q), current)
+    flags = [s.within_limits for s in sols]
+    assert flags == sorted(flags, reverse=True)
+    inside = [s for s in sols if s.within_limits]
+    weights = 1.0 / m.max_speed
+    costs = [np.sqrt(np.sum(((s.q - current) * weights) ** 2)) for s in inside]
+    assert costs == sorted(costs)
+    assert all(np.all(s.q >= m.lower - 1e-9) and np.all(s.q <= m.upper + 1e-9) for s in inside)
+
+
+@pytest.mark.parametrize("name", ["lrmate100ib", "robot_5r"])
+def test_5r_shoulder_flip_and_elbows(name):
+    """5R: both elbows, and the shoulder-flip solution (q1 + pi) where it reaches.
+
+    The target is near the J1 axis with the tool pointing down (beta = 90 deg), its wrist point
+    at mid-reach of J2, so that both shoulder branches reach it.
+    """
+    m = closed_form_model(name)
+    d = m.dims
+    mid = (abs(d["d1"] - d["l2"]) + d["d1"] + d["l2"]) / 2
+    p = np.array([0.02, 0.01, mid - d["l3"]])
+    T = make_transform(euler_zyx_to_matrix(np.arctan2(p[1], p[0]), np.pi / 2, 0.2), p)
+    sols = solve_ik(m, T)
+    branches = {s.branch for s in sols}
+    assert {"front/up", "front/down", "back/up", "back/down"} <= branches
+    front = [s for s in sols if s.branch.startswith("front")][0]
+    for s in sols:
+        np.testing.assert_allclose(m.fk(s.q), T, atol=1e-9)
+        if s.branch.startswith("back"):
+            assert abs(wrap_to_pi(s.q[0] - front.q[0] - np.pi)) < 1e-9
+
+
+def test_200ic_unreachable_distance_in_mm():
+    """A pose beyond reach: UnreachableError with the wrist centre's distance outside (m)."""
+    m = closed_form_model("lrmate200ic5l")
+    d = m.dims
+    p = np.array([1.5, 0.0, 0.3])
+    R = np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])  # a along +x
+    with pytest.raises(UnreachableError) as err:
+        solve_ik(m, make_transform(R, p))
+    w = p - d["R6"] * R[:, 2]
+    expected = np.hypot(w[0] - d["d2"], w[2]) - (d["d3"] + np.hypot(d["R4"], d["d4"]))
+    assert err.value.distance == pytest.approx(expected, abs=1e-12)
+    assert f"{1e3 * expected:.1f} mm" in str(err.value)
+
+
+def test_5r_unreachable_and_wrong_orientation():
+    m = closed_form_model("lrmate100ib")
+    d = m.dims
+    T = make_transform(np.eye(3), [1.0, 0.0, 0.25])
+    with pytest.raises(UnreachableError) as err:
+        solve_ik(m, T)
+    u, v = 1.0 - d["l1"] - d["l3"], 0.25
+    assert err.value.distance == pytest.approx(np.hypot(u, v) - d["d1"] - d["l2"], abs=1e-12)
+    # tool x axis out of the arm plane: a 5-axis arm cannot take this orientation
+    R = euler_zyx_to_matrix(0.3, 0.2, 0.0)
+    with pytest.raises(UnreachableError, match="5-axis"):
+        solve_ik(m, make_transform(R, [0.5, 0.0, 0.1]))
+
+
+def test_wrist_singularity_keeps_j4_and_warns():
+    """theta5 = 0 (seed 004 eq. 23): a valid solution with J4 = current J4, and a warning."""
+    m = closed_form_model("lrmate200ic5l")
+    q = np.deg2rad([15.0, 10.0, -25.0, 40.0, 0.0, -20.0])
+    current = np.deg2rad([14.0, 9.0, -24.0, 33.0, 2.0, -10.0])
+    with pytest.warns(SingularityWarning, match="theta5"):
+        sols = solve_ik(m, m.fk(q), current)
+    front_up = [s for s in sols if s.branch == "front/up/singular"]
+    assert front_up
+    s = front_up[0]
+    assert s.q[3] == pytest.approx(current[3], abs=1e-12)
+    assert s.q[4] == pytest.approx(0.0, abs=1e-12)
+    np.testing.assert_allclose(m.fk(s.q), m.fk(q), atol=1e-9)
+    assert s.q[3] + s.q[5] == pytest.approx(q[3] + q[5], abs=1e-9)
+
+
+def test_ik_path_branch_continuity_and_error_index():
+    m = _model_with_ranges("lrmate200ic5l")
+    q0 = np.deg2rad([0.0, 10.0, -10.0, 170.0, 60.0, 300.0])
+    q1 = np.deg2rad([40.0, 30.0, -40.0, 185.0, 80.0, 350.0])
+    Q = np.linspace(q0, q1, 25)
+    poses = m.fk(Q)
+    out = ik_path(m, poses, q_start=q0)
+    np.testing.assert_allclose(out, Q, atol=1e-8)  # same branch and representation throughout
+    assert np.abs(np.diff(out, axis=0)).max() < np.deg2rad(3.0)
+    bad = poses.copy()
+    bad[7, :3, 3] = [3.0, 0.0, 0.0]
+    with pytest.raises(UnreachableError, match="path point 7"):
+        ik_path(m, bad, q_start=q0)
+
+
+def test_ik_path_5r_follows_a_line():
+    """A straight weld line for the 5R robot: FK of the path IK reproduces every pose."""
+    m = closed_form_model("robot_5r")
+    P = np.linspace([1.2, -0.3, 0.2], [1.2, 0.4, 0.2], 15)
+    poses = [make_transform(euler_zyx_to_matrix(np.arctan2(p[1], p[0]), 0.6, 0.1), p) for p in P]
+    Q = ik_path(m, poses, q_start=np.array([0.0, 0.5, -0.2, 0.3, 0.1]), respect_limits=False)
+    np.testing.assert_allclose(m.fk(Q), np.array(poses), atol=1e-9)
+    assert np.abs(np.diff(Q, axis=0)).max() < 0.2
+
+
+def test_bad_pose_input():
+    m = closed_form_model("robot_5r")
+    with pytest.raises(KinematicsError):
+        solve_ik(m, np.full((4, 4), np.nan))
+    with pytest.raises(KinematicsError):
+        solve_ik(m, np.eye(3))
+    with pytest.raises(KinematicsError):
+        ik_path(m, np.eye(4))
+
+
+def test_registry_dims_used():
+    for name in ALL_ROBOTS:
+        assert closed_form_model(name).dims == get_robot(name).dims
