@@ -1,0 +1,232 @@
+"""Rendering the frames of a recorded run, one tile per camera, side by side.
+
+:class:`FrameRenderer` owns one ``mujoco.Renderer`` (one OpenGL context) and closes it
+explicitly (use it as a context manager), so nothing is left for the interpreter to free at
+exit. For a frame at time ``t`` it interpolates ``qpos`` from the record
+(:class:`~sim.render.interp.QposInterpolator`), runs the position-dependent stages MuJoCo's
+visualiser needs (``mj_kinematics``, ``mj_comPos``, ``mj_camlight``, and ``mj_tendon`` /
+``mj_flex`` when the model has tendons / flexes; no dynamics, no collision detection),
+renders each camera with the overlay (:mod:`sim.render.overlay`) and draws the caption.
+
+``width`` and ``height`` are the size of ONE camera tile; the frame is
+``(height, width * len(cameras), 3)``. If the model's offscreen framebuffer
+(``<visual><global offwidth offheight>``) is smaller than the tile, it is enlarged on the
+loaded model (the file is not changed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from sim.errors import RenderError
+from sim.gl import configure_gl
+from sim.render.interp import QposInterpolator
+from sim.render.overlay import OverlayStyle, PathOverlay, caption_text, draw_caption
+from sim.render.run import REQUIRED_FOR_VIDEO, RunFolderError, RunRecord, as_record
+
+#: Largest tile side accepted, pixels (8K; larger sizes fail in most OpenGL drivers).
+MAX_SIDE = 8192
+
+
+def validate_size(width: int, height: int) -> None:
+    """Checks a tile size for H.264 yuv420p video.
+
+    Raises:
+        RenderError: Not an integer, smaller than 16, larger than :data:`MAX_SIDE`, or odd
+            (yuv420p stores colour at half resolution, so both sides must be even).
+    """
+    for name, value in (("width", width), ("height", height)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise RenderError(f"video {name} must be an integer number of pixels, got {value!r}")
+        if not 16 <= value <= MAX_SIDE:
+            raise RenderError(f"video {name} must be between 16 and {MAX_SIDE} pixels, got {value}")
+        if value % 2:
+            raise RenderError(
+                f"video {name} must be even for H.264 yuv420p, got {value} (try {value - 1} or {value + 1})"
+            )
+
+
+def camera_names(model: Any) -> list[str]:
+    """Names of the model's cameras, in model order (unnamed ones as ``#<id>``)."""
+    import mujoco
+
+    names = []
+    for i in range(model.ncam):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, i)
+        names.append(name if name else f"#{i}")
+    return names
+
+
+def resolve_cameras(model: Any, cameras: Sequence[str]) -> list[int]:
+    """Camera ids of ``cameras``.
+
+    Raises:
+        RenderError: An empty list, or an unknown name; the message lists the model's cameras.
+    """
+    import mujoco
+
+    if isinstance(cameras, str):
+        cameras = (cameras,)
+    if not cameras:
+        raise RenderError("no camera given; name at least one (--camera NAME)")
+    ids = []
+    for name in cameras:
+        cid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, str(name))
+        if cid < 0:
+            known = camera_names(model)
+            listed = ", ".join(known) if known else "none (add a <camera name=...> to the cell)"
+            raise RenderError(f"unknown camera {name!r}; the model's cameras: {listed}")
+        ids.append(cid)
+    return ids
+
+
+class FrameRenderer:
+    """Renders a run's frames at chosen times.
+
+    Args:
+        run: A run folder or a :class:`~sim.render.run.RunRecord`.
+        cameras: Camera names, tiled left to right.
+        width: Tile width, pixels (even).
+        height: Tile height, pixels (even).
+        overlay: Draw trails and weld bead.
+        caption: Draw the caption.
+        gl: OpenGL backend (``"egl"``, ``"osmesa"``) or None for automatic.
+        style: Overlay colours and sizes.
+
+    Raises:
+        RenderError: Bad size, unknown camera, or no OpenGL backend.
+        RunFolderError: The run is incomplete or does not match its model.
+    """
+
+    def __init__(
+        self,
+        run: Any,
+        *,
+        cameras: Sequence[str] = ("overview",),
+        width: int = 640,
+        height: int = 480,
+        overlay: bool = True,
+        caption: bool = True,
+        gl: str | None = None,
+        style: OverlayStyle | None = None,
+    ) -> None:
+        self._renderer: Any = None
+        validate_size(width, height)
+        self.record: RunRecord = as_record(run)
+        self.record.require(REQUIRED_FOR_VIDEO)
+        configure_gl(gl)
+        import mujoco
+
+        self._mj = mujoco
+        model = self.record.load_model()
+        self.camera_ids = resolve_cameras(model, cameras)
+        self.cameras = [str(c) for c in ([cameras] if isinstance(cameras, str) else cameras)]
+        qpos = self.record.get("qpos")
+        if qpos.ndim != 2 or qpos.shape[1] != model.nq:
+            raise RunFolderError(
+                f"{self.record.where}: trajectory.npz 'qpos' has shape {qpos.shape} but model.xml "
+                f"has nq={model.nq}"
+            )
+        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), int(width))
+        model.vis.global_.offheight = max(int(model.vis.global_.offheight), int(height))
+        self.model = model
+        self.data = mujoco.MjData(model)
+        self.width, self.height = int(width), int(height)
+        self.interp = QposInterpolator(model, self.record.t, qpos)
+        self.overlay = PathOverlay(self.record, style) if overlay else None
+        self.caption = caption
+        extra = self.overlay.max_geoms if self.overlay else 0
+        max_geom = 10000 + extra
+        try:
+            self._renderer = mujoco.Renderer(model, self.height, self.width, max_geom=max_geom)
+        except Exception as exc:  # context creation failures come as various types
+            raise RenderError(
+                f"could not create a {self.width}x{self.height} OpenGL renderer: {exc}"
+            ) from exc
+        self._geoms = self._renderer.scene.geoms
+        self._tiles = [np.empty((self.height, self.width, 3), np.uint8) for _ in self.camera_ids]
+
+    # -- life cycle ---------------------------------------------------------------------
+    def close(self) -> None:
+        """Frees the OpenGL context (idempotent)."""
+        renderer, self._renderer = self._renderer, None
+        self._geoms = None
+        if renderer is not None:
+            renderer.close()
+
+    def __enter__(self) -> FrameRenderer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:  # last resort; callers close explicitly
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - never raise from a finalizer
+            pass
+
+    # -- frames -------------------------------------------------------------------------
+    @property
+    def frame_shape(self) -> tuple[int, int, int]:
+        """Shape of one frame, (height, width * n_cameras, 3)."""
+        return (self.height, self.width * len(self.camera_ids), 3)
+
+    def frame_times(self, fps: float) -> np.ndarray:
+        """Video frame times ``t0 + k / fps`` for ``k = 0 .. floor(duration * fps)``.
+
+        The frame count is ``floor(duration * fps) + 1``: the first frame shows the first
+        sample, the last one the state at most ``1 / fps`` before the end.
+
+        Raises:
+            RenderError: ``fps`` not positive and finite.
+        """
+        if not np.isfinite(fps) or fps <= 0:
+            raise RenderError(f"fps must be a positive number, got {fps!r}")
+        n = int(np.floor(self.record.duration * fps + 1e-9)) + 1
+        return self.record.t0 + np.arange(n) / float(fps)
+
+    def set_state(self, time: float) -> None:
+        """Puts the interpolated state at ``time`` into ``self.data`` (positions only)."""
+        mj, m, d = self._mj, self.model, self.data
+        self.interp(time, out=d.qpos)
+        mj.mj_kinematics(m, d)
+        mj.mj_comPos(m, d)
+        mj.mj_camlight(m, d)
+        if m.ntendon:
+            mj.mj_tendon(m, d)
+        if m.nflex:
+            mj.mj_flex(m, d)
+
+    def render(self, time: float, out: np.ndarray | None = None) -> np.ndarray:
+        """Renders the frame at ``time`` (s).
+
+        Args:
+            time: Frame time, s (clamped to the record).
+            out: Optional C-contiguous uint8 array of :attr:`frame_shape` to fill.
+
+        Returns:
+            The frame (H, W * n_cameras, 3) uint8.
+        """
+        if self._renderer is None:
+            raise RenderError("render() called after close()")
+        self.set_state(time)
+        if out is None:
+            out = np.empty(self.frame_shape, np.uint8)
+        r = self._renderer
+        single = len(self.camera_ids) == 1
+        for k, cid in enumerate(self.camera_ids):
+            r.update_scene(self.data, cid)
+            if self.overlay is not None:
+                self.overlay.add_to_scene(r.scene, time, self.height, self._geoms)
+            if single:
+                r.render(out=out)
+            else:
+                r.render(out=self._tiles[k])
+                out[:, k * self.width : (k + 1) * self.width] = self._tiles[k]
+        if self.caption:
+            draw_caption(out, caption_text(self.record, time))
+        return out

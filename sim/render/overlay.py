@@ -1,0 +1,317 @@
+"""What cellsim draws over the cell: tool-point trails, the weld bead and a caption.
+
+Trails and bead are added to a ``mujoco.MjvScene`` as extra geoms after
+``mjv_updateScene`` and before rendering, so the robot occludes them correctly:
+
+* reference tool path (``tcp_pos_ref``): the whole planned path, green ``mjGEOM_LINE``
+  segments (width in pixels, unlit, so the colour is exact);
+* actual tool path (``tcp_pos``): red line segments from the start up to the frame's time;
+* weld bead: where ``arc_on`` is true, thick bead-coloured capsules laid along the actual path
+  up to the frame's time (so it grows while welding); the capsule radius is
+  ``OverlayStyle.bead_radius`` (m) but never thinner than ``bead_min_px`` pixels on screen.
+
+Each line point is moved towards the camera along its line of sight by a few millimetres
+(``lift_*``): its projection is unchanged, but it is drawn in front of the bead and the
+reference, instead of flickering with them at equal depth. Paths are
+simplified (Ramer-Douglas-Peucker, ``tolerance``) to at most ``max_segments`` segments each,
+which bounds the geoms added per frame (each is a draw call; straight seams cost one).
+Overlay geoms cast no shadow (no second drawing pass).
+
+The caption (time, phase, highest |joint torque| with the joint's name, arc/suction state) is
+drawn into the image with Pillow.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sim.render.interp import interp_rows, sample_index
+from sim.render.run import RunRecord
+
+
+@dataclass(frozen=True)
+class OverlayStyle:
+    """Colours and sizes of the overlay.
+
+    Attributes:
+        reference_rgba: Colour of the reference tool path (RGBA, 0..1).
+        actual_rgba: Colour of the actual tool path.
+        bead_rgba: Colour of the weld bead.
+        line_px: Trail line width, pixels; None: 1.5 px per 240 px of image height, >= 1.5.
+        bead_radius: Weld bead radius, m.
+        bead_min_px: Smallest on-screen bead diameter, pixels.
+        lift_reference: How far reference points move towards the camera, m.
+        lift_actual: How far actual-path points move towards the camera, m.
+        tolerance: Path simplification tolerance (Ramer-Douglas-Peucker), m.
+        max_segments: Most segments per trail (bound on the geoms added per frame).
+    """
+
+    reference_rgba: tuple[float, float, float, float] = (0.10, 0.85, 0.20, 1.0)
+    actual_rgba: tuple[float, float, float, float] = (1.0, 0.08, 0.08, 1.0)
+    bead_rgba: tuple[float, float, float, float] = (1.0, 0.55, 0.05, 1.0)
+    line_px: float | None = None
+    bead_radius: float = 0.004
+    bead_min_px: float = 3.0
+    lift_reference: float = 0.015
+    lift_actual: float = 0.02
+    tolerance: float = 0.001
+    max_segments: int = 400
+
+
+def simplify_polyline(points: np.ndarray, tolerance: float, max_points: int) -> np.ndarray:
+    """Indices of the vertices kept by Ramer-Douglas-Peucker simplification.
+
+    Every dropped point lies within ``tolerance`` of the chord between the kept vertices
+    around it. If more than ``max_points`` vertices remain, the tolerance is doubled until
+    they fit.
+
+    Args:
+        points: Polyline vertices (N, 3), m.
+        tolerance: Largest distance of a dropped point from the simplified line, m (> 0).
+        max_points: Most vertices to keep (>= 2).
+
+    Returns:
+        Sorted indices (M,), 2 <= M <= max(max_points, 2) (M = N when N < 2), holding 0 and N - 1.
+    """
+    pts = np.asarray(points, dtype=float)
+    n = len(pts)
+    if n <= 2:
+        return np.arange(n)
+    max_points = max(int(max_points), 2)
+    tol = max(float(tolerance), 1e-9)
+    while True:
+        keep = np.zeros(n, dtype=bool)
+        keep[0] = keep[-1] = True
+        stack = [(0, n - 1)]
+        while stack:
+            a, b = stack.pop()
+            if b <= a + 1:
+                continue
+            rel = pts[a + 1 : b] - pts[a]
+            chord = pts[b] - pts[a]
+            length = float(np.linalg.norm(chord))
+            if length < 1e-12:
+                dist = np.linalg.norm(rel, axis=1)
+            else:
+                dist = np.linalg.norm(np.cross(rel, chord / length), axis=1)
+            k = int(np.argmax(dist))
+            if dist[k] > tol:
+                i = a + 1 + k
+                keep[i] = True
+                stack.append((a, i))
+                stack.append((i, b))
+        idx = np.flatnonzero(keep)
+        if len(idx) <= max_points:
+            return idx
+        tol *= 2.0
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """[start, stop) index ranges where ``mask`` is true."""
+    m = np.concatenate([[False], np.asarray(mask, dtype=bool), [False]])
+    edges = np.flatnonzero(np.diff(m.astype(np.int8)))
+    return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
+
+
+class PathOverlay:
+    """Trails and bead of one run, ready to be added to a scene at any time.
+
+    Args:
+        record: The run; uses ``tcp_pos_ref``, ``tcp_pos`` and ``arc_on`` when present.
+        style: Colours and sizes.
+    """
+
+    def __init__(self, record: RunRecord, style: OverlayStyle | None = None) -> None:
+        self.style = style or OverlayStyle()
+        self.t = record.t
+        n_max = self.style.max_segments + 1
+        self.reference: np.ndarray | None = None
+        if record.has("tcp_pos_ref"):
+            ref = record.get("tcp_pos_ref").astype(float)
+            self.reference = ref[simplify_polyline(ref, self.style.tolerance, n_max)]
+        self.actual: np.ndarray | None = None
+        self.actual_t: np.ndarray | None = None
+        self._actual_full: np.ndarray | None = None
+        self.bead_runs: list[tuple[np.ndarray, np.ndarray, float, float]] = []
+        if record.has("tcp_pos"):
+            act = record.get("tcp_pos").astype(float)
+            self._actual_full = act
+            idx = simplify_polyline(act, self.style.tolerance, n_max)
+            self.actual, self.actual_t = act[idx], self.t[idx]
+            if record.has("arc_on"):
+                arc = record.get("arc_on").astype(bool)
+                runs = _runs(arc)
+                lengths = [
+                    float(np.linalg.norm(np.diff(act[a:b], axis=0), axis=1).sum()) for a, b in runs
+                ]
+                total = sum(lengths) or 1.0
+                for (a, b), length in zip(runs, lengths):
+                    share = max(2, int(n_max * length / total))
+                    sub = a + simplify_polyline(act[a:b], self.style.tolerance, share)
+                    t_end = float(self.t[b]) if b < len(self.t) else float(self.t[-1])
+                    self.bead_runs.append((act[sub], self.t[sub], float(self.t[a]), t_end))
+
+    @property
+    def max_geoms(self) -> int:
+        """Most geoms :meth:`add_to_scene` adds in one call."""
+        n = 0
+        if self.reference is not None:
+            n += len(self.reference)
+        if self.actual is not None:
+            n += len(self.actual) + 1
+        n += sum(len(p) + 1 for p, _, _, _ in self.bead_runs)
+        return n
+
+    def add_to_scene(self, scene: Any, time: float, height: int, geoms: Any = None) -> int:
+        """Appends the overlay at ``time`` to ``scene`` (after ``mjv_updateScene``).
+
+        Args:
+            scene: The ``mujoco.MjvScene`` (its camera must be set: uses ``scene.camera[0]``).
+            time: Frame time, s.
+            height: Image height, pixels (line widths and the bead's smallest size).
+            geoms: ``scene.geoms`` cached by the caller (building it is costly), or None.
+
+        Returns:
+            Number of geoms added (stops silently at ``scene.maxgeom``).
+        """
+        import mujoco
+
+        st = self.style
+        cam = scene.camera[0]
+        eye = np.array(cam.pos, dtype=float)
+        span = (cam.frustum_top - cam.frustum_bottom) / max(height, 1)
+        ortho = bool(cam.orthographic)
+        near = max(float(cam.frustum_near), 1e-9)
+        line_px = st.line_px if st.line_px is not None else max(1.5, 1.5 * height / 240.0)
+        if geoms is None:
+            geoms = scene.geoms
+        room = scene.maxgeom - scene.ngeom
+        added = 0
+        eye3 = np.zeros(3)
+        mat = np.eye(3).ravel()
+
+        def lifted(points: np.ndarray, lift: float) -> np.ndarray:
+            v = eye - points
+            d = np.linalg.norm(v, axis=1, keepdims=True)
+            d = np.maximum(d, 1e-9)
+            return points + v / d * np.minimum(lift, 0.25 * d)
+
+        def polyline(points: np.ndarray, gtype: int, rgba: tuple, widths: np.ndarray | float,
+                     emission: float) -> None:
+            nonlocal added
+            rgba32 = np.asarray(rgba, dtype=np.float32)
+            w = np.broadcast_to(np.asarray(widths, dtype=float), (max(len(points) - 1, 0),))
+            for k in range(len(points) - 1):
+                if added >= room:
+                    return
+                g = geoms[scene.ngeom]
+                mujoco.mjv_initGeom(g, gtype, eye3, eye3, mat, rgba32)
+                g.emission = emission
+                g.castshadow = 0
+                mujoco.mjv_connector(g, gtype, float(w[k]), points[k], points[k + 1])
+                scene.ngeom += 1
+                added += 1
+
+        # Weld bead: capsules along the actual path where the arc was on, up to `time`.
+        for pts, pts_t, t_start, t_end in self.bead_runs:
+            if time < t_start:
+                continue
+            k = int(np.searchsorted(pts_t, time, side="right"))
+            path = pts[:k]
+            if time < t_end and self._actual_full is not None:
+                path = np.vstack([path, interp_rows(self.t, self._actual_full, time)])
+            if len(path) < 2:
+                continue
+            mid = 0.5 * (path[1:] + path[:-1])
+            dist = np.linalg.norm(mid - eye, axis=1)
+            px = span if ortho else dist * span / near  # metres per pixel at each segment
+            radius = np.maximum(st.bead_radius, 0.5 * st.bead_min_px * px)
+            polyline(path, mujoco.mjtGeom.mjGEOM_CAPSULE, st.bead_rgba, radius, 0.35)
+        # Reference path, whole.
+        if self.reference is not None:
+            polyline(lifted(self.reference, st.lift_reference), mujoco.mjtGeom.mjGEOM_LINE,
+                     st.reference_rgba, line_px, 1.0)
+        # Actual path up to `time`.
+        if self.actual is not None and self._actual_full is not None:
+            k = int(np.searchsorted(self.actual_t, time, side="right"))
+            path = np.vstack([self.actual[:k], interp_rows(self.t, self._actual_full, time)])
+            polyline(lifted(path, st.lift_actual), mujoco.mjtGeom.mjGEOM_LINE, st.actual_rgba,
+                     line_px, 1.0)
+        return added
+
+
+# ----------------------------------------------------------------------------------------
+# Caption
+
+
+@lru_cache(maxsize=8)
+def _font(size: int) -> Any:
+    from PIL import ImageFont
+
+    spec = importlib.util.find_spec("matplotlib")
+    if spec is not None and spec.submodule_search_locations:
+        ttf = (
+            Path(list(spec.submodule_search_locations)[0])
+            / "mpl-data" / "fonts" / "ttf" / "DejaVuSansMono.ttf"
+        )
+        if ttf.is_file():
+            return ImageFont.truetype(str(ttf), size)
+    return ImageFont.load_default(size=size)
+
+
+def caption_text(record: RunRecord, time: float) -> str:
+    """Caption of the frame at ``time``: time, phase, highest |joint torque|, arc/suction.
+
+    Args:
+        record: The run.
+        time: Frame time, s.
+
+    Returns:
+        One line, e.g. ``"t=1.20 s  weld  |tau|max j2 23.4 N m  ARC"``.
+    """
+    t = record.t
+    i = sample_index(t, time)
+    parts = [f"t={time - record.t0:6.2f} s"]
+    if record.has("phase") and record.phases:
+        parts.append(record.phase_name(int(record.get("phase")[i])))
+    if record.has("tau") and record.joints:
+        tau = interp_rows(t, record.get("tau"), time)
+        j = int(np.argmax(np.abs(tau)))
+        parts.append(f"|tau|max {record.joints[j]} {abs(float(tau[j])):6.1f} N m")
+    if record.has("arc_on") and bool(record.get("arc_on")[i]):
+        parts.append("ARC")
+    if record.has("suction") and bool(record.get("suction")[i]):
+        parts.append("SUCTION")
+    return "  ".join(parts)
+
+
+def draw_caption(frame: np.ndarray, text: str) -> None:
+    """Draws ``text`` in a darkened strip along the top of ``frame`` (in place).
+
+    Args:
+        frame: RGB image (H, W, 3) uint8, C-contiguous.
+        text: One line of text; the font size follows the image height (about 4 %), shrunk
+            (down to 7 px) and then the text cut to fit the width.
+    """
+    from PIL import Image, ImageDraw
+
+    height, width = frame.shape[:2]
+    size = max(9, int(round(height * 0.04)))
+    while size > 7 and _font(size).getlength(text) > width - size:
+        size -= 1  # narrow frames: smaller font, then cut the text
+    font = _font(size)
+    while text and font.getlength(text) > width - 2:
+        text = text[:-1]
+    strip_h = min(height, int(size * 1.6))
+    strip = frame[:strip_h]
+    strip[:] = (strip.astype(np.uint16) * 2 // 5).astype(np.uint8)
+    image = Image.fromarray(strip)
+    x = min(max(2, size // 2), max(0, int(width - 2 - font.getlength(text))))
+    ImageDraw.Draw(image).text((x, (strip_h - size) // 2), text, fill=(255, 255, 255), font=font)
+    strip[:] = np.asarray(image)
