@@ -1,0 +1,173 @@
+"""`cellsim ik` and `cellsim workspace`: outputs, JSON shape, exit codes, bad input."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sim.cli import main
+from sim.kinematics.model import closed_form_model, kinematic_model
+from sim.kinematics.rotations import euler_zyx_to_matrix, matrix_to_euler_zyx
+from sim.robots import ROBOTS
+
+ALL_ROBOTS = sorted(ROBOTS)
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _run(capsys, *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _pose_args(name: str, q: np.ndarray) -> list[str]:
+    T = kinematic_model(name).fk(q)
+    a, b, g = np.rad2deg(matrix_to_euler_zyx(T[:3, :3]))
+    return [*(f"{v:.12f}" for v in 1e3 * T[:3, 3]), "--euler-zyx-deg",
+            *(f"{v:.12f}" for v in (a, b, g))]
+
+
+@pytest.mark.parametrize("name", ALL_ROBOTS)
+def test_ik_json_round_trip(capsys, name):
+    m = kinematic_model(name)
+    q = np.deg2rad([10.0, 20.0, -15.0, 25.0, 30.0, 40.0][: m.n_joints])
+    code, out, err = _run(capsys, "ik", name, *_pose_args(name, q), "--all", "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert set(doc) == {"robot", "solutions"} and doc["robot"] == name
+    assert len(doc["solutions"]) >= 2
+    for s in doc["solutions"]:
+        assert set(s) == {"joints_deg", "within_limits"}
+        assert isinstance(s["within_limits"], bool) and len(s["joints_deg"]) == m.n_joints
+        np.testing.assert_allclose(m.fk(np.deg2rad(s["joints_deg"])), m.fk(q), atol=1e-9)
+    # the source configuration (home is close to it, it is inside the ranges) ranks first
+    np.testing.assert_allclose(doc["solutions"][0]["joints_deg"], np.rad2deg(q), atol=1e-6)
+    # without --all only the best one
+    code, out, _ = _run(capsys, "ik", name, *_pose_args(name, q), "--json")
+    assert code == 0 and len(json.loads(out)["solutions"]) == 1
+
+
+def test_ik_text_seed000_table2_point1(capsys):
+    """Seed 000 Table 2 point 1 -> Table 3 row 1 (q2 28.79, q3 -1.2, q4 2.41 deg, within 0.35)."""
+    code, out, err = _run(capsys, "ik", "lrmate100ib", "660.56", "0", "5.17",
+                          "--euler-zyx-deg", "0", "30", "0")
+    assert code == 0, err
+    line = [ln for ln in out.splitlines() if ln.strip().startswith("1:")][0]
+    q = [float(v) for v in line.split(":")[1].split()[:5]]
+    np.testing.assert_allclose(q, [0.0, 28.79, -1.2, 2.41, 0.0], atol=0.35)
+    assert "within limits" in line
+    assert err == ""
+
+
+def test_ik_5axis_disagreeing_alpha_note(capsys):
+    m = kinematic_model("lrmate100ib")
+    q = np.deg2rad([30.0, 20.0, -10.0, 15.0, 5.0])
+    T = m.fk(q)
+    x, y, z = 1e3 * T[:3, 3]
+    code, out, err = _run(capsys, "ik", "lrmate100ib", f"{x}", f"{y}", f"{z}",
+                          "--euler-zyx-deg", "0", "25", "5", "--json")
+    assert code == 0
+    assert err.count("\n") == 1 and "implied by the position" in err and "30.000" in err
+    best = np.deg2rad(json.loads(out)["solutions"][0]["joints_deg"])
+    np.testing.assert_allclose(m.fk(best), T, atol=1e-9)
+    # a consistent A gives no note
+    code, out, err = _run(capsys, "ik", "lrmate100ib", f"{x}", f"{y}", f"{z}",
+                          "--euler-zyx-deg", "30", "25", "5")
+    assert code == 0 and err == ""
+
+
+def test_ik_default_orientation_is_home(capsys):
+    m = kinematic_model("lrmate200ic5l")
+    p = 1e3 * m.fk(np.zeros(6))[:3, 3]
+    code, out, err = _run(capsys, "ik", "lrmate200ic5l", *(f"{v:.9f}" for v in p), "--json")
+    assert code == 0
+    q = np.deg2rad(json.loads(out)["solutions"][0]["joints_deg"])
+    np.testing.assert_allclose(q, 0.0, atol=1e-9)
+    assert "wrist singularity" in err  # home has theta5 = 0
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["ik", "lrmate300", "1", "2", "3"], "lrmate100ib, lrmate200ic5l, robot_5r"),
+    (["ik", "robot_5r", "1", "2", "nan"], "Z must be a finite number"),
+    (["ik", "robot_5r", "1", "2", "3", "--euler-zyx-deg", "0", "inf", "0"], "B must be a finite"),
+    (["ik", "lrmate200ic5l", "2000", "0", "300"], "mm outside"),
+    (["workspace", "robot_6r"], "unknown robot"),
+    (["workspace", "robot_5r", "--out", "picture.jpg"], ".png"),
+])
+def test_bad_input_exit_2(capsys, argv, needle):
+    code, out, err = _run(capsys, *argv)
+    assert code == 2
+    assert needle in err and err.count("\n") == 1 and out == ""
+
+
+@pytest.mark.parametrize("argv", [["ik", "robot_5r", "1", "2"],
+                                  ["ik", "robot_5r", "1", "2", "3", "4"],
+                                  ["ik", "robot_5r", "1", "2", "x"],
+                                  ["ik", "robot_5r", "1", "2", "3", "--euler-zyx-deg", "1", "2"]])
+def test_wrong_number_of_values_argparse_exit_2(capsys, argv):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+
+
+def test_python_m_sim_ik_subprocess():
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    ok = subprocess.run([sys.executable, "-m", "sim", "ik", "lrmate100ib", "428.36", "0",
+                         "-426.53", "--euler-zyx-deg", "0", "90", "0", "--json"],
+                        capture_output=True, text=True, cwd=REPO, env=env, timeout=120)
+    assert ok.returncode == 0, ok.stderr
+    doc = json.loads(ok.stdout)
+    q = doc["solutions"][0]["joints_deg"]
+    # seed 000 Table 3 row 3: q2 86.38, q3 -3.62, q4 7.24
+    np.testing.assert_allclose(q, [0.0, 86.38, -3.62, 7.24, 0.0], atol=0.35)
+    bad = subprocess.run([sys.executable, "-m", "sim", "ik", "nosuchrobot", "1", "2", "3"],
+                         capture_output=True, text=True, cwd=REPO, env=env, timeout=120)
+    assert bad.returncode == 2 and "known: lrmate100ib" in bad.stderr
+    bad = subprocess.run([sys.executable, "-m", "sim", "ik", "robot_5r", "1"],
+                         capture_output=True, text=True, cwd=REPO, env=env, timeout=120)
+    assert bad.returncode == 2
+
+
+def test_workspace_png_and_reach(capsys, tmp_path):
+    out_png = tmp_path / "ws.png"
+    code, out, err = _run(capsys, "workspace", "lrmate200ic5l", "--out", str(out_png))
+    assert code == 0, err
+    data = out_png.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000
+    line = [ln for ln in out.splitlines() if "wrist centre" in ln][0]
+    reach_mm = float(line.split(":")[1].split("mm")[0])
+    # seed 004 Table 2: reach 892 mm = d2 + d3 + sqrt(R4^2 + d4^2) (the ranges allow it)
+    assert reach_mm == pytest.approx(892.0, abs=0.5)
+
+
+def test_reach_definition_against_closed_form():
+    from sim.kinematics.workspace import compute_reach
+
+    m = closed_form_model("lrmate200ic5l")
+    m.lower = m.upper = None
+    d = m.dims
+    r = compute_reach(m)
+    assert r.wrist == pytest.approx(d["d2"] + d["d3"] + np.hypot(d["R4"], d["d4"]), abs=1e-6)
+    assert r.tcp == pytest.approx(r.wrist + d["R6"], abs=1e-6)
+    m5 = closed_form_model("robot_5r")
+    m5.lower = m5.upper = None
+    d5 = m5.dims
+    r5 = compute_reach(m5)
+    # |J2 -> wrist|^2 = d1^2 + l2^2 - 2 d1 l2 sin q3: longest at q3 = -90 deg
+    assert r5.wrist == pytest.approx(d5["l1"] + d5["d1"] + d5["l2"], abs=1e-6)
+    assert r5.tcp == pytest.approx(r5.wrist + d5["l3"], abs=1e-6)
+    # the configurations attain what they claim
+    assert np.hypot(*m5.fk(r5.q_tcp)[:2, 3]) == pytest.approx(r5.tcp, abs=1e-9)
+
+
+def test_euler_helpers_round_trip():
+    rng = np.random.default_rng(0)
+    for a, b, g in rng.uniform([-3, -1.5, -3], [3, 1.5, 3], size=(20, 3)):
+        np.testing.assert_allclose(matrix_to_euler_zyx(euler_zyx_to_matrix(a, b, g)), [a, b, g],
+                                   atol=1e-12)
