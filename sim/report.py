@@ -278,6 +278,13 @@ def sizing_charts(result: SizingResult) -> dict[str, bytes]:
 # Markdown and HTML
 # --------------------------------------------------------------------------------------------
 
+def _pct(m: float) -> str:
+    """A margin in percent: one decimal, more when it is small (so a fail never reads -0.0)."""
+    if m is None or not np.isfinite(m):
+        return "n/a"
+    return f"{m:.1f}" if abs(m) >= 1 else f"{m:.2g}"
+
+
 def _f(x: float, digits: int = 4) -> str:
     return f"{x:.{digits}g}" if x is not None and np.isfinite(x) else "n/a"
 
@@ -300,15 +307,15 @@ def _table_cells(j: JointSizing) -> list[str]:
     return [j.joint, _pair(j, "peak_torque"), _pair(j, "rms_torque"), _pair(j, "peak_speed"),
             _pair(j, "peak_power"), _pair(j, "energy"), _pair(j, "peak_torque", True),
             _pair(j, "rms_torque", True), _pair(j, "peak_speed_rpm", True),
-            lim.title if lim else "n/a", f"{j.margin_pct:.1f}" if np.isfinite(j.margin_pct) else "n/a",
-            "PASS" if j.passed else "FAIL"]
+            (lim.title if lim else "n/a") + (" (simulated torque saturated)" if j.saturated else ""),
+            _pct(j.margin_pct), "PASS" if j.passed else "FAIL"]
 
 
 def _checks_cells(j: JointSizing) -> list[list[str]]:
     rows = []
     for c in j.checks:
         rows.append([j.joint, c.title, f"{_f(c.used)} {c.unit}", f"{_f(c.limit)} {c.unit}",
-                     f"{c.margin_pct:.1f}" if np.isfinite(c.margin_pct) else "n/a", c.source,
+                     _pct(c.margin_pct), c.source,
                      "PASS" if c.passed else "FAIL"])
     return rows
 

@@ -351,6 +351,23 @@ class SizingResult:
         finite = [j for j in self.joints if np.isfinite(j.margin_pct)]
         return min(finite, key=lambda j: j.margin_pct) if finite else None
 
+    @property
+    def hardest_joint(self) -> str | None:
+        """Name of the joint with the smallest margin (None when no joint had a limit)."""
+        h = self.hardest
+        return h.joint if h else None
+
+    @property
+    def hardest_margin_pct(self) -> float:
+        """Smallest margin over all joints, percent (NaN when no joint had a limit)."""
+        h = self.hardest
+        return h.margin_pct if h else float("nan")
+
+    @property
+    def all_pass(self) -> bool:
+        """Alias of :attr:`passed`."""
+        return self.passed
+
     def joint(self, name: str) -> JointSizing:
         for j in self.joints:
             if j.joint == name:
@@ -963,6 +980,11 @@ def size_run(run_dir: str | Path, spec: RobotSpec, drives: Sequence[Drive] | Non
 _SOURCE_SHORT = {"id": "inverse dynamics", "sim": "simulated"}
 
 
+def _pct(m: float) -> str:
+    """A margin in percent: one decimal, two significant digits below 1 % (never "-0.0")."""
+    return f"{m:.1f}" if abs(m) >= 1 else f"{m:.2g}"
+
+
 def _fmt(x: float, unit: str) -> str:
     if not np.isfinite(x):
         return "n/a"
@@ -989,12 +1011,12 @@ def verdict_text(result: SizingResult) -> str:
     failed = [j for j in result.joints if not j.passed]
     if not failed:
         text = (f"PASS: all {n} joints are within their limits on {basis}. The hardest joint is "
-                f"{hardest.joint}, margin {hardest.margin_pct:.1f}% on {detail}.")
+                f"{hardest.joint}, margin {_pct(hardest.margin_pct)}% on {detail}.")
     else:
         worst = ", ".join(f"{j.joint} ({j.limiting.title if j.limiting else '?'}, "
-                          f"{j.margin_pct:.1f}%)" for j in sorted(failed, key=lambda j: j.margin_pct))
+                          f"{_pct(j.margin_pct)}%)" for j in sorted(failed, key=lambda j: j.margin_pct))
         text = (f"FAIL: {len(failed)} of {n} joints exceed a limit on {basis}: {worst}. The hardest "
-                f"joint is {hardest.joint}, margin {hardest.margin_pct:.1f}% on {detail}.")
+                f"joint is {hardest.joint}, margin {_pct(hardest.margin_pct)}% on {detail}.")
     sat = [j.joint for j in result.joints if j.saturated]
     if sat:
         text += (f" The simulated actuator torque reached its force range on {', '.join(sat)}: "

@@ -475,3 +475,33 @@ def test_size_run_rejects_bad_run_folders(tmp_path) -> None:
              tau=z, tau_id=np.zeros((5, 5)))
     with pytest.raises(CellsimError, match="tau_id has shape"):
         load_trajectory(tmp_path)
+
+
+def test_runner_facing_summary_properties() -> None:
+    res = _three_joint_case(forcerange=[[-100, 100]] * 3)
+    assert res.hardest_joint == "j2" and res.hardest_margin_pct == pytest.approx(-20.0)
+    assert res.all_pass is False
+    none = _three_joint_case()
+    assert none.hardest_joint is None and math.isnan(none.hardest_margin_pct) and none.all_pass
+
+
+def test_tiny_negative_margin_never_reads_as_zero() -> None:
+    # 100.2 against 100: margin -0.2 %, must read as a failure, not "-0.0%".
+    res = _three_joint_case(peaks=(100.2, 10.0, 10.0), forcerange=[[-100, 100]] * 3)
+    assert not res.passed
+    assert "-0.2%" in res.verdict and "-0.0%" not in res.verdict
+
+
+@pytest.mark.parametrize("robot", sorted(ROBOTS))
+def test_model_limits_and_armature_convention(robot: str) -> None:
+    # The shipped models: every joint has a finite force range around zero, and the MJCF
+    # armature is the drive's reflected inertia J_r N^2 (sim/robots.py), which size_run
+    # subtracts by default so that the rotor inertia is counted once.
+    import mujoco
+
+    spec = ROBOTS[robot]
+    model = mujoco.MjModel.from_xml_path(str(spec.robot_path))
+    fr = forcerange_from_model(model, spec.joints)
+    assert np.all(np.isfinite(fr)) and np.all(fr[:, 0] < 0) and np.all(fr[:, 1] > 0)
+    arm = armature_from_model(model, spec.joints)
+    assert arm == pytest.approx([d.reflected_inertia for d in spec.drives], rel=1e-9)
