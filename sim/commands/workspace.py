@@ -44,8 +44,8 @@ def run(args: argparse.Namespace) -> int:
         "no joint ranges known: +-180 deg assumed"
     print(f"{spec.title} ({spec.name}), {ranges}")
     print(f"  reach of the wrist centre (max distance from the J1 axis): {1e3 * reach.wrist:.1f} mm"
-          f" at q = {np.array2string(np.rad2deg(reach.q_wrist), precision=1)} deg")
+          f" at q = {np.array2string(np.rad2deg(reach.q_wrist), precision=1, suppress_small=True)} deg")
     print(f"  reach of the tcp (max distance from the J1 axis):          {1e3 * reach.tcp:.1f} mm"
-          f" at q = {np.array2string(np.rad2deg(reach.q_tcp), precision=1)} deg")
+          f" at q = {np.array2string(np.rad2deg(reach.q_tcp), precision=1, suppress_small=True)} deg")
     print(f"  wrote {out}")
     return 0

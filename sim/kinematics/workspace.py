@@ -136,10 +136,10 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
     im = ax1.pcolormesh(np.rad2deg(g2), np.rad2deg(g3), 1e3 * shoulder.T, shading="auto",
                         cmap="viridis")
     fig.colorbar(im, ax=ax1, label="wrist centre distance from J1 axis (signed), mm")
-    ax1.contour(np.rad2deg(g2), np.rad2deg(g3), elbow.T, levels=[0.0], colors="red",
-                linewidths=2)
-    ax1.contour(np.rad2deg(g2), np.rad2deg(g3), shoulder.T, levels=[0.0], colors="white",
-                linewidths=2, linestyles="--")
+    cs_elbow = ax1.contour(np.rad2deg(g2), np.rad2deg(g3), elbow.T, levels=[0.0],
+                           colors="red", linewidths=2)
+    cs_shoulder = ax1.contour(np.rad2deg(g2), np.rad2deg(g3), shoulder.T, levels=[0.0],
+                              colors="white", linewidths=2, linestyles="--")
     ax1.plot([], [], "r-", label=elbow_label)
     ax1.plot([], [], "w--", label=shoulder_label)
     ax1.set_xlabel("theta2 (deg)" if model.family == "fanuc6" else "q2 (deg)")
@@ -155,11 +155,16 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
         P = model.fk(Qt)[:, :3, 3]
         ax2.scatter(1e3 * P[:, 0], 1e3 * P[:, 2], s=0.3, c="tab:blue", alpha=0.3,
                     label="tcp (q4 swept)")
-    for mask, colour, label in ((np.abs(elbow.ravel()) < 4e-3, "red", "elbow singular"),
-                                (np.abs(shoulder.ravel()) < 2e-3, "black", "shoulder singular")):
-        ax2.scatter(1e3 * W[mask, 0], 1e3 * W[mask, 2], s=2, c=colour, label=label)
+    # the singular curves of the left panel mapped into the section (wrist centre, J1 = 0)
+    for cs, style, label in ((cs_elbow, "r-", "elbow singular"),
+                             (cs_shoulder, "k--", "shoulder singular")):
+        for k, seg in enumerate(cs.allsegs[0]):
+            Qs = np.zeros((len(seg), n))
+            Qs[:, 1:3] = np.deg2rad(seg)
+            Ws = wrist_points(model, Qs)
+            ax2.plot(1e3 * Ws[:, 0], 1e3 * Ws[:, 2], style, lw=2, label=label if k == 0 else None)
     ax2.axvline(0.0, color="k", lw=0.5)
-    ax2.axvline(1e3 * reach.wrist, color="green", ls=":", label=f"reach {1e3 * reach.wrist:.1f} mm")
+    ax2.axvline(1e3 * reach.wrist, color="green", ls=":", label=f"wrist-centre reach {1e3 * reach.wrist:.1f} mm")
     ax2.set_aspect("equal")
     ax2.set_xlabel("x in frame0 (mm)")
     ax2.set_ylabel("z in frame0 (mm)")
