@@ -157,11 +157,18 @@ def _pyopengl_platform() -> str | None:
 
 def _activate(backend: str) -> None:
     """Sets the environment and, if mujoco is already imported, rebinds its GLContext."""
-    os.environ["MUJOCO_GL"] = backend
-    bound = _pyopengl_platform()
-    if bound is None:
-        os.environ["PYOPENGL_PLATFORM"] = backend
     gl_module = sys.modules.get("mujoco.rendering.classic.gl_context")
+    current = (str(getattr(gl_module, "_MUJOCO_GL", "")) or "glfw") if gl_module else None
+    bound = _pyopengl_platform()
+    if bound is not None and bound != backend:
+        before = f"mujoco was already imported with MUJOCO_GL={current!r} and " if current else ""
+        raise RenderError(
+            f"{before}PyOpenGL is already bound to the {bound!r} platform, so the {backend!r} "
+            f"backend cannot be used in this process; set MUJOCO_GL={backend} in the environment "
+            "or call sim.gl.configure_gl() before anything imports mujoco or OpenGL"
+        )
+    os.environ["MUJOCO_GL"] = backend
+    os.environ["PYOPENGL_PLATFORM"] = backend
     if gl_module is None:
         if "mujoco" in sys.modules:
             raise RenderError(
@@ -169,17 +176,9 @@ def _activate(backend: str) -> None:
                 "missing; reinstall mujoco"
             )
         return  # mujoco not imported yet: it will read MUJOCO_GL itself
-    current = str(getattr(gl_module, "_MUJOCO_GL", "")) or "glfw"
     context_cls = getattr(gl_module, "GLContext", None)
     if current == backend and context_cls is not None and backend in context_cls.__module__:
         return
-    if bound is not None and bound != backend:
-        raise RenderError(
-            f"mujoco was already imported with MUJOCO_GL={current!r} and PyOpenGL is bound to "
-            f"{bound!r}, so the {backend!r} backend cannot be used in this process; set "
-            f"MUJOCO_GL={backend} in the environment or call sim.gl.configure_gl() before "
-            "anything imports mujoco"
-        )
     try:
         if backend == "egl":
             from mujoco.egl import GLContext as backend_cls
