@@ -31,6 +31,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def _deg(q: np.ndarray) -> str:
+    return np.array2string(np.rad2deg(q), precision=1, suppress_small=True)
+
+
 def run(args: argparse.Namespace) -> int:
     spec = get_robot(args.robot)
     out = Path(args.out or f"workspace_{spec.name}.png")
@@ -44,8 +48,8 @@ def run(args: argparse.Namespace) -> int:
         "no joint ranges known: +-180 deg assumed"
     print(f"{spec.title} ({spec.name}), {ranges}")
     print(f"  reach of the wrist centre (max distance from the J1 axis): {1e3 * reach.wrist:.1f} mm"
-          f" at q = {np.array2string(np.rad2deg(reach.q_wrist), precision=1, suppress_small=True)} deg")
+          f" at q = {_deg(reach.q_wrist)} deg")
     print(f"  reach of the tcp (max distance from the J1 axis):          {1e3 * reach.tcp:.1f} mm"
-          f" at q = {np.array2string(np.rad2deg(reach.q_tcp), precision=1, suppress_small=True)} deg")
+          f" at q = {_deg(reach.q_tcp)} deg")
     print(f"  wrote {out}")
     return 0

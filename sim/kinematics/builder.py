@@ -192,7 +192,7 @@ class KinematicChain:
     # ------------------------------------------------------------------ MJCF
     def _body_frames(self) -> tuple[list[NDArray[np.float64]], list[NDArray[np.float64]],
                                     NDArray[np.float64]]:
-        """Body j pose relative to its parent (frame 0 for j = 1), joint axis in body j, tcp pose."""
+        """Body j pose in its parent (frame 0 for j = 1), joint axis in body j, tcp pose."""
         n = self.n_joints
         if self.convention == "dh":
             fixed = [self.base] + [r.fixed() for r in self.rows]
@@ -315,7 +315,8 @@ def rtt_chain(L1: float = RTT_L1, convention: str = "screw") -> KinematicChain:
         rows = [DHRow(0.0, 0.0, 0.0, 0.0), DHRow(0.0, 0.0, 0.0, -np.pi / 2, "P", (0.0, 1.0)),
                 DHRow(0.0, L1, 0.0, 0.0, "P", lim)]
         return KinematicChain("dh", rows, tool=_rx(np.pi / 2), name="rtt_dh")
-    raise KinematicsError(f"unknown convention {convention!r} for the RTT example; known: dh, screw")
+    raise KinematicsError(
+        f"unknown convention {convention!r} for the RTT example; known: dh, screw")
 
 
 def rrrt_chain(H: float = RRRT_DIMS["H"], L2: float = RRRT_DIMS["L2"],

@@ -81,7 +81,7 @@ class IKSolution:
 
 
 def _annulus_gap(rho: float, r_in: float, r_out: float) -> float:
-    """How far (m) a planar distance ``rho`` lies outside the annulus [r_in, r_out] (<= 0 inside)."""
+    """How far (m) a planar distance ``rho`` is outside the annulus [r_in, r_out] (<= 0 inside)."""
     return max(rho - r_out, r_in - rho)
 
 
@@ -234,14 +234,14 @@ def _ry(a: float) -> NDArray[np.float64]:
 
 # ---------------------------------------------------------------------------- public API
 def ranking_cost(model: KinematicModel, q: ArrayLike, current: ArrayLike) -> float:
-    """Weighted joint distance ``sqrt(sum(((q - current) / v_max)^2))``, s (the ranking criterion)."""
+    """Weighted joint distance ``sqrt(sum(((q - current) / v_max)^2))``, s (ranking criterion)."""
     dq = (np.asarray(q, dtype=float) - np.asarray(current, dtype=float)) / model.max_speed
     return float(np.sqrt(np.sum(dq**2)))
 
 
 def _representations(model: KinematicModel, q: NDArray[np.float64], current: NDArray[np.float64]
                      ) -> list[NDArray[np.float64]]:
-    """Every ``q_i + 2 k pi`` inside the ranges; the one nearest ``current`` when ranges are unknown."""
+    """Each ``q_i + 2 k pi`` inside the ranges; the one nearest ``current`` if ranges are unknown."""
     choices = []
     for i, qi in enumerate(wrap_to_pi(q)):
         if model.lower is None or model.upper is None or not np.isfinite(model.lower[i]) \

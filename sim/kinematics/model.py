@@ -164,7 +164,8 @@ class KinematicModel:
 
 
 def _mdh_batch(alpha: float, d: float, theta: NDArray[np.float64], r: float) -> NDArray[np.float64]:
-    """Vectorized :func:`sim.kinematics.closed_form.mdh_transform` over ``theta`` (N,): (N, 4, 4)."""
+    """Vectorized :func:`sim.kinematics.closed_form.mdh_transform` over ``theta`` (N,): (N, 4, 4).
+    """
     T = np.zeros(theta.shape + (4, 4))
     ca, sa = np.cos(alpha), np.sin(alpha)
     ct, st = np.cos(theta), np.sin(theta)

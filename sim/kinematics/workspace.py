@@ -123,7 +123,8 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
     if model.family == "fanuc6":
         L = np.hypot(d["R4"], d["d4"])
         elbow = (d["R4"] * np.cos(T3) - d["d4"] * np.sin(T3)) / L
-        shoulder = d["d2"] - d["d3"] * np.sin(T2) + d["R4"] * np.cos(T2 + T3) - d["d4"] * np.sin(T2 + T3)
+        shoulder = (d["d2"] - d["d3"] * np.sin(T2) + d["R4"] * np.cos(T2 + T3)
+                    - d["d4"] * np.sin(T2 + T3))
         elbow_label = "eq. 24: R4 c3 - d4 s3 = 0 (elbow)"
         shoulder_label = "eq. 25: wrist centre on J1 axis (shoulder)"
     else:
@@ -164,7 +165,8 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
             Ws = wrist_points(model, Qs)
             ax2.plot(1e3 * Ws[:, 0], 1e3 * Ws[:, 2], style, lw=2, label=label if k == 0 else None)
     ax2.axvline(0.0, color="k", lw=0.5)
-    ax2.axvline(1e3 * reach.wrist, color="green", ls=":", label=f"wrist-centre reach {1e3 * reach.wrist:.1f} mm")
+    ax2.axvline(1e3 * reach.wrist, color="green", ls=":",
+                label=f"wrist-centre reach {1e3 * reach.wrist:.1f} mm")
     ax2.set_aspect("equal")
     ax2.set_xlabel("x in frame0 (mm)")
     ax2.set_ylabel("z in frame0 (mm)")
