@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import multiprocessing
 import os
 import time
 from pathlib import Path
@@ -47,7 +48,8 @@ def fake_runner(variant: Variant) -> Path:
              qd=qd, tau=tau, tau_id=0.99 * tau)
     (run_dir / "summary.json").write_text(json.dumps(
         {"scenario": str(variant.scenario), "joints": JOINTS, "pid": os.getpid()}))
-    time.sleep(0.05)  # long enough for the pool to hand work to every worker
+    if multiprocessing.parent_process() is not None:
+        time.sleep(0.25)  # in a worker: long enough for the pool to hand work to every worker
     return run_dir
 
 
