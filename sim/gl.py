@@ -145,7 +145,7 @@ def active_backend() -> str | None:
 
 
 def _pyopengl_platform() -> str | None:
-    """Platform PyOpenGL is bound to (``"egl"``, ``"osmesa"``, ``"glx"`` ...), or None if not imported."""
+    """Platform PyOpenGL is bound to (``"egl"``, ``"osmesa"``, ``"glx"``...); None before import."""
     if "OpenGL.platform" not in sys.modules:
         return None
     platform = getattr(sys.modules["OpenGL.platform"], "PLATFORM", None)

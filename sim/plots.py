@@ -147,7 +147,8 @@ def tool_path_figure(record: RunRecord) -> Any:
         arc = record.get("arc_on").astype(bool)
         first = True
         for a, b in _runs(arc):
-            ax.plot(*act[a:b].T, color=_BEAD, lw=4.0, alpha=0.8, label="seam (arc on)" if first else None)
+            ax.plot(*act[a:b].T, color=_BEAD, lw=4.0, alpha=0.8,
+                    label="seam (arc on)" if first else None)
             first = False
     knots = _knots(record)
     if knots.size:

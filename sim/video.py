@@ -38,7 +38,9 @@ class VideoResult:
         fps: Frames per second of the video.
         width: Frame width, pixels (tile width x number of cameras).
         height: Frame height, pixels.
-        seconds: Wall-clock time of rendering + encoding, s.
+        seconds: Wall-clock time of the whole call (model load, OpenGL context, ffmpeg start,
+            rendering, encoding), s.
+        loop_seconds: Wall-clock time from the first frame to the encoder's last, s.
         backend: OpenGL backend used.
     """
 
@@ -48,12 +50,18 @@ class VideoResult:
     width: int
     height: int
     seconds: float
+    loop_seconds: float
     backend: str
 
     @property
     def frames_per_second(self) -> float:
-        """Throughput of the whole pipeline, frames per wall-clock second."""
+        """Throughput of the whole call, frames per wall-clock second."""
         return self.frames / self.seconds if self.seconds > 0 else float("inf")
+
+    @property
+    def loop_frames_per_second(self) -> float:
+        """Throughput of the render + encode loop (set-up excluded), frames per second."""
+        return self.frames / self.loop_seconds if self.loop_seconds > 0 else float("inf")
 
 
 class _Encoder:
@@ -167,6 +175,7 @@ def write_video(
                 ffmpeg_log_level="error",
                 output_params=["-crf", str(crf), "-preset", preset, "-movflags", "+faststart"],
             )
+            loop_start = time.perf_counter()
             try:
                 encoder = _Encoder(writer, queue_size)
                 bar = tqdm(total=len(times), unit="frame", desc="render", file=sys.stderr,
@@ -178,8 +187,14 @@ def write_video(
                 finally:
                     bar.close()
                     encoder.finish()
-            finally:
-                writer.close()
+            except BaseException:
+                try:
+                    writer.close()
+                except Exception:  # noqa: BLE001 - keep the first error
+                    pass
+                raise
+            writer.close()  # waits for ffmpeg to encode the last frames
+            loop_seconds = time.perf_counter() - loop_start
             os.replace(tmp, out_path)
             ok = True
         finally:
@@ -187,5 +202,6 @@ def write_video(
                 tmp.unlink()
     return VideoResult(
         path=out_path, frames=len(times), fps=float(fps), width=w, height=h,
-        seconds=time.perf_counter() - started, backend=active_backend() or "",
+        seconds=time.perf_counter() - started, loop_seconds=loop_seconds,
+        backend=active_backend() or "",
     )

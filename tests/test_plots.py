@@ -72,7 +72,8 @@ def test_joint_figure_shows_q_qd_qdd_qddd_and_knots(run_dir: Path) -> None:
             np.testing.assert_array_equal(ref.get_ydata(), record.get(key)[:, j])
             marker = next(line for line in rest if line.get_label() == "knots")
             np.testing.assert_allclose(marker.get_xdata(), knots)
-            np.testing.assert_allclose(marker.get_ydata(), np.interp(knots, t, record.get(key)[:, j]))
+            expected = np.interp(knots, t, record.get(key)[:, j])
+            np.testing.assert_allclose(marker.get_ydata(), expected)
             verticals = [line for line in rest if line.get_xdata()[0] in knots
                          and len(set(line.get_xdata())) == 1]
             assert len(verticals) == len(knots)

@@ -19,7 +19,13 @@ from scipy.spatial.transform import Rotation, Slerp
 import sim.gl as gl
 from sim.errors import RenderError
 from sim.render.interp import QposInterpolator, slerp
-from sim.render.overlay import OverlayStyle, PathOverlay, caption_text, draw_caption, simplify_polyline
+from sim.render.overlay import (
+    OverlayStyle,
+    PathOverlay,
+    caption_text,
+    draw_caption,
+    simplify_polyline,
+)
 from sim.render.run import RunFolderError, RunRecord, load_run
 from sim.render.synthetic import JOINTS, write_synthetic_run
 
@@ -180,7 +186,8 @@ def test_qpos_interpolation_lerp_and_slerp_match_scipy() -> None:
     for time in (0.1, 0.25, 0.4, 0.77):
         got = interp(time)
         for lin in (slice(0, 3), slice(7, 9)):
-            expected = np.array([np.interp(time, t, qpos[:, i]) for i in range(lin.start, lin.stop)])
+            cols = range(lin.start, lin.stop)
+            expected = np.array([np.interp(time, t, qpos[:, i]) for i in cols])
             np.testing.assert_allclose(got[lin], expected, atol=1e-12)
         for sl, ref in ((slice(3, 7), free_slerp), (slice(9, 13), ball_slerp)):
             q = got[sl]
@@ -227,7 +234,8 @@ def test_kinematic_state_matches_mj_forward(run_dir: Path) -> None:
 def test_unknown_camera_lists_the_models_cameras(run_dir: Path) -> None:
     from sim.render.frames import FrameRenderer
 
-    with pytest.raises(RenderError, match=r"unknown camera 'top'; the model's cameras: overview, tool"):
+    message = r"unknown camera 'top'; the model's cameras: overview, tool"
+    with pytest.raises(RenderError, match=message):
         FrameRenderer(run_dir, cameras=("overview", "top"), width=64, height=48)
 
 
@@ -429,7 +437,8 @@ def test_inconsistent_arrays_are_reported(run_dir: Path) -> None:
     arrays = dict(base.arrays)
     arrays["qpos"] = arrays["qpos"][:, :-1]
     record = RunRecord.from_arrays(arrays, joints=base.joints, model_path=base.model_path)
-    with pytest.raises(RunFolderError, match=r"'qpos' has shape \(201, 10\) but model.xml has nq=11"):
+    message = r"'qpos' has shape \(201, 10\) but model.xml has nq=11"
+    with pytest.raises(RunFolderError, match=message):
         FrameRenderer(record, width=32, height=32)
     bad_t = dict(base.arrays)
     bad_t["t"] = bad_t["t"][::-1].copy()

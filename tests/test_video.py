@@ -120,7 +120,8 @@ def test_video_argument_errors(run_dir: Path, tmp_path: Path) -> None:
 
     with pytest.raises(RenderError, match=r"must end in \.mp4"):
         write_video(run_dir, tmp_path / "v.avi")
-    with pytest.raises(RenderError, match="unknown camera 'side'; the model's cameras: overview, tool"):
+    message = "unknown camera 'side'; the model's cameras: overview, tool"
+    with pytest.raises(RenderError, match=message):
         write_video(run_dir, tmp_path / "v.mp4", cameras=("side",), width=64, height=48)
     with pytest.raises(RenderError, match="fps must be a positive"):
         write_video(run_dir, tmp_path / "v.mp4", width=64, height=48, fps=0)

@@ -45,7 +45,8 @@ def validate_size(width: int, height: int) -> None:
             raise RenderError(f"video {name} must be between 16 and {MAX_SIDE} pixels, got {value}")
         if value % 2:
             raise RenderError(
-                f"video {name} must be even for H.264 yuv420p, got {value} (try {value - 1} or {value + 1})"
+                f"video {name} must be even for H.264 yuv420p, got {value} "
+                f"(try {value - 1} or {value + 1})"
             )
 
 

@@ -252,7 +252,9 @@ def _phase(item: Phase | Mapping[str, Any], where: str) -> Phase:
     if isinstance(item, Phase):
         return item
     try:
-        return Phase(str(item["name"]), str(item.get("kind", "")), float(item["t0"]), float(item["t1"]))
+        return Phase(
+            str(item["name"]), str(item.get("kind", "")), float(item["t0"]), float(item["t1"])
+        )
     except (KeyError, TypeError, ValueError) as exc:
         raise RunFolderError(
             f"{where}: each phase needs 'name', 't0', 't1' (got {dict(item)!r})"
