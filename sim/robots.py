@@ -10,9 +10,11 @@ model folder and ``../shared/reference/robots.md``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from sim.errors import UnknownNameError
 from sim.resources import models_dir
@@ -107,8 +109,18 @@ ROBOTS: dict[str, RobotSpec] = {
             # seed 000 Table 2 point 0 fixes d1 and l1+l2+l3; split after the RoboDK table
             # (../shared/reference/robots.md); l3 = 80 mm flange + 145 mm torch.
             dims={"l1": 0.150, "d1": 0.250, "l2": 0.220, "l3": 0.225},
-            max_speed=_deg(240, 270, 270, 330, 480),  # provisional; see model README
+            # as commonly quoted for the LR Mate 100iB/200iB family (estimate, see model README)
+            max_speed=_deg(240, 270, 270, 330, 480),
             description="5-axis FANUC LR Mate 100iB (seed 000), 5 kg payload",
+            # estimated beta-iS class motors (0.2-0.75 kW) + harmonic reducers; the README of
+            # the model lists the sizing criteria (speed, gravity torque with 5 kg payload)
+            drives=(
+                Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
+                Drive(120, 0.75, 4.5e-5, 1.3, 4.5, 6000),
+                Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
+                Drive(80, 0.70, 5.0e-6, 0.32, 1.0, 5000),
+                Drive(50, 0.70, 3.0e-6, 0.25, 0.8, 5000),
+            ),
         ),
         RobotSpec(
             name="lrmate200ic5l",
@@ -117,8 +129,17 @@ ROBOTS: dict[str, RobotSpec] = {
             robot_file="lrmate200ic5l.xml",
             family="fanuc6",
             dims={"d2": 0.075, "d3": 0.400, "d4": 0.075, "R4": 0.410, "R6": 0.080},
-            max_speed=_deg(270, 270, 270, 450, 450, 720),
+            max_speed=_deg(270, 270, 270, 450, 450, 720),  # ROS-Industrial URDF
             description="6-axis FANUC LR Mate 200iC/5L (seed 004), 5 kg payload",
+            # estimated beta-iS class motors (0.2-0.75 kW) + harmonic reducers (model README)
+            drives=(
+                Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
+                Drive(120, 0.75, 4.5e-5, 1.3, 4.5, 6000),
+                Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
+                Drive(75, 0.70, 5.0e-6, 0.32, 1.0, 6000),
+                Drive(75, 0.70, 5.0e-6, 0.32, 1.0, 6000),
+                Drive(48, 0.70, 3.0e-6, 0.25, 0.8, 6000),
+            ),
         ),
         RobotSpec(
             name="robot_5r",
@@ -126,12 +147,54 @@ ROBOTS: dict[str, RobotSpec] = {
             folder="robot_5r",
             robot_file="robot_5r.xml",
             family="5r",
-            dims={"l1": 0.200, "d1": 0.900, "l2": 0.800, "l3": 0.350},  # provisional
-            max_speed=_deg(150, 150, 180, 300, 300),  # provisional
+            # chosen for seed 001's cell (models/robot_5r/README.md): l3 = 100 mm flange +
+            # 300 mm torch; long upper arm, short forearm for a large seam radius
+            dims={"l1": 0.250, "d1": 1.000, "l2": 0.600, "l3": 0.400},
+            max_speed=_deg(150, 150, 180, 300, 450),  # estimate for the 1.8-2 m reach class
             description="5-axis welding robot for large cylindrical parts (seed 001)",
+            # estimated alpha-iS class motors (1-3 kW) + cycloidal/harmonic reducers
+            drives=(
+                Drive(160, 0.80, 1.2e-3, 8.0, 32.0, 4000),
+                Drive(160, 0.80, 2.3e-3, 12.0, 46.0, 4000),
+                Drive(150, 0.80, 5.2e-4, 4.0, 15.0, 5000),
+                Drive(90, 0.75, 2.9e-4, 2.0, 7.8, 5000),
+                Drive(60, 0.75, 1.0e-4, 1.0, 4.0, 5000),
+            ),
         ),
     )
 }
+
+
+@lru_cache(maxsize=None)
+def _mjcf_ranges(path: str, joints: tuple[str, ...]) -> tuple[tuple[float, float], ...]:
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_path(path)
+    out = []
+    for j in joints:
+        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j)
+        if jid < 0:
+            raise UnknownNameError("joint", j, joints)
+        lo, hi = model.jnt_range[jid]
+        out.append((float(lo), float(hi)) if model.jnt_limited[jid] else (-np.inf, np.inf))
+    return tuple(out)
+
+
+def joint_ranges(robot: str | RobotSpec) -> NDArray[np.float64]:
+    """Joint position ranges read from the robot's MJCF (the single source of truth).
+
+    Args:
+        robot: Registry name or spec.
+
+    Returns:
+        Array of shape (n_joints, 2): lower and upper limit of joints ``j1..jN``, rad, in the
+        seed's convention (MuJoCo qpos equals the seed's joint value).
+
+    Raises:
+        UnknownNameError: Unknown robot name.
+    """
+    spec = robot if isinstance(robot, RobotSpec) else get_robot(robot)
+    return np.array(_mjcf_ranges(str(spec.robot_path), spec.joints), dtype=float)
 
 
 def get_robot(name: str) -> RobotSpec:
