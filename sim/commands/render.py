@@ -44,7 +44,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="re-render a finished run (RUN_DIR) into an MP4 video, without simulating",
         description="Render the recorded states of a finished run (RUN_DIR/model.xml and "
                     "RUN_DIR/trajectory.npz) into an H.264 MP4: tool-point reference path "
-                    "(green), actual path (red), weld bead (orange), caption with time, phase "
+                    "(green), actual path (red), weld bead (gold), caption with time, phase "
                     "and the highest joint torque. Several --camera views are tiled side by side.",
     )
     p.add_argument("run_dir", metavar="RUN_DIR", help="folder written by `cellsim run`")

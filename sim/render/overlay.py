@@ -54,10 +54,10 @@ class OverlayStyle:
 
     reference_rgba: tuple[float, float, float, float] = (0.10, 0.85, 0.20, 1.0)
     actual_rgba: tuple[float, float, float, float] = (1.0, 0.08, 0.08, 1.0)
-    bead_rgba: tuple[float, float, float, float] = (1.0, 0.55, 0.05, 1.0)
+    bead_rgba: tuple[float, float, float, float] = (1.0, 0.72, 0.15, 1.0)
     line_px: float | None = None
     bead_radius: float = 0.004
-    bead_min_px: float = 3.0
+    bead_min_px: float = 5.0
     lift_reference: float = 0.015
     lift_actual: float = 0.02
     tolerance: float = 0.001
