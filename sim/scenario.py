@@ -341,6 +341,45 @@ class Scenario:
     def sha256(self) -> str:
         return hashlib.sha256(self.text.encode()).hexdigest()
 
+    def scaled(self, speed_scale: float = 1.0, payload_kg: float | None = None) -> "Scenario":
+        """This scenario run ``speed_scale`` times faster, optionally with another payload.
+
+        Knot times, segment durations, hold durations and action times are divided by
+        ``speed_scale``; Cartesian speeds are multiplied by it (sampling periods and ramps
+        divided), and boundary velocities, accelerations and jerks scale by its 1st, 2nd and 3rd
+        power, so the joint paths are the same, traversed faster. Without gravity, friction and
+        damping, joint torques then scale exactly as ``speed_scale**2``.
+
+        Raises:
+            ScenarioError: ``speed_scale`` not positive, or negative ``payload_kg``.
+        """
+        import dataclasses
+
+        if not (np.isfinite(speed_scale) and speed_scale > 0):
+            raise ScenarioError(f"speed scale must be a positive number, got {speed_scale!r}")
+        if payload_kg is not None and not (np.isfinite(payload_kg) and payload_kg >= 0):
+            raise ScenarioError(f"payload_kg must be >= 0, got {payload_kg!r}")
+        s = float(speed_scale)
+        order = {"v": 1, "a": 2, "j": 3}
+        phases: list[Phase] = []
+        for p in self.phases:
+            if isinstance(p, JointPhase):
+                phases.append(dataclasses.replace(
+                    p, times=None if p.times is None else p.times / s,
+                    durations=p.durations / s,
+                    boundary={k: v * s ** order[k[0]] for k, v in p.boundary.items()}))
+            elif isinstance(p, CartesianPhase):
+                phases.append(dataclasses.replace(
+                    p, speed=p.speed * s, sample_period=p.sample_period / s,
+                    ramp=None if p.ramp is None else p.ramp / s))
+            else:
+                phases.append(dataclasses.replace(p, duration=p.duration / s))
+        actions = tuple(dataclasses.replace(a, time=None if a.time is None else a.time / s)
+                        for a in self.actions)
+        return dataclasses.replace(
+            self, phases=tuple(phases), actions=actions,
+            payload_kg=self.payload_kg if payload_kg is None else float(payload_kg))
+
     @property
     def fixed_timing(self) -> bool:
         """True when every phase is a joint phase with absolute times (no timing to resolve)."""
