@@ -236,4 +236,13 @@ def solve_piecewise(times: NDArray[np.float64], q: NDArray[np.float64], degrees:
     seg_of_col = np.repeat(np.arange(m), degrees + 1)
     pow_of_col = np.arange(n_unknown) - col0[seg_of_col]
     coef[seg_of_col, :, pow_of_col] = x
+    # The coefficients fixed by a single condition (seed 001 section 5, seed 000 after eq. 19
+    # and 22: "determined directly") are set exactly, dropping the solve's rounding:
+    # a_k = value_k t^k / k! at both ends, a_0 = q_{i-1} for the segments in t.
+    for k in range(K + 1):
+        v0 = q[0] if k == 0 else start[k - 1]
+        vm = q[-1] if k == 0 else end[k - 1]
+        coef[0, :, k] = v0 * h[0] ** k / factorial(k)
+        coef[-1, :, k] = vm * h[-1] ** k / factorial(k)
+    coef[1:m - 1, :, 0] = q[1:m - 1]
     return coef
