@@ -18,7 +18,7 @@ The target is ``pipeline >= 0.8 x raw``. Runs unchanged on a GPU machine (EGL) a
 Usage::
 
     python benchmarks/bench_video.py [--run RUN_DIR] [--camera overview] [--frames 90]
-        [--sizes 320x240,640x480,1280x720] [--gl egl|osmesa] [--json OUT.json]
+        [--sizes 320x240,640x480,1280x720] [--gl egl|osmesa] [--repeat N] [--json OUT.json]
 """
 
 from __future__ import annotations
@@ -111,6 +111,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--fps", type=float, default=30.0)
     parser.add_argument("--sizes", type=_sizes, default=_sizes("320x240,640x480,1280x720"))
     parser.add_argument("--gl", choices=("egl", "osmesa"), default=None)
+    parser.add_argument("--repeat", type=int, default=1,
+                        help="measure each variant N times, interleaved, keep the best (noisy hosts)")
     parser.add_argument("--json", type=Path, default=None, help="also write the results here")
     args = parser.parse_args(argv)
 
@@ -137,26 +139,37 @@ def main(argv: list[str] | None = None) -> int:
                   f"{'serial':>7} {'no-ovl':>7}")
         results = []
         for width, height in args.sizes:
-            raw, gl_name = bench_raw(record, args.camera, width, height, times)
+            best: dict[str, float] = {}
+
+            def keep(key: str, value: float) -> None:
+                best[key] = max(best.get(key, 0.0), value)
+
+            for _ in range(max(1, args.repeat)):
+                raw, gl_name = bench_raw(record, args.camera, width, height, times)
+                keep("raw", raw)
+                res = write_video(record, tmp / f"p_{width}.mp4", cameras=(args.camera,),
+                                  width=width, height=height, fps=args.fps)
+                keep("pipeline", res.loop_frames_per_second)
+                keep("e2e", res.frames_per_second)
+                bare = write_video(record, tmp / f"b_{width}.mp4", cameras=(args.camera,),
+                                   width=width, height=height, fps=args.fps, overlay=False,
+                                   caption=False)
+                keep("bare", bare.loop_frames_per_second)
+                keep("serial", bench_serial(record, args.camera, width, height, args.fps,
+                                            tmp / f"s_{width}.mp4"))
             if not results:
                 print(f"# OpenGL renderer: {gl_name}")
                 print(header)
-            res = write_video(record, tmp / f"p_{width}.mp4", cameras=(args.camera,), width=width,
-                              height=height, fps=args.fps)
-            bare = write_video(record, tmp / f"b_{width}.mp4", cameras=(args.camera,), width=width,
-                               height=height, fps=args.fps, overlay=False, caption=False)
-            serial = bench_serial(record, args.camera, width, height, args.fps,
-                                  tmp / f"s_{width}.mp4")
             row = {
-                "width": width, "height": height, "frames": res.frames, "gl_renderer": gl_name,
-                "raw_fps": raw, "pipeline_fps": res.loop_frames_per_second,
-                "ratio": res.loop_frames_per_second / raw,
-                "end_to_end_fps": res.frames_per_second, "serial_fps": serial,
-                "no_overlay_fps": bare.loop_frames_per_second,
+                "width": width, "height": height, "frames": len(times), "gl_renderer": gl_name,
+                "raw_fps": best["raw"], "pipeline_fps": best["pipeline"],
+                "ratio": best["pipeline"] / best["raw"], "end_to_end_fps": best["e2e"],
+                "serial_fps": best["serial"], "no_overlay_fps": best["bare"],
+                "no_overlay_ratio": best["bare"] / best["raw"],
             }
             results.append(row)
-            print(f"{width:>5}x{height:<4} {raw:9.1f} {row['pipeline_fps']:9.1f} "
-                  f"{row['ratio']:6.2f} {row['end_to_end_fps']:7.1f} {serial:7.1f} "
+            print(f"{width:>5}x{height:<4} {row['raw_fps']:9.1f} {row['pipeline_fps']:9.1f} "
+                  f"{row['ratio']:6.2f} {row['end_to_end_fps']:7.1f} {row['serial_fps']:7.1f} "
                   f"{row['no_overlay_fps']:7.1f}", flush=True)
     if args.json:
         args.json.write_text(json.dumps({"backend": backend, "results": results}, indent=1))

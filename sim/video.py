@@ -4,7 +4,8 @@
 ``k = 0 .. floor(duration * fps)`` (so ``floor(duration * fps) + 1`` frames), interpolating
 the recorded states between samples (it does not render every physics step). Frames go
 through a bounded queue to a background thread that feeds imageio's ffmpeg writer
-(imageio-ffmpeg's static ffmpeg, libx264), so encoding overlaps rendering. The file is
+(imageio-ffmpeg's static ffmpeg, libx264), so encoding (and drawing the caption) overlaps
+rendering. The file is
 written under a temporary name in the same folder and renamed when complete; on error or
 interruption the partial file is removed.
 """
@@ -24,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from sim.errors import RenderError
-from sim.render.overlay import OverlayStyle
+from sim.render.overlay import OverlayStyle, draw_caption
 from sim.render.run import RunRecord
 
 
@@ -65,7 +66,11 @@ class VideoResult:
 
 
 class _Encoder:
-    """Background thread appending frames to an imageio writer, fed by a bounded queue."""
+    """Background thread appending frames to an imageio writer, fed by a bounded queue.
+
+    Items are ``(frame, caption)``; a non-empty caption is drawn in this thread (Pillow), in
+    parallel with the next frame's rendering (MuJoCo releases the GIL while rendering).
+    """
 
     _STOP = object()
 
@@ -84,14 +89,17 @@ class _Encoder:
             if self.error is not None:
                 continue  # drain after a failure so put() never blocks forever
             try:
-                self.writer.append_data(item)
+                frame, caption = item
+                if caption:
+                    draw_caption(frame, caption)
+                self.writer.append_data(frame)
             except BaseException as exc:  # noqa: BLE001 - reported to the producer
                 self.error = exc
 
-    def put(self, frame: np.ndarray) -> None:
+    def put(self, frame: np.ndarray, caption: str = "") -> None:
         if self.error is not None:
             raise RenderError(f"video encoding failed: {self.error}") from self.error
-        self.queue.put(frame)
+        self.queue.put((frame, caption))
 
     def finish(self) -> None:
         self.queue.put(self._STOP)
@@ -182,7 +190,9 @@ def write_video(
                            disable=not (progress and sys.stderr.isatty()), leave=False)
                 try:
                     for t in times:
-                        encoder.put(frames.render(float(t)))
+                        t = float(t)
+                        text = frames.caption_at(t) if caption else ""
+                        encoder.put(frames.render(t, caption=False), text)
                         bar.update(1)
                 finally:
                     bar.close()

@@ -80,6 +80,8 @@ def test_video_with_each_available_backend(backend: str, run_dir: Path, tmp_path
         assert diff > 0.1, f"frames {k} and {k + 1} are identical"
     assert _red(frames[-1]).sum() > 20, "the actual-path trail colour is missing in the last frame"
     assert _red(frames[0]).sum() < 5  # nothing travelled at t = 0
+    text = frames[0][: HEIGHT // 10].min(axis=2) > 180  # white caption text on the dark strip
+    assert text.sum() > 10
 
 
 def test_clean_exit_after_an_error_inside_the_render_loop(run_dir: Path, tmp_path: Path) -> None:

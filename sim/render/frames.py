@@ -202,12 +202,20 @@ class FrameRenderer:
         if m.nflex:
             mj.mj_flex(m, d)
 
-    def render(self, time: float, out: np.ndarray | None = None) -> np.ndarray:
+    def caption_at(self, time: float) -> str:
+        """Caption text of the frame at ``time`` (see :func:`~sim.render.overlay.caption_text`)."""
+        return caption_text(self.record, time)
+
+    def render(
+        self, time: float, out: np.ndarray | None = None, *, caption: bool | None = None
+    ) -> np.ndarray:
         """Renders the frame at ``time`` (s).
 
         Args:
             time: Frame time, s (clamped to the record).
             out: Optional C-contiguous uint8 array of :attr:`frame_shape` to fill.
+            caption: Draw the caption; None: as chosen at construction. (The video writer
+                draws it in its encoder thread instead, with :meth:`caption_at`.)
 
         Returns:
             The frame (H, W * n_cameras, 3) uint8.
@@ -228,6 +236,6 @@ class FrameRenderer:
             else:
                 r.render(out=self._tiles[k])
                 out[:, k * self.width : (k + 1) * self.width] = self._tiles[k]
-        if self.caption:
-            draw_caption(out, caption_text(self.record, time))
+        if self.caption if caption is None else caption:
+            draw_caption(out, self.caption_at(time))
         return out
