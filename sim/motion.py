@@ -242,6 +242,43 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     return motion
 
 
+def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True) -> list[str]:
+    """One line per joint limit the reference motion exceeds (position range from the MJCF,
+    speed limits from the robot registry), naming the phase, joint, time, value and limit."""
+    from planners.limits import find_limit_violations
+    from sim.robots import joint_ranges
+
+    rng = joint_ranges(scenario.robot)
+    where = scenario.source.name
+    out = []
+    for pm in motion.phases:
+        if isinstance(pm.trajectory, HoldTrajectory):
+            continue
+        found = find_limit_violations(
+            pm.trajectory, lower=rng[:, 0], upper=rng[:, 1],
+            max_velocity=np.asarray(scenario.robot.max_speed) if speed else None,
+            joint_names=scenario.robot.joints)
+        out += [f"{where}: phases[{pm.phase.index}] ({pm.name}): {v.message()}" for v in found]
+    return out
+
+
+def check_motion_limits(scenario: Scenario, motion: Motion) -> None:
+    """Raise on the first joint-limit violation of the reference motion.
+
+    Position ranges are always enforced (the joint cannot go there); speed limits unless the
+    scenario sets ``simulation.enforce_speed_limits = false`` (the sizing report then shows
+    by how much each joint is over its limit).
+
+    Raises:
+        ScenarioError: One line naming the phase, joint, time, value and limit.
+    """
+    found = limit_violations(scenario, motion,
+                             speed=scenario.simulation.enforce_speed_limits)
+    if found:
+        more = f" (and {len(found) - 1} more)" if len(found) > 1 else ""
+        raise ScenarioError(found[0] + more)
+
+
 def _check_phase_continuity(prev: PhaseMotion, pm: PhaseMotion, label: str,
                             joints: tuple[str, ...]) -> None:
     a = prev.trajectory.at(prev.t1)

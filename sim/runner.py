@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 
 from sim import __version__
 from sim.errors import CellsimError, SimulationError
-from sim.motion import CartesianContext, Motion, build_motion
+from sim.motion import CartesianContext, Motion, build_motion, check_motion_limits
 from sim.scenario import Scenario
 
 #: Steps per rollout chunk (checked for instability after each).
@@ -529,6 +529,7 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
     built = build(scenario)
     _check_tcp_consistency(built, scenario)
     motion = build_motion(scenario, built.context)
+    check_motion_limits(scenario, motion)
 
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))

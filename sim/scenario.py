@@ -154,6 +154,7 @@ class SimulationSpec(_Strict):
     timestep_s: float | None = Field(None, gt=0, le=0.01)
     feedforward: bool = True
     settle_s: float = Field(0.0, ge=0)
+    enforce_speed_limits: bool = True
 
 
 class VideoSpec(_Strict):

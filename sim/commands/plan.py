@@ -1,6 +1,7 @@
 """``cellsim plan SCENARIO``: the planned polynomial coefficients of every phase.
 
-Prints, per phase and joint, each segment's duration and its coefficients in normalized time
+Prints, per phase and joint (hold phases have no polynomial and are left out), each
+segment's duration and its coefficients in normalized time
 (t in [0, 1], the last segment in t_bar = t - 1 in [-1, 0]) and in real time (powers of the
 absolute time tau, s), like seed 000 Tables 4-5. Text output is in degrees as the seeds print
 them; ``--json`` gives radians, ascending powers, in this shape::
@@ -19,7 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from sim.scenario import PlannedPhase, Scenario, load_scenario, plan_scenario
+from sim.motion import HoldTrajectory, Motion, PhaseMotion, build_motion, limit_violations
+from sim.scenario import CartesianPhase, Scenario, load_scenario
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -37,7 +39,21 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def plan_json(scenario: Scenario, planned: list[PlannedPhase]) -> dict[str, Any]:
+def planned_phases(scenario: Scenario) -> list[PhaseMotion]:
+    """The scenario's polynomial phases on one clock (Cartesian ones through the cell's IK)."""
+    context = None
+    if any(isinstance(p, CartesianPhase) for p in scenario.phases):
+        from sim.runner import build
+
+        context = build(scenario).context
+    motion: Motion = build_motion(scenario, context)
+    for line in limit_violations(scenario, motion,
+                                 speed=True):
+        print(f"cellsim: warning: {line}", file=sys.stderr)
+    return [pm for pm in motion.phases if not isinstance(pm.trajectory, HoldTrajectory)]
+
+
+def plan_json(scenario: Scenario, planned: list[PhaseMotion]) -> dict[str, Any]:
     """The ``--json`` document of a planned scenario (coefficients in radians)."""
     phases = []
     for pp in planned:
@@ -57,7 +73,7 @@ def plan_json(scenario: Scenario, planned: list[PlannedPhase]) -> dict[str, Any]
         phases.append({
             "name": pp.phase.name,
             "planner": pp.phase.planner,
-            "time_s": [float(t) for t in pp.phase.times],
+            "time_s": [float(t) for t in knots],
             "joints": joints,
         })
     return {"scenario": scenario.name, "phases": phases}
@@ -74,11 +90,10 @@ def _poly_text(coeffs: np.ndarray, var: str) -> str:
     return " ".join(terms) if terms else "0"
 
 
-def format_plan(scenario: Scenario, planned: list[PlannedPhase]) -> str:
+def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
     """Human-readable tables (degrees), one block per phase and joint."""
     lines = [f"scenario {scenario.name}: robot {scenario.robot.name} "
-             f"({scenario.robot.n_joints} joints), {len(planned)} phase(s), "
-             f"{scenario.duration:g} s",
+             f"({scenario.robot.n_joints} joints), {len(planned)} polynomial phase(s)",
              "coefficients in degrees; normalized time t = (tau - tau_k-1)/t_k, "
              "last segment in t_bar = t - 1; real time in powers of tau [s]"]
     deg = 180.0 / np.pi
@@ -103,7 +118,7 @@ def format_plan(scenario: Scenario, planned: list[PlannedPhase]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
-    planned = plan_scenario(scenario)
+    planned = planned_phases(scenario)
     if args.json:
         json.dump(plan_json(scenario, planned), sys.stdout, indent=1)
         sys.stdout.write("\n")

@@ -1,0 +1,99 @@
+"""`cellsim plan` and `cellsim list` (issue 2 section 3): output shapes, seed values through
+the command line, and one-line errors with exit code 2."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from sim.cli import main
+from sim.resources import shipped_scenarios
+
+
+def _run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "sim", *args], capture_output=True, text=True,
+                          timeout=120)
+
+
+def test_plan_json_shape_and_seed001_joint1(capsys):
+    """JSON shape of the issue; seed 001 eq. 18-20 (joint 1, normalized, rad) through the CLI."""
+    assert main(["plan", "bugnar_5r_phase1", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert set(doc) == {"scenario", "phases"} and doc["scenario"] == "bugnar_5r_phase1"
+    (phase,) = doc["phases"]
+    assert set(phase) == {"name", "planner", "time_s", "joints"}
+    assert phase["planner"] == "434" and phase["time_s"] == [0.0, 3.33, 6.67, 10.0]
+    assert [j["index"] for j in phase["joints"]] == [1, 2, 3, 4, 5]
+    segs = phase["joints"][0]["segments"]
+    assert [set(s) for s in segs] == [{"t0", "t1", "normalized", "real"}] * 3
+    expected = [[0, 0, 0, -0.2985, 0.1659], [-0.1326, -0.2324, 0.1, -0.0002],
+                [-0.2653, 0, 0, 0.0331, 0.0331]]
+    for seg, exp in zip(segs, expected):
+        np.testing.assert_allclose(seg["normalized"], exp, atol=1e-3)
+    # real-time form evaluated at a segment's ends equals the knot values (rad)
+    q1 = np.deg2rad([0, -7.6, -15.2, -15.2])
+    for k, seg in enumerate(segs):
+        b = np.asarray(seg["real"])
+        for tau, q in ((seg["t0"], q1[k]), (seg["t1"], q1[k + 1])):
+            assert np.polyval(b[::-1], tau) == pytest.approx(q, abs=1e-9)
+
+
+def test_plan_text_lists_every_segment(capsys):
+    assert main(["plan", "kacso_lrmate100ib_sequence1"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("segment 1:") == 5 and out.count("segment 3:") == 5
+    assert "t_bar" in out and "tau" in out
+
+
+def test_plan_warns_about_speed_limit(capsys):
+    """Seed 000's sequence drives J2 above the 100iB's 270 deg/s: plan says so on stderr."""
+    assert main(["plan", "kacso_lrmate100ib_sequence1", "--json"]) == 0
+    err = capsys.readouterr().err
+    assert "warning" in err and "joint j2" in err and "velocity" in err
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["plan", "no_such_scenario"], "unknown scenario"),
+    (["plan", "/nonexistent/x.toml"], "no such scenario file"),
+    (["ik", "no_such_robot", "1", "2", "3"], "unknown robot"),
+])
+def test_bad_input_exit_code_2_one_line(args, fragment):
+    res = _run(*args)
+    assert res.returncode == 2, res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and fragment in lines[0], res.stderr
+    assert "Traceback" not in res.stderr
+
+
+@pytest.mark.parametrize("body, fragment", [
+    ("name = 'x'\ndescription = 'd'\nrobot = 'robot_5r'\n[[phases]]\nname='a'\nplanner='434'\n"
+     "time_s=[0,1]\njoints_deg=[[0,0,0,0,0],[1,1,1,1,1]]\n", "at least 3"),
+    ("name = 'x'\ndescription = 'd'\nrobot = 'robot_5r'\n[[phases]]\nname='a'\nplanner='443'\n"
+     "time_s=[0,1,2]\njoints_deg=[[0,0,0,0,0],[1,1,1,1,1],[2,2,2,2,2]]\n", "phases[0].planner"),
+    ("name = 'x'\ndescription = 'd'\nrobot = 'robot_5r'\n[[phases]]\nname='a'\nplanner='434'\n"
+     "time_s=[0,1,0.5]\njoints_deg=[[0,0,0,0,0],[1,1,1,1,1],[2,2,2,2,2]]\n", "must increase"),
+    ("name = 'x'\ndescription = 'd'\nrobot = 'robot_5r'\n[[phases]]\nname='a'\nplanner='434'\n"
+     "time_s=[0,1,2]\njoints_deg=[[0,0,0,0,0],[1,1,1,1],[2,2,2,2,2]]\n", "joints_deg[1]"),
+    ("name = 'x'\ndescription = 'd'\nrobot = 'robot_5r'\n[[phases]]\nname='a'\nplanner='434'\n"
+     "time_s=[0,1,2]\njoints_deg=[[0,0,0,0,0],[1,nan,1,1,1],[2,2,2,2,2]]\n", "finite"),
+    ("name = 'x\ndescription", "invalid TOML"),
+])
+def test_plan_bad_files_exit_2(tmp_path, body, fragment):
+    f = tmp_path / "bad.toml"
+    f.write_text(body)
+    res = _run("plan", str(f))
+    assert res.returncode == 2
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and fragment in lines[0] and "bad.toml" in lines[0], res.stderr
+
+
+def test_list_shows_every_robot_and_scenario(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for name in ("lrmate100ib", "lrmate200ic5l", "robot_5r", *shipped_scenarios()):
+        assert name in out
+    assert "(invalid" not in out
