@@ -187,7 +187,8 @@ def write_video(
             try:
                 encoder = _Encoder(writer, queue_size)
                 bar = tqdm(total=len(times), unit="frame", desc="render", file=sys.stderr,
-                           disable=not (progress and sys.stderr.isatty()), leave=False)
+                           disable=not (progress and sys.stderr.isatty()), leave=False,
+                           delay=1.0)  # only renders longer than a second show a bar
                 try:
                     for t in times:
                         t = float(t)
