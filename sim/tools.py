@@ -3,11 +3,11 @@
 Every tool is built in its own *tool frame*: origin on the robot's flange face, ``+z`` along the
 flange's approach axis (out of the flange), so that a tool is *straight*: its tool centre point
 (site ``tip``) lies on the flange axis at ``(0, 0, length_m)``, with the orientation of the tool
-frame. The seeds' closed-form kinematics therefore still hold with the tool length added
-(5R family: ``l3_eff = (J4 axis -> flange) + length_m``; LR Mate 200iC: ``r = length_m`` in seed
-004 eq. 6-7). :mod:`sim.cells` attaches a tool at the robot's ``flange`` site, turning the tool
-frame so that its ``+z`` is the flange approach axis, and moves the robot's ``tcp`` site onto the
-tool tip.
+frame. The seeds' closed-form kinematics therefore still hold with the tool length added (5R
+family: ``l3_eff = (J4 axis -> flange) + length_m``; LR Mate 200iC: ``r = length_m`` in seed 004
+eq. 6-7). :mod:`sim.cells` attaches a tool at the robot's ``flange`` site, turning the tool frame
+so that its ``+z`` is the flange approach axis, and moves the robot's ``tcp`` site onto the tool
+tip.
 
 Tools (all dimensions along the tool axis from the flange face; masses from the geometry and the
 materials below, set explicitly on every geom so the numbers are visible and testable):
@@ -30,46 +30,44 @@ contact tip           118 - 130     cylinder r 4 mm       0.005 kg (CuCrZr, 8900
 wire stick-out        130 - 145     cylinder r 0.6 mm     0.0001 kg (steel, 7850 kg/m^3)
 ====================  ============  ====================  ===================================
 
-``mig_torch_long`` - the same design sized for the large 5R welding robot: a straight
-water-cooled 500 A torch, 300 mm from the flange face to the wire tip (the 5R robot's
-l3 = 400 mm = 100 mm flange + 300 mm torch, ``models/robot_5r/README.md``), 1.70 kg: adapter
-r 32 mm 0-15 mm (0.130 kg, aluminium), collision sensor r 34 mm 15-65 mm (0.939 kg, effective
-5170 kg/m^3), neck r 14 mm 65-230 mm (0.508 kg, effective 5000 kg/m^3), nozzle r 13 mm
-230-283 mm (0.117 kg, copper tube OD 26 / ID 19), contact tip r 4.5 mm 273-285 mm (0.007 kg),
-wire 285-300 mm.
+``mig_torch_long`` - the same design sized for the large 5R welding robot: a straight water-cooled
+500 A torch, 300 mm from the flange face to the wire tip (the 5R robot's l3 = 400 mm = 100 mm
+flange + 300 mm torch, ``models/robot_5r/README.md``), 1.70 kg: adapter r 32 mm 0-15 mm (0.130 kg,
+aluminium), collision sensor r 34 mm 15-65 mm (0.939 kg, effective 5170 kg/m^3), neck r 14 mm
+65-230 mm (0.508 kg, effective 5000 kg/m^3), nozzle r 13 mm 230-283 mm (0.117 kg, copper tube OD 26
+/ ID 19), contact tip r 4.5 mm 273-285 mm (0.007 kg), wire 285-300 mm.
 
-With its default torch each robot's tcp is where the seed dimensions put it (100iB:
-l3 = 80 + 145 = 225 mm; 5R: l3 = 100 + 300 = 400 mm), so ``sim/robots.py``'s dims hold as they
-are in the welding cells. The 15 mm wire stick-out is the contact-tip-to-work distance usual for 1.0-1.2 mm wire in
+With its default torch each robot's tcp is where the seed dimensions put it (100iB: l3 = 80 + 145 =
+225 mm; 5R: l3 = 100 + 300 = 400 mm), so ``sim/robots.py``'s dims hold as they are in the welding
+cells. The 15 mm wire stick-out is the contact-tip-to-work distance usual for 1.0-1.2 mm wire in
 short-arc MAG welding. The hose package is not modelled (it hangs from the robot's arm). Torch
-geoms do not collide with anything (``contype = conaffinity = 0``): a welding torch never
-touches the work, and contact forces would pollute the joint torques used for motor sizing.
+geoms do not collide with anything (``contype = conaffinity = 0``): a welding torch never touches
+the work, and contact forces would pollute the joint torques used for motor sizing.
 
 ``vacuum_gripper`` - a single Ø40 mm suction cup on a stem, 100 mm from the flange face to the cup
 lip, 0.25 kg. The cup is its own body (``cup``) carrying a MuJoCo ``adhesion`` actuator
 (``suction``, ``ctrl`` in [0, 1]). Its lip is a ring of 8 spheres (r 3 mm on a 17 mm radius) that
-touch the part: sphere-box contacts are exact and give 8 well-spread contact points, which is
-what makes adhesion and friction hold a box without rocking. Adhesion force (MuJoCo's
-``adhesion`` actuator): ``gain * ctrl`` = 40 N at full suction, split equally between the cup's
-contacts, pulling along each contact normal; 40 N is about half the theoretical hold of a Ø40 mm
-cup at -60 kPa (75 N), the usual safety factor 2. The lip geoms have ``margin`` 0 and ``gap`` 3 mm. In MuJoCo 4 (checked with
-``mj_forward`` on two geoms, see ``tests/test_tools.py``) a contact is *active* (in the solver,
-repulsive) while the distance is below ``margin`` and is still *detected* but inactive
-(``exclude = 1``) for a further ``gap``; the adhesion actuator pulls at every detected contact,
-so suction attracts a part lying up to 3 mm below the lip, as a real cup does, while the lip
-only pushes on actual penetration. (Older MuJoCo versions read these two attributes the other
-way round: active within ``margin - gap``.)
-The lip uses a stiff contact (``solref`` 0.002 s, the smallest time constant MuJoCo accepts at
-the robots' 1 ms step; ``solimp`` 0.95-0.99): MuJoCo's friction is soft, and a held part creeps
-by about ``timeconst / 2`` times the velocity change friction has to give it (measured: a part
-carried through a 90 deg J1 swing drifts outwards 12 mm with 0.01 s, 1.3 mm with 0.002 s).
-Parts are held by these contact forces and friction (``friction`` 1.0, rubber), never by
-constraints or teleporting.
+touch the part: sphere-box contacts are exact and give 8 well-spread contact points, which keeps a
+held box from rocking. Adhesion force (MuJoCo's ``adhesion`` actuator): ``gain * ctrl`` = 40 N at
+full suction, split equally between the cup's contacts, pulling along each contact normal; 40 N is
+about half the theoretical hold of a Ø40 mm cup at -60 kPa (75 N), the usual safety factor 2. The
+lip geoms have ``margin`` 0 and ``gap`` 3 mm. In MuJoCo 4 (checked with ``mj_forward`` on two
+geoms, ``tests/test_tools.py``) a contact is *active* (in the solver, repulsive) while the distance
+is below ``margin`` and is still *detected* but inactive (``exclude = 1``) for a further ``gap``;
+the adhesion actuator pulls at every detected contact, so suction attracts a part lying up to 3 mm
+below the lip, as a real cup does, while the lip only pushes on actual penetration. (Older MuJoCo
+versions read these two attributes the other way round: active within ``margin - gap``.) The lip
+uses a stiff contact (``solref`` 0.002 s, the smallest time constant MuJoCo accepts at the robots'
+1 ms step; ``solimp`` 0.95-0.99): MuJoCo's friction is soft, and a held part creeps by about
+``timeconst / 2`` times the velocity change friction has to give it (measured: a part carried
+through a 90 deg J1 swing drifts outwards 12 mm with 0.01 s, 1.3 mm with 0.002 s). Parts are held
+by these contact forces and friction (``friction`` 1.0, rubber), never by constraints or
+teleporting.
 
-Integrator: with a suction tool the cell switches the model from ``implicitfast`` to
-``implicit``: with ``implicitfast`` a 0.5 kg part held by adhesion started to tumble and the
-simulation diverged within 0.35 s of lifting, while ``implicit``, ``Euler`` and ``RK4`` held it
-(see :func:`sim.cells.compose.prepare_robot`).
+Integrator: with a suction tool the cell switches the model from ``implicitfast`` to ``implicit``:
+with ``implicitfast`` a 0.5 kg part held by adhesion started to tumble and the simulation diverged
+within 0.35 s of lifting, while ``implicit``, ``Euler`` and ``RK4`` held it (see
+:func:`sim.cells.compose.prepare_robot`).
 """
 
 from __future__ import annotations

@@ -231,7 +231,8 @@ def build_cell(cell: str | None, robot: str, *, tool: str | None = None, mount: 
         world_from_frame0=layout.world_from_frame0,
         adhesion_actuator=suction_actuator_name(rig), home_q=np.asarray(home_q, float),
         start_q=layout.start_q, payload_kg=payload, tip_site=tip_site_name(rig),
-        dims=layout.dims, description=cspec.description, _rig=rig)
+        dims={k: float(v) for k, v in layout.dims.items()}, description=cspec.description,
+        _rig=rig)
 
 
 __all__ = ["BARE", "CELLS", "MOUNTS", "NO_TOOL", "Cell", "CellSpec", "Seam", "build_cell"]

@@ -468,7 +468,9 @@ def tip_site_name(rig: RobotRig) -> str | None:
 
 def cup_body_name(rig: RobotRig) -> str | None:
     """Full name of the suction-cup body, or None."""
-    return None if suction_actuator_name(rig) is None else f"{ROBOT_PREFIX}/{TOOL_PREFIX}/{CUP_BODY}"
+    if suction_actuator_name(rig) is None:
+        return None
+    return f"{ROBOT_PREFIX}/{TOOL_PREFIX}/{CUP_BODY}"
 
 
 Builder = Callable[[RobotRig, str], Layout]

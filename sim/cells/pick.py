@@ -4,7 +4,7 @@ Laid out in the robot's frame 0 (robot upright on a 0.6 m riser; world = frame 0
 0.6 + 0.33 m). Sizes in m:
 
 * **infeed table** (top 0.18 below J2, x 0.14..0.50, y 0.30..0.46) carrying four **parts**: free
-  steel-grey boxes 60 x 40 x 30 mm, 0.25 kg each (a density of 3470 kg/m^3: a hollow aluminium
+  boxes 60 x 40 x 30 mm, 0.25 kg each (a density of 3470 kg/m^3: a hollow aluminium
   casting), friction 0.8, long side along x, centres at x = 0.20, 0.28, 0.36, 0.44, y = 0.38,
   resting on the table (body names ``part0`` .. ``part3``);
 * **outfeed tray** (floor top 0.18 below J2; 30 mm rim around x 0.20..0.44, y -0.48..-0.28) with
@@ -12,7 +12,7 @@ Laid out in the robot's frame 0 (robot upright on a 0.6 m riser; world = frame 0
   holds where each part's centre is once placed: on the tray floor, 15 mm up.
 
 Every pick and place pose has the gripper pointing straight down (tcp z axis = -z) at the top
-face of a part (0.15 below J2, radius 0.43..0.62 m from J1): the analytic IK reaches all of
+face of a part (0.15 below J2, 0.43..0.58 m from the J1 axis): the analytic IK reaches all of
 them inside the joint ranges with |theta5| >= 22 deg (clear of the wrist singularity). The
 parts rest on the table by contact alone (MuJoCo soft contacts; they settle by ~0.1 mm).
 """

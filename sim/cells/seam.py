@@ -93,13 +93,15 @@ class Seam:
         set_ = object.__setattr__
         pts = np.array(self.points, dtype=float)
         if self.kind not in ("line", "arc"):
-            raise CellsimError(f"seam {self.name!r}: kind must be 'line' or 'arc', got {self.kind!r}")
+            raise CellsimError(f"seam {self.name!r}: kind must be 'line' or 'arc', "
+                               f"got {self.kind!r}")
         want = (2, 3) if self.kind == "line" else (3, 3)
         if pts.shape != want or not np.all(np.isfinite(pts)):
             raise CellsimError(f"seam {self.name!r}: a {self.kind} needs finite points of shape "
                                f"{want}, got {pts.shape}")
         set_(self, "points", pts)
-        set_(self, "surface_normal", _unit(self.surface_normal, f"seam {self.name!r} surface_normal"))
+        set_(self, "surface_normal",
+             _unit(self.surface_normal, f"seam {self.name!r} surface_normal"))
         if self.torch_side not in (1, -1):
             raise CellsimError(f"seam {self.name!r}: torch_side must be +1 or -1")
         if self.tool_axis not in (0, 2):
@@ -186,7 +188,8 @@ class Seam:
             p0, p1 = self.points
             return p0 + (p1 - p0) * (s / self.length())
         th = s / self._radius  # type: ignore[attr-defined]
-        return self._center + self._radius * (np.cos(th) * self._u + np.sin(th) * self._v)  # type: ignore[attr-defined]
+        c, r, u, v = self._center, self._radius, self._u, self._v  # type: ignore[attr-defined]
+        return c + r * (np.cos(th) * u + np.sin(th) * v)
 
     def tangent(self, s: float) -> NDArray[np.float64]:
         """Unit travel direction at arc length ``s`` (m), (3,)."""
