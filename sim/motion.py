@@ -220,7 +220,11 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     for phase in scenario.phases:
         label = f"{where}: phases[{phase.index}] ({phase.name})"
         if isinstance(phase, JointPhase):
-            placed = phase if phase.times is not None else phase.with_start(t, q)
+            placed = phase.with_start(t, q)
+            if phase.target is not None:
+                if context is None:
+                    raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
+                placed = placed.with_end(_solve_target(phase, placed.q[0], context, label))
             traj = plan_phase(placed, where)
             pm = PhaseMotion(placed, placed.t0, placed.t1, traj, knot_times=placed.times.copy())
         elif isinstance(phase, HoldPhase):
@@ -308,12 +312,41 @@ def _resolve_actions(scenario: Scenario, motion: Motion) -> list[tuple[float, st
     return out
 
 
-def _rot_zyx(angles: NDArray[np.float64]) -> NDArray[np.float64]:
-    a, b, g = angles
-    rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
-    ry = np.array([[np.cos(b), 0, np.sin(b)], [0, 1, 0], [-np.sin(b), 0, np.cos(b)]])
-    rx = np.array([[1, 0, 0], [0, np.cos(g), -np.sin(g)], [0, np.sin(g), np.cos(g)]])
-    return rz @ ry @ rx
+def _seam(ctx: CartesianContext, name: str, label: str) -> Any:
+    if name not in ctx.seams:
+        from sim.errors import UnknownNameError
+
+        raise ScenarioError(f"{label}: {UnknownNameError('seam', name, ctx.seams)}")
+    return ctx.seams[name]
+
+
+def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianContext,
+                  label: str) -> NDArray[np.float64]:
+    """Joint values of a joint phase's pose target: the in-limits IK solution closest to
+    the phase's start (weighted by joint speed limits, see ``sim.kinematics.ik``)."""
+    from sim.kinematics.ik import solve_ik
+
+    tgt = phase.target
+    assert tgt is not None
+    T = np.eye(4)
+    if tgt.seam is not None:
+        seam = _seam(ctx, tgt.seam, f"{label}.to_seam")
+        T[:3, 3] = ctx.to_frame0(seam.points[0])
+        T[:3, :3] = ctx.rot_to_frame0(seam.torch_rotation(0.0))
+    else:
+        T[:3, 3] = tgt.position
+        T[:3, :3] = (tgt.rotation if tgt.rotation is not None
+                     else np.asarray(ctx.kinematics.fk(q0), dtype=float)[:3, :3])
+    key = "to_seam" if tgt.seam is not None else "to_mm"
+    try:
+        sols = solve_ik(ctx.kinematics, T, current=q0)
+    except CellsimError as exc:
+        raise ScenarioError(f"{label}.{key}: {exc}") from None
+    good = [s for s in sols if s.within_limits]
+    if not good:
+        raise ScenarioError(f"{label}.{key}: the pose is reachable only outside the joint "
+                            "ranges")
+    return np.asarray(good[0].q, dtype=float)
 
 
 def default_ramp(phase: CartesianPhase, p0: NDArray[np.float64], seam: Any,
@@ -347,11 +380,7 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
 
     seam = None
     if phase.seam is not None:
-        if phase.seam not in ctx.seams:
-            from sim.errors import UnknownNameError
-
-            raise ScenarioError(f"{label}.seam: {UnknownNameError('seam', phase.seam, ctx.seams)}")
-        seam = ctx.seams[phase.seam]
+        seam = _seam(ctx, phase.seam, f"{label}.seam")
         if seam.kind != ("line" if phase.kind == "linear" else "arc"):
             raise ScenarioError(f"{label}.seam: {phase.seam!r} is a {seam.kind} seam; a "
                                 f"{phase.kind} phase needs a {'line' if phase.kind == 'linear' else 'arc'}")
@@ -367,7 +396,9 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     mode = {"keep": "geodesic", "euler": "geodesic", "seam": "geodesic", "follow": "carry"}[
         phase.orientation]
     if phase.orientation == "euler":
-        rot_end = _rot_zyx(phase.euler_zyx)
+        from sim.kinematics.rotations import euler_zyx_to_matrix
+
+        rot_end = euler_zyx_to_matrix(*phase.euler_zyx)
     elif phase.orientation == "seam":
         rot_end = ctx.rot_to_frame0(seam.torch_rotation(seam.length()))
     kw: dict[str, Any] = dict(rotation_start=R0, orientation=mode,

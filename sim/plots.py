@@ -67,6 +67,10 @@ def _shade_phases(ax: Any, record: RunRecord, label: bool) -> None:
             )
 
 
+#: Above this many knots (dense Cartesian via points) knots are dots only, no vertical lines.
+MAX_KNOT_LINES = 60
+
+
 def _knots(record: RunRecord) -> np.ndarray:
     if not record.has("knot_t"):
         return np.zeros(0)
@@ -113,10 +117,12 @@ def joint_figure(record: RunRecord, joint: int) -> Any:
         if act_key and record.has(act_key):
             ax.plot(t, record.get(act_key)[:, joint], color=_ACT, lw=1.0, ls="--",
                     label="simulated")
-        for tk in knots:
-            ax.axvline(tk, color="0.45", lw=0.7, ls=":", zorder=1)
+        if 0 < knots.size <= MAX_KNOT_LINES:
+            ax.vlines(knots, 0, 1, transform=ax.get_xaxis_transform(), colors="0.45", lw=0.7,
+                      linestyles=":", zorder=1)
         if knots.size:
-            ax.plot(knots, np.interp(knots, t, ref), "o", color="k", ms=4, label="knots")
+            ms = 4 if knots.size <= MAX_KNOT_LINES else 1.5
+            ax.plot(knots, np.interp(knots, t, ref), "o", color="k", ms=ms, label="knots")
         ax.set_ylabel(label)
         ax.grid(True, lw=0.3)
     axes[0].legend(loc="upper right", fontsize=8)

@@ -75,6 +75,9 @@ class JointPhaseSpec(_Strict):
     start_jerk_rad_s3: list[float] | None = None
     end_jerk_deg_s3: list[float] | None = None
     end_jerk_rad_s3: list[float] | None = None
+    to_mm: Vec3 | None = None
+    to_seam: str | None = None
+    euler_zyx_deg: Vec3 | None = None
     note: str | None = Field(None, description="free text (e.g. which seed value was chosen)")
 
 
@@ -225,6 +228,7 @@ class JointPhase:
     q: NDArray[np.float64]
     boundary: dict[str, NDArray[np.float64]] = field(default_factory=dict)
     kind: str = "joint"
+    target: "PoseTarget | None" = None
 
     @property
     def t0(self) -> float:
@@ -240,16 +244,45 @@ class JointPhase:
 
     @property
     def starts_from_previous(self) -> bool:
-        return bool(np.isnan(self.q[0]).any())
+        return self.times is None
 
     def with_start(self, t0: float, q0: NDArray[np.float64]) -> "JointPhase":
         """This phase placed at ``t0`` and, if it starts from the previous phase, from ``q0``."""
+        import dataclasses
+
         q = self.q.copy()
         if self.starts_from_previous:
             q[0] = q0
-        times = t0 + np.concatenate([[0.0], np.cumsum(self.durations)])
-        return JointPhase(self.index, self.name, self.planner, times, self.durations, q,
-                          dict(self.boundary))
+        times = (self.times if self.times is not None
+                 else t0 + np.concatenate([[0.0], np.cumsum(self.durations)]))
+        return dataclasses.replace(self, times=times, q=q)
+
+    def with_end(self, q_end: NDArray[np.float64]) -> "JointPhase":
+        """This phase ending at ``q_end`` (its pose target solved); an automatic via point
+        (NaN row) becomes the joint-space midpoint of start and end."""
+        import dataclasses
+
+        q = self.q.copy()
+        q[-1] = q_end
+        for r in range(1, q.shape[0] - 1):
+            if np.isnan(q[r]).all():
+                q[r] = 0.5 * (q[0] + q_end)
+        return dataclasses.replace(self, q=q)
+
+
+@dataclass(frozen=True)
+class PoseTarget:
+    """Where a joint phase ends, in Cartesian terms (solved by inverse kinematics).
+
+    Attributes:
+        position: tcp position in frame 0, m, (3,), or ``None`` with ``seam``.
+        rotation: tcp orientation in frame 0, (3, 3); ``None`` keeps the previous one.
+        seam: A cell seam whose start (and torch posture) is the target.
+    """
+
+    position: NDArray[np.float64] | None = None
+    rotation: NDArray[np.float64] | None = None
+    seam: str | None = None
 
 
 @dataclass(frozen=True)
@@ -471,7 +504,8 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
                 raise ScenarioError(
                     f"{key}.durations_s: the first phase must give time_s and its start knot")
             phase = _build_joint_phase(i, pspec, robot, key)
-            if isinstance(prev, JointPhase) and prev.times is not None and phase.times is not None:
+            if (isinstance(prev, JointPhase) and prev.times is not None and phase.times is not None
+                    and prev.target is None):
                 _check_continuity(prev, phase, key, robot)
         elif prev is None:
             raise ScenarioError(f"{key}.kind: the first phase must be a joint phase (it sets the "
@@ -484,6 +518,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
 
     _check_registry_name(where, "cell", spec.cell, "sim.cells", "CELLS")
     _check_registry_name(where, "tool", spec.tool, "sim.tools", "TOOLS")
+    effective_tool, tool_kind = _effective_tool(spec)
     drives: dict[str, dict[str, float]] = {}
     for joint, override in spec.drives.items():
         if joint not in robot.joints:
@@ -501,12 +536,10 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise ScenarioError(f"{where}: actions[{i}].phase: no phase named {a.phase!r}{hint}; "
                                 f"phases: {', '.join(seen)}")
-        if a.action.startswith("suction") and spec.tool != "vacuum_gripper":
-            raise ScenarioError(f"{where}: actions[{i}].action: {a.action} needs "
-                                f"tool = \"vacuum_gripper\" (tool is {spec.tool!r})")
-        if a.action.startswith("arc") and spec.tool != "mig_torch":
-            raise ScenarioError(f"{where}: actions[{i}].action: {a.action} needs "
-                                f"tool = \"mig_torch\" (tool is {spec.tool!r})")
+        need = "gripper" if a.action.startswith("suction") else "torch"
+        if tool_kind != need:
+            raise ScenarioError(f"{where}: actions[{i}].action: {a.action} needs a {need} tool "
+                                f"(the tool is {effective_tool or 'none'})")
         actions.append(Action(a.action, a.time_s, a.phase, a.at))
     return Scenario(
         name=spec.name,
@@ -524,6 +557,19 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         drives=drives,
         actions=tuple(actions),
     )
+
+
+def _effective_tool(spec: ScenarioSpec) -> tuple[str | None, str | None]:
+    """The tool a scenario ends up with (its own, or its cell's default) and that tool's kind."""
+    from sim.cells import CELLS
+    from sim.tools import TOOLS
+
+    tool = spec.tool
+    if tool is None and spec.cell is not None:
+        tool = CELLS[spec.cell].default_tool
+    if tool in (None, "none"):
+        return None, None
+    return tool, TOOLS[tool].kind
 
 
 def _check_registry_name(where: str, kind: str, name: str | None, module: str, attr: str) -> None:
@@ -570,24 +616,50 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
                                 f"got {durations[k]:g} s")
         n_rows = durations.size  # the start knot is the previous phase's end
 
-    if (spec.joints_deg is None) == (spec.joints_rad is None):
-        raise ScenarioError(f"{where}: give exactly one of joints_deg or joints_rad")
-    key, rows, scale = (("joints_deg", spec.joints_deg, math.pi / 180.0)
-                        if spec.joints_deg is not None else ("joints_rad", spec.joints_rad, 1.0))
-    assert rows is not None
-    if len(rows) != n_rows:
-        what = ("knot times; give one row per time" if times is not None else
-                "segments; give one row per segment end (the start is the previous phase's end)")
-        raise ScenarioError(f"{where}.{key}: {len(rows)} rows for {n_rows} {what}")
+    target = _pose_target(spec, where)
+    if target is not None:
+        n_rows -= 1  # the last knot comes from the pose target
     n = robot.n_joints
-    for r, row in enumerate(rows):
-        if len(row) != n:
+    if spec.joints_deg is not None and spec.joints_rad is not None:
+        raise ScenarioError(f"{where}: give exactly one of joints_deg or joints_rad")
+    if spec.joints_deg is None and spec.joints_rad is None:
+        if target is None:
+            raise ScenarioError(f"{where}: give joints_deg (or joints_rad), or a pose target "
+                                "(to_mm or to_seam)")
+        if times is not None or durations.size != 1:
             raise ScenarioError(
-                f"{where}.{key}[{r}]: {len(row)} values; robot {robot.name} has {n} joints "
-                f"({', '.join(robot.joints)})")
-    q = np.asarray(rows, dtype=float) * scale
-    if times is None:
-        q = np.vstack([np.full((1, n), np.nan), q])
+                f"{where}.joints_deg: required for the via points (without via points give one "
+                "duration: durations_s = [T])")
+        # one duration, no via points: the joint-space midpoint becomes the via point
+        durations = np.array([durations[0] / 2, durations[0] / 2])
+        q = np.full((3, n), np.nan)
+    else:
+        key, rows, scale = (("joints_deg", spec.joints_deg, math.pi / 180.0)
+                            if spec.joints_deg is not None else ("joints_rad", spec.joints_rad, 1.0))
+        assert rows is not None
+        if target is not None and times is None and len(rows) == 0:
+            raise ScenarioError(f"{where}.{key}: empty; leave it out for a move with no via point")
+        if len(rows) != n_rows:
+            if target is not None:
+                what = ("rows (the start knot and the via points; the end is the pose target)"
+                        if times is not None else "rows (the via points; the start is the previous "
+                        "phase's end and the end is the pose target)")
+                raise ScenarioError(f"{where}.{key}: {len(rows)} rows, expected {n_rows} {what}")
+            what = ("knot times; give one row per time" if times is not None else
+                    "segments; give one row per segment end (the start is the previous phase's end)")
+            raise ScenarioError(f"{where}.{key}: {len(rows)} rows for {n_rows} {what}")
+        for r, row in enumerate(rows):
+            if len(row) != n:
+                raise ScenarioError(
+                    f"{where}.{key}[{r}]: {len(row)} values; robot {robot.name} has {n} joints "
+                    f"({', '.join(robot.joints)})")
+        q = np.asarray(rows, dtype=float).reshape(-1, n) * scale
+        if times is None:
+            q = np.vstack([np.full((1, n), np.nan), q])
+        if target is not None:
+            q = np.vstack([q, np.full((1, n), np.nan)])
+    if target is not None and times is not None and np.isnan(q[0]).any():
+        raise ScenarioError(f"{where}.joints_deg: the first row is the start knot")
 
     boundary: dict[str, NDArray[np.float64]] = {}
     for bkey, (kw, bscale) in _BOUNDARY_KEYS.items():
@@ -605,7 +677,24 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
                 f"{where}.{bkey}: {len(values)} values; robot {robot.name} has {n} joints")
         boundary[kw] = np.asarray(values, dtype=float) * bscale
     return JointPhase(index=index, name=spec.name, planner=spec.planner, times=times,
-                      durations=durations, q=q, boundary=boundary)
+                      durations=durations, q=q, boundary=boundary, target=target)
+
+
+def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
+    if spec.to_mm is not None and spec.to_seam is not None:
+        raise ScenarioError(f"{where}: give one of to_mm or to_seam")
+    if spec.euler_zyx_deg is not None and spec.to_mm is None:
+        raise ScenarioError(f"{where}.euler_zyx_deg: only used with to_mm")
+    if spec.to_seam is not None:
+        return PoseTarget(seam=spec.to_seam)
+    if spec.to_mm is None:
+        return None
+    rot = None
+    if spec.euler_zyx_deg is not None:
+        from sim.kinematics.rotations import euler_zyx_to_matrix
+
+        rot = euler_zyx_to_matrix(*np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)))
+    return PoseTarget(position=np.asarray(spec.to_mm, dtype=float) * 1e-3, rotation=rot)
 
 
 def _build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec,

@@ -42,7 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def planned_phases(scenario: Scenario) -> list[PhaseMotion]:
     """The scenario's polynomial phases on one clock (Cartesian ones through the cell's IK)."""
     context = None
-    if any(isinstance(p, CartesianPhase) for p in scenario.phases):
+    if any(isinstance(p, CartesianPhase) or getattr(p, "target", None) is not None
+           for p in scenario.phases):
         from sim.runner import build
 
         context = build(scenario).context
