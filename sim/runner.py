@@ -185,21 +185,30 @@ def inverse_dynamics(model: Any, built: BuiltCell, q: NDArray[np.float64],
                      qd: NDArray[np.float64], qdd: NDArray[np.float64]) -> NDArray[np.float64]:
     """Joint torques that realise the reference exactly (``mj_inverse``), (N, n_joints), N m.
 
-    The rest of the model (parts) stays at its initial pose and at rest.
+    The robot's own dynamics with its tool and payload: gravity, inertia (with armature),
+    joint damping and friction. Contacts are switched off for the computation (a reference
+    that touches a part would otherwise count the contact's push as the robot's torque), the
+    rest of the model (parts) stays at its initial pose and at rest, and a part held by
+    suction is not included (it is in the simulated torque).
     """
     import mujoco
 
     data = mujoco.MjData(model)
     mujoco.mj_resetData(model, data)
     out = np.zeros_like(q)
-    for k in range(q.shape[0]):
-        data.qpos[built.robot_qpos] = q[k]
-        data.qvel[:] = 0.0
-        data.qvel[built.robot_dof] = qd[k]
-        data.qacc[:] = 0.0
-        data.qacc[built.robot_dof] = qdd[k]
-        mujoco.mj_inverse(model, data)
-        out[k] = data.qfrc_inverse[built.robot_dof]
+    flags = model.opt.disableflags
+    model.opt.disableflags = flags | int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    try:
+        for k in range(q.shape[0]):
+            data.qpos[built.robot_qpos] = q[k]
+            data.qvel[:] = 0.0
+            data.qvel[built.robot_dof] = qd[k]
+            data.qacc[:] = 0.0
+            data.qacc[built.robot_dof] = qdd[k]
+            mujoco.mj_inverse(model, data)
+            out[k] = data.qfrc_inverse[built.robot_dof]
+    finally:
+        model.opt.disableflags = flags
     return out
 
 

@@ -255,7 +255,8 @@ class JointPhase:
             q[0] = q0
         times = (self.times if self.times is not None
                  else t0 + np.concatenate([[0.0], np.cumsum(self.durations)]))
-        return dataclasses.replace(self, times=times, q=q)
+        placed = dataclasses.replace(self, times=times, q=q)
+        return placed if self.target is not None else placed.with_end(q[-1])
 
     def with_end(self, q_end: NDArray[np.float64]) -> "JointPhase":
         """This phase ending at ``q_end`` (its pose target solved); an automatic via point
@@ -594,7 +595,8 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
         if times.size < 3:
             raise ScenarioError(
                 f"{where}.time_s: {times.size} knot time(s) given; a {spec.planner} phase needs "
-                "at least 3 (start, one via point, end)")
+                "at least 3 (start, one via point, end); for a single move give "
+                "durations_s = [T] in a later phase")
         steps = np.diff(times)
         if np.any(steps <= 0):
             k = int(np.argmax(steps <= 0)) + 1
@@ -606,10 +608,8 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
     else:
         durations = np.asarray(spec.durations_s, dtype=float)
         times = None
-        if durations.size < 2:
-            raise ScenarioError(
-                f"{where}.durations_s: {durations.size} segment(s) given; a {spec.planner} phase "
-                "needs at least 2")
+        if durations.size < 1:
+            raise ScenarioError(f"{where}.durations_s: empty; give at least one segment duration")
         if np.any(durations <= 0):
             k = int(np.argmax(durations <= 0))
             raise ScenarioError(f"{where}.durations_s[{k}]: segment durations must be positive, "
@@ -626,19 +626,13 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
         if target is None:
             raise ScenarioError(f"{where}: give joints_deg (or joints_rad), or a pose target "
                                 "(to_mm or to_seam)")
-        if times is not None or durations.size != 1:
-            raise ScenarioError(
-                f"{where}.joints_deg: required for the via points (without via points give one "
-                "duration: durations_s = [T])")
-        # one duration, no via points: the joint-space midpoint becomes the via point
-        durations = np.array([durations[0] / 2, durations[0] / 2])
-        q = np.full((3, n), np.nan)
+        if times is not None:
+            raise ScenarioError(f"{where}.joints_deg: required: its first row is the start knot")
+        rows_q = np.zeros((0, n))
     else:
         key, rows, scale = (("joints_deg", spec.joints_deg, math.pi / 180.0)
                             if spec.joints_deg is not None else ("joints_rad", spec.joints_rad, 1.0))
         assert rows is not None
-        if target is not None and times is None and len(rows) == 0:
-            raise ScenarioError(f"{where}.{key}: empty; leave it out for a move with no via point")
         if len(rows) != n_rows:
             if target is not None:
                 what = ("rows (the start knot and the via points; the end is the pose target)"
@@ -653,11 +647,23 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
                 raise ScenarioError(
                     f"{where}.{key}[{r}]: {len(row)} values; robot {robot.name} has {n} joints "
                     f"({', '.join(robot.joints)})")
-        q = np.asarray(rows, dtype=float).reshape(-1, n) * scale
-        if times is None:
-            q = np.vstack([np.full((1, n), np.nan), q])
-        if target is not None:
-            q = np.vstack([q, np.full((1, n), np.nan)])
+        rows_q = np.asarray(rows, dtype=float).reshape(-1, n) * scale
+    if target is None and rows_q.shape[0] == 0:
+        raise ScenarioError(f"{where}: no knots")
+    blocks = []
+    if times is None:
+        blocks.append(np.full((1, n), np.nan))  # start: the previous phase's end
+    blocks.append(rows_q)
+    if target is not None:
+        blocks.append(np.full((1, n), np.nan))  # end: solved from the pose target
+    q = np.vstack(blocks)
+    if durations.size == 1:
+        # a single segment: the joint-space midpoint is the via point (4-4 / 5-6 polynomial),
+        # filled in once start and end are known (JointPhase.with_start / with_end)
+        durations = np.array([durations[0] / 2, durations[0] / 2])
+        if times is not None:
+            times = np.array([times[0], times[0] + durations[0], times[1]])
+        q = np.vstack([q[:1], np.full((1, n), np.nan), q[1:]])
     if target is not None and times is not None and np.isnan(q[0]).any():
         raise ScenarioError(f"{where}.joints_deg: the first row is the start knot")
 

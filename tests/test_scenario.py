@@ -49,13 +49,18 @@ def test_required_scenarios_ship():
 
 @pytest.mark.parametrize("name", sorted(SHIPPED))
 def test_shipped_scenario_loads_with_consistent_phases(name):
+    from sim.scenario import JointPhase
+
     sc = load_scenario(name)
     assert sc.name == name, "a shipped scenario's name must equal its file name"
     for prev, phase in zip(sc.phases, sc.phases[1:]):
-        assert phase.t0 == pytest.approx(prev.t1)
-        np.testing.assert_allclose(phase.q[0], prev.q[-1], atol=1e-12)
+        if (isinstance(prev, JointPhase) and isinstance(phase, JointPhase)
+                and prev.times is not None and phase.times is not None and prev.target is None):
+            assert phase.t0 == pytest.approx(prev.t1)
+            np.testing.assert_allclose(phase.q[0], prev.q[-1], atol=1e-12)
     for phase in sc.phases:
-        assert phase.q.shape == (phase.times.size, sc.robot.n_joints)
+        if isinstance(phase, JointPhase):
+            assert phase.q.shape == (phase.durations.size + 1, sc.robot.n_joints)
 
 
 def test_bugnar_phase1_is_seed001_table1_in_radians():
@@ -345,3 +350,37 @@ def test_action_unknown_phase_suggests():
         parse_scenario(text, source="c.toml")
     # no tool: the tool check or the phase check fires, both one line naming actions[0]
     assert "actions[0]" in str(info.value)
+
+
+def test_single_segment_gets_the_joint_space_midpoint():
+    """durations_s = [T] with one row: the midpoint becomes the via point (4-4)."""
+    text = GOOD + """
+[[phases]]
+name = "b"
+planner = "434"
+durations_s = [2.0]
+joints_deg = [[0,0,0,0,0]]
+"""
+    sc = parse_scenario(text, source="s.toml")
+    placed = sc.phases[1].with_start(2.0, np.deg2rad([2, 4, 6, 8, 10]))
+    np.testing.assert_allclose(placed.times, [2.0, 3.0, 4.0])
+    np.testing.assert_allclose(np.rad2deg(placed.q[1]), [1, 2, 3, 4, 5])
+
+
+def test_pose_target_rows():
+    """With to_mm the end knot comes from IK: joints_deg lists the via points only."""
+    text = GOOD + """
+[[phases]]
+name = "b"
+planner = "434"
+durations_s = [1.0, 1.0]
+joints_deg = [[1,1,1,1,1]]
+to_mm = [600.0, 0.0, 0.0]
+"""
+    sc = parse_scenario(text, source="s.toml")
+    ph = sc.phases[1]
+    assert ph.target is not None and ph.q.shape == (3, 5)
+    assert np.isnan(ph.q[0]).all() and np.isnan(ph.q[2]).all()
+    bad = text.replace("joints_deg = [[1,1,1,1,1]]", "joints_deg = [[1,1,1,1,1],[2,2,2,2,2]]")
+    msg = _err(bad)
+    assert "phases[1].joints_deg" in msg and "pose target" in msg
