@@ -1,7 +1,7 @@
 """Every shipped scenario, run end to end (issue 4 acceptance), parameterized.
 
-Each scenario runs once per test session (no video, no plots) and the checks share the
-result: tracking at the seeds' speeds, tool-point deviation and travel speed on weld seams,
+Each scenario runs once per test session (no video, no plots; the ``scenario_run`` fixture
+of conftest.py) and the checks share the result: tracking at the seeds' speeds, tool-point deviation and travel speed on weld seams,
 simulated vs inverse-dynamics torque, parts placed in their slots.
 """
 
@@ -14,32 +14,13 @@ import numpy as np
 import pytest
 
 from sim.resources import shipped_scenarios
-from sim.runner import RunOptions, run_scenario
-from sim.scenario import load_scenario
 
 SCENARIOS = sorted(shipped_scenarios())
 WELD = [n for n in SCENARIOS if "weld" in n]
-_RUNS: dict[str, tuple[Path, dict]] = {}
-
-
-@pytest.fixture(scope="session")
-def runs_root(tmp_path_factory) -> Path:
-    return tmp_path_factory.mktemp("scenario_runs")
-
-
-def run_once(name: str, root: Path) -> tuple[Path, dict]:
-    if name not in _RUNS:
-        out = root / name
-        summary = run_scenario(load_scenario(name),
-                               RunOptions(out_dir=out, video=False, plots=False, progress=False))
-        _RUNS[name] = (out, summary)
-    return _RUNS[name]
-
-
 @pytest.mark.parametrize("name", SCENARIOS)
-def test_scenario_runs_and_tracks(name, runs_root):
+def test_scenario_runs_and_tracks(name, scenario_run):
     """Joint tracking error under 0.1 deg at the scenarios' speeds; folder complete."""
-    out, summary = run_once(name, runs_root)
+    out, summary = scenario_run(name)
     assert json.loads((out / "summary.json").read_text())["scenario"] == name
     assert max(summary["max_tracking_error_deg"]) < 0.1, summary["max_tracking_error_deg"]
     a = np.load(out / "trajectory.npz")
@@ -50,10 +31,10 @@ def test_scenario_runs_and_tracks(name, runs_root):
 
 
 @pytest.mark.parametrize("name", WELD)
-def test_weld_seams_path_speed_and_torch(name, runs_root):
+def test_weld_seams_path_speed_and_torch(name, scenario_run):
     """On every weld phase: tool point within 0.5 mm of the seam path, travel speed within 5 %
     of the set speed on the constant-speed part, torch axis on its reference."""
-    out, summary = run_once(name, runs_root)
+    out, summary = scenario_run(name)
     welds = summary["weld"]
     assert welds, "a weld scenario has weld phases (arc on)"
     for w in welds:
@@ -76,10 +57,10 @@ def test_weld_seams_path_speed_and_torch(name, runs_root):
 
 
 @pytest.mark.parametrize("name", WELD)
-def test_weld_torque_matches_inverse_dynamics(name, runs_root):
+def test_weld_torque_matches_inverse_dynamics(name, scenario_run):
     """Simulated actuator torque vs inverse dynamics of the reference: RMS difference under
     5 % of the joint's peak torque."""
-    out, _ = run_once(name, runs_root)
+    out, _ = scenario_run(name)
     a = np.load(out / "trajectory.npz")
     peak = np.max(np.abs(a["tau_id"]), axis=0)
     rms = np.sqrt(np.mean((a["tau"] - a["tau_id"]) ** 2, axis=0))
@@ -87,9 +68,9 @@ def test_weld_torque_matches_inverse_dynamics(name, runs_root):
     assert np.all(rms[loaded] < 0.05 * peak[loaded]), (rms, peak)
 
 
-def test_pick_place_parts_in_slots(runs_root):
+def test_pick_place_parts_in_slots(scenario_run):
     """Every part ends within 5 mm of its slot; none is dropped on the way."""
-    out, summary = run_once("lrmate200ic_pick_place", runs_root)
+    out, summary = scenario_run("lrmate200ic_pick_place")
     assert summary["placed"] == [True] * 4
     assert max(summary["place_error_mm"]) < 5.0
     a = np.load(out / "trajectory.npz")
@@ -107,9 +88,9 @@ def test_pick_place_parts_in_slots(runs_root):
         assert np.all(off < 0.005), f"part {i} slid {off.max() * 1e3:.2f} mm in the cup"
 
 
-def test_weld_cycle_phase1_ends_at_seam_start(runs_root):
+def test_weld_cycle_phase1_ends_at_seam_start(scenario_run):
     """The end of seed 001's phase I puts the torch on the seam start (the cell is built so)."""
-    out, summary = run_once("bugnar_5r_weld_cycle", runs_root)
+    out, summary = scenario_run("bugnar_5r_weld_cycle")
     a = np.load(out / "trajectory.npz")
     t_end = summary["phases"][0]["t1"]
     k = int(np.argmin(np.abs(a["t"] - t_end)))
