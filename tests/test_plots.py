@@ -74,9 +74,12 @@ def test_joint_figure_shows_q_qd_qdd_qddd_and_knots(run_dir: Path) -> None:
             np.testing.assert_allclose(marker.get_xdata(), knots)
             expected = np.interp(knots, t, record.get(key)[:, j])
             np.testing.assert_allclose(marker.get_ydata(), expected)
-            verticals = [line for line in rest if line.get_xdata()[0] in knots
-                         and len(set(line.get_xdata())) == 1]
-            assert len(verticals) == len(knots)
+            # knot lines: one vertical segment per knot (a single LineCollection)
+            (knot_lines,) = [c for c in ax.collections
+                             if c.__class__.__name__ == "LineCollection"]
+            xs = sorted(seg[0, 0] for seg in knot_lines.get_segments())
+            assert all(seg[0, 0] == seg[1, 0] for seg in knot_lines.get_segments())
+            np.testing.assert_allclose(xs, np.sort(knots))
         simulated = [line for line in axes[0].get_lines() if line.get_label() == "simulated"]
         np.testing.assert_array_equal(simulated[0].get_ydata(), record.get("q")[:, j])
 
