@@ -537,6 +537,17 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
 
     built = build(scenario)
     _check_tcp_consistency(built, scenario)
+    if options.video:  # refuse bad video settings before simulating, not after
+        from sim.render.frames import resolve_cameras, validate_size
+
+        video_args = _video_args(scenario, options)
+        resolve_cameras(built.model, video_args.get("cameras", ("overview",)))
+        validate_size(video_args.get("width", 640), video_args.get("height", 480))
+        fps = video_args.get("fps", 30.0)
+        if not (np.isfinite(fps) and fps > 0):
+            from sim.errors import RenderError
+
+            raise RenderError(f"--fps must be a positive number, got {fps!r}")
     motion = build_motion(scenario, built.context)
     check_motion_limits(scenario, motion)
 
@@ -566,8 +577,6 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         # written now for the report writers, rewritten complete at the end; the folder only
         # becomes visible (moved into place) once everything succeeded
         (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
-        if options.sizing:
-            _write_sizing(tmp, scenario, built, arrays, summary)
         if options.plots:
             from sim.plots import write_plots
 
@@ -578,6 +587,9 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
             video_args = _video_args(scenario, options)
             write_video(tmp, tmp / "video.mp4", progress=options.progress, **video_args)
             summary["video"] = "video.mp4"
+            (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+        if options.sizing:  # last: report.html links the video when there is one
+            _write_sizing(tmp, scenario, built, arrays, summary)
         (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
     except BaseException:
         if tmp.exists():
