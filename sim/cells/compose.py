@@ -306,7 +306,7 @@ def new_world(name: str, center=(0.0, 0.0, 0.8), extent: float = 3.0) -> mjcf.Ro
     g = getattr(w.visual, "global")
     g.offwidth, g.offheight = OFFSCREEN
     g.azimuth, g.elevation = 140.0, -25.0
-    w.visual.quality.shadowsize = 4096
+    w.visual.quality.shadowsize = 2048  # 4096 costs 50 % more per frame on software GL
     w.visual.headlight.ambient = (0.3, 0.3, 0.3)
     w.visual.headlight.diffuse = (0.5, 0.5, 0.5)
     w.visual.headlight.specular = (0.0, 0.0, 0.0)
