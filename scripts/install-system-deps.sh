@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Install the Debian packages named on the command line when they are missing.
 # Used by `make setup`; a no-op when everything is present.
-set -euo pipefail
+set -uo pipefail
 missing=()
 for p in "$@"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -19,5 +19,8 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 echo "cellsim: installing system packages: ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+if ! { $SUDO apt-get update -qq && \
+       $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null; }; then
+  echo "cellsim: warning: could not install ${missing[*]}; simulation works, videos need" \
+       "EGL or OSMesa (cellsim says which when it cannot render)" >&2
+fi
