@@ -397,10 +397,10 @@ def _quat_to_mat(q: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def _distance_to_path(p: NDArray[np.float64], cart: Any, T: NDArray[np.float64]) -> NDArray[np.float64]:
     """Distance of world points ``p`` (N,3) from the ideal ADNIA path (frame 0 -> world ``T``)."""
-    s = np.linspace(0.0, cart.length, max(2000, int(cart.length / 1e-5)))
-    dur = cart.duration
-    # sample the path densely by time (the path is traversed monotonically)
-    tt = np.linspace(0.0, dur, s.size)
+    # sample the path densely (every 10 um, at least 2000 points) by time: the path is
+    # traversed monotonically, so nearest samples plus chord projection give the distance
+    n = max(2000, int(cart.length / 1e-5))
+    tt = np.linspace(0.0, cart.duration, n)
     pts = cart.at(tt).position @ T[:3, :3].T + T[:3, 3]
     # nearest dense sample, refined by projection on the neighbouring chords
     from scipy.spatial import cKDTree
@@ -527,8 +527,6 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
     Raises:
         CellsimError: A user mistake or an unstable simulation (one-line message).
     """
-    import mujoco
-
     options = options or RunOptions()
     out_dir = Path(options.out_dir) if options.out_dir else default_out_dir(scenario)
     out_dir = out_dir.resolve()
@@ -603,7 +601,6 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
     stale = out_dir.with_name(out_dir.name + ".failed")
     if stale.exists():
         shutil.rmtree(stale, ignore_errors=True)
-    del mujoco
     return summary
 
 

@@ -186,3 +186,54 @@ def test_joint_range_violation_names_joint_and_time(tmp_path):
     msg = str(info.value)
     assert "joint j5" in msg and "position" in msg and "t=" in msg
     assert not (tmp_path / "l").exists()
+
+
+COARSE_LINE = """
+name = "coarse_line"
+description = "200iC welding the table's line seam with via points 1 s apart"
+robot = "lrmate200ic5l"
+cell = "weld_table"
+tool = "mig_torch"
+[[actions]]
+action = "arc_on"
+phase = "weld"
+[[actions]]
+action = "arc_off"
+phase = "weld"
+at = "end"
+[[phases]]
+name = "ready"
+planner = "434"
+time_s = [0.0, 1.0, 2.0]
+joints_deg = [[0,0,0,0,-90,0],[-15,4,-25,0,-75,0],[-30,8,-50,0,-45,0]]
+[[phases]]
+name = "to_line"
+planner = "434"
+durations_s = [2.0]
+to_seam = "line"
+[[phases]]
+name = "weld"
+kind = "linear"
+seam = "line"
+orientation = "seam"
+speed_mm_s = 40.0
+sample_period_s = 1.0
+"""
+
+
+def test_path_deviation_metric_against_the_line(tmp_path):
+    """Via points 40 mm apart: the joint polynomial leaves the straight seam between them. The
+    summary's max_path_deviation_mm equals the largest distance of the recorded tool point
+    from the seam's line (computed here from the cell's seam end points)."""
+    from sim.cells import build_cell
+
+    s = _run(parse_scenario(COARSE_LINE, source="coarse.toml"), tmp_path / "c")
+    (weld,) = s["weld"]
+    a = np.load(tmp_path / "c" / "trajectory.npz")
+    seam = build_cell("weld_table", "lrmate200ic5l", tool="mig_torch").seams["line"]
+    p0, p1 = seam.points
+    u = (p1 - p0) / np.linalg.norm(p1 - p0)
+    p = a["tcp_pos"][a["arc_on"]] - p0
+    dist = np.linalg.norm(p - np.outer(p @ u, u), axis=1)
+    assert weld["max_path_deviation_mm"] > 0.01, "coarse via points must show a deviation"
+    assert weld["max_path_deviation_mm"] == pytest.approx(dist.max() * 1e3, rel=0.02, abs=2e-3)
