@@ -690,7 +690,33 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "actions": [{"t": t, "action": act} for t, act in motion.actions],
         "weld": weld_metrics(a, motion, built, torch_axis),
     }
+    summary["singularity"] = singularity_summary(a, motion, built, rec.timestep)
     pick = pick_metrics(a, built)
     if pick is not None:
         summary.update(pick)
     return summary
+
+
+def singularity_summary(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell,
+                        dt: float) -> dict[str, Any]:
+    """Closest approach of the reference to a singularity (sampled every 10 ms).
+
+    ``min_sigma`` is the smallest singular value of the task Jacobian (0 at a singularity,
+    mixed units; :func:`sim.kinematics.jacobian.singularity_measures`), with its time and
+    phase; ``min_abs_<factor>`` are the explicit factors of det J (200iC: ``wrist`` = sin
+    theta5, ``elbow``, ``shoulder`` = wrist-centre distance from the J1 axis in m; 5R:
+    ``elbow`` = cos q3, ``shoulder`` = reach in m).
+    """
+    from sim.kinematics.jacobian import singularity_measures
+
+    step = max(1, int(round(0.01 / dt)))
+    t = arrays["t"][::step]
+    m = singularity_measures(built.context.kinematics, arrays["q_ref"][::step])
+    i = int(np.argmin(m["sigma_min"]))
+    out: dict[str, Any] = {"min_sigma": float(m["sigma_min"][i]), "t": float(t[i]),
+                           "phase": motion.phases[int(np.atleast_1d(motion.phase_index(t[i]))[0])].name,
+                           "min_manipulability": float(np.min(m["manipulability"]))}
+    for factor in ("wrist", "elbow", "shoulder"):
+        if factor in m:
+            out[f"min_abs_{factor}"] = float(np.min(np.abs(m[factor])))
+    return out

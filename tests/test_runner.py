@@ -237,3 +237,27 @@ def test_path_deviation_metric_against_the_line(tmp_path):
     dist = np.linalg.norm(p - np.outer(p @ u, u), axis=1)
     assert weld["max_path_deviation_mm"] > 0.01, "coarse via points must show a deviation"
     assert weld["max_path_deviation_mm"] == pytest.approx(dist.max() * 1e3, rel=0.02, abs=2e-3)
+
+
+def test_singularity_summary_sees_the_wrist_singularity(tmp_path):
+    """A 200iC phase passing through theta5 = 0 (seed 004 eq. 23: det J = 0) is reported as the
+    closest approach to a singularity, at that time; a phase far from it is not."""
+    text = """
+name = "wrist"
+description = "theta5 through zero"
+robot = "lrmate200ic5l"
+[[phases]]
+name = "through"
+planner = "434"
+time_s = [0.0, 0.5, 1.0]
+joints_deg = [[0,0,0,0,-30,0],[0,0,0,0,0,0],[0,0,0,0,30,0]]
+[[phases]]
+name = "away"
+planner = "434"
+durations_s = [0.5, 0.5]
+joints_deg = [[0,10,-20,0,45,0],[0,20,-40,0,60,0]]
+"""
+    s = _run(parse_scenario(text, source="w.toml"), tmp_path / "w")
+    sing = s["singularity"]
+    assert sing["phase"] == "through" and sing["t"] == pytest.approx(0.5, abs=0.011)
+    assert sing["min_abs_wrist"] < 1e-3 and sing["min_sigma"] < 1e-3

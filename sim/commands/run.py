@@ -71,6 +71,12 @@ def run(args: argparse.Namespace) -> int:
               f"{weld['travel_speed_mm_s']:.2f} mm/s (cv {weld['travel_speed_cv']:.4f}), path "
               f"deviation {weld['max_path_deviation_mm']:.3f} mm, torch angle error "
               f"{weld['torch_angle_error_deg']:.3f} deg")
+    sing = summary.get("singularity")
+    if sing:
+        extra = (f", |sin theta5| >= {sing['min_abs_wrist']:.3f}" if "min_abs_wrist" in sing
+                 else "")
+        print(f"  closest to a singularity: sigma_min {sing['min_sigma']:.4g} at "
+              f"{sing['t']:.2f} s ({sing['phase']}){extra}")
     if "placed" in summary:
         print(f"  parts placed: {sum(summary['placed'])}/{len(summary['placed'])}, errors "
               + ", ".join(f"{e:.2f}" for e in summary["place_error_mm"]) + " mm")
