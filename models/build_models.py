@@ -392,7 +392,9 @@ def robot_5r(spec: RobotSpec) -> RobotDef:
                  ("side", (0.8, -4.5, 1.2), (0.8, 0, 0.9)),
                  ("top", (0.6, 0.0, 5.0), (0.6, 0, 0.6))],
         stat_center=(0.6, 0, 0.9), stat_extent=2.6,
-        excludes=[("base", "link2")],
+        # the wrist (link5) folds back past the forearm's end (link3) inside J4's +-135 deg,
+        # as a real offset wrist housing does; the primitive shapes would overlap there
+        excludes=[("base", "link2"), ("link3", "link5")],
         report_pose_deg=(-15.2, 116.82, -1.3, 1.4, -0.206),
         report_pose_label="Seed 001 phase-I end pose",
     )

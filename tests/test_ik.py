@@ -248,3 +248,29 @@ def test_bad_pose_input():
 def test_registry_dims_used():
     for name in ALL_ROBOTS:
         assert closed_form_model(name).dims == get_robot(name).dims
+
+
+def test_5axis_orientation_tolerance_for_typed_angles():
+    """5-axis robots: a tool x axis a hair out of the arm plane (rounded, typed-in angles) is
+    accepted and solved to the nearest reachable orientation; a clear miss is refused with the
+    angle in the message."""
+    import numpy as np
+    import pytest
+
+    from sim.errors import UnreachableError
+    from sim.kinematics.ik import PLANE_TOL, solve_ik
+    from sim.kinematics.model import closed_form_model
+    from sim.kinematics.rotations import rot_z
+
+    kin = closed_form_model("lrmate100ib")
+    q = np.deg2rad([20.0, 30.0, -10.0, 15.0, 5.0])
+    T = np.asarray(kin.fk(q), dtype=float)
+    for angle, ok in ((0.5 * np.degrees(np.arcsin(PLANE_TOL)), True), (1.0, False)):
+        Tt = T.copy()
+        Tt[:3, :3] = rot_z(np.deg2rad(angle)) @ T[:3, :3]  # turn the tool out of the plane
+        if ok:
+            sol = solve_ik(kin, Tt, current=q)[0]
+            np.testing.assert_allclose(sol.q, q, atol=np.deg2rad(0.05))
+        else:
+            with pytest.raises(UnreachableError, match="deg out of the vertical plane"):
+                solve_ik(kin, Tt, current=q)

@@ -58,6 +58,11 @@ from sim.kinematics.rotations import (euler_zyx_to_matrix, invert_transform, mak
 #: |sin theta5| (200iC) or distance from the J1 axis (m) below which the pose is singular.
 SINGULAR_TOL = 1e-9
 
+#: 5-axis robots: a requested tool x axis at most this far (sine of the angle, 0.05 deg) out of
+#: the arm plane is accepted and the solution takes the nearest reachable orientation (the
+#: in-plane part); typed-in or rounded angles are never exactly in the plane.
+PLANE_TOL = float(np.sin(np.deg2rad(0.05)))
+
 
 class SingularityWarning(UserWarning):
     """An IK solution sits on a singularity; one joint was kept at its current value."""
@@ -104,11 +109,12 @@ def _ik_5r_raw(T: NDArray[np.float64], dims: dict[str, float], q1_current: float
     # The tool x axis must lie in the arm plane (eq. 6: alpha = q1 or q1 + pi).
     normal = np.array([-np.sin(base), np.cos(base), 0.0])
     off_plane = float(R[:, 0] @ normal)
-    if abs(off_plane) > 1e-7:
+    if abs(off_plane) > PLANE_TOL:
         raise UnreachableError(
             f"orientation not reachable by a 5-axis arm: the tool x axis is "
-            f"{np.rad2deg(np.arcsin(min(1.0, abs(off_plane)))):.3f} deg out of the vertical "
-            "plane through the J1 axis and the tool point (alpha is implied by the position)",
+            f"{np.rad2deg(np.arcsin(min(1.0, abs(off_plane)))):.4f} deg out of the vertical "
+            "plane through the J1 axis and the tool point (alpha is implied by the position; "
+            f"up to {np.rad2deg(np.arcsin(PLANE_TOL)):.2f} deg is accepted)",
             float("nan"))
     sols: list[tuple[NDArray[np.float64], str]] = []
     gaps = []
