@@ -142,7 +142,9 @@ def build(rig: RobotRig, mount: str) -> Layout:
     j2 = T0[2, 3]
     cameras = add_cameras(world, rig, overview_pos=[1.35, -1.15, j2 + 0.5],
                           overview_target=[0.35, 0.0, z_plate_w],
-                          tool_pos=w([0.95, -0.55, PLATE_TOP + 0.30]).tolist(), tool_fovy=30.0)
+                          # the tool camera looks from the torch side (inside the arc, over
+                          # the V-block), so both seams and their beads are in view
+                          tool_pos=w([0.12, -0.62, PLATE_TOP + 0.45]).tolist(), tool_fovy=40.0)
     dims = {"riser_height": RISER, "plate_top_height": z_plate_w,
             "plate_top_below_j2": -PLATE_TOP, "line_root_height": w(p_start)[2],
             "line_length": r1 - r0, "arc_radius": ARC_R, "arc_sweep_deg": ARC_DEG[1] - ARC_DEG[0],

@@ -6,8 +6,9 @@ Trails and bead are added to a ``mujoco.MjvScene`` as extra geoms after
 * reference tool path (``tcp_pos_ref``): the whole planned path, green ``mjGEOM_LINE``
   segments (width in pixels, unlit, so the colour is exact);
 * actual tool path (``tcp_pos``): red line segments from the start up to the frame's time;
-* weld bead: where ``arc_on`` is true, thick bead-coloured capsules laid along the actual path
-  up to the frame's time (so it grows while welding); the capsule radius is
+* weld bead: where ``arc_on`` is true, a wide bead-coloured line laid along the actual path
+  up to the frame's time (so it grows while welding), lifted towards the eye by the bead radius
+  so that a bead in a fillet's corner is not buried in the plates; its width is
   ``OverlayStyle.bead_radius`` (m) but never thinner than ``bead_min_px`` pixels on screen.
 
 Each line point is moved towards the camera along its line of sight by a few millimetres
@@ -218,7 +219,7 @@ class PathOverlay:
                 scene.ngeom += 1
                 added += 1
 
-        # Weld bead: capsules along the actual path where the arc was on, up to `time`.
+        # Weld bead: a wide line along the actual path where the arc was on, up to `time`.
         for pts, pts_t, t_start, t_end in self.bead_runs:
             if time < t_start:
                 continue
@@ -231,8 +232,12 @@ class PathOverlay:
             mid = 0.5 * (path[1:] + path[:-1])
             dist = np.linalg.norm(mid - eye, axis=1)
             px = span if ortho else dist * span / near  # metres per pixel at each segment
-            radius = np.maximum(st.bead_radius, 0.5 * st.bead_min_px * px)
-            polyline(path, mujoco.mjtGeom.mjGEOM_CAPSULE, st.bead_rgba, radius, 0.35)
+            # a wide line (bead width on screen, at least bead_min_px) lifted towards the eye
+            # by the bead radius: a bead laid in a fillet's corner would otherwise be buried
+            # in both plates; lines also cost far less than capsules on software OpenGL
+            width_px = np.maximum(2.0 * st.bead_radius / px, st.bead_min_px)
+            polyline(lifted(path, st.bead_radius), mujoco.mjtGeom.mjGEOM_LINE, st.bead_rgba,
+                     width_px, 0.35)
         # Reference path, whole.
         if self.reference is not None:
             polyline(lifted(self.reference, st.lift_reference), mujoco.mjtGeom.mjGEOM_LINE,
