@@ -97,6 +97,31 @@ def validate_knots(times: ArrayLike, q: ArrayLike) -> tuple[NDArray[np.float64],
     return t, qa
 
 
+def per_joint_array(name: str, value: ArrayLike, n_joints: int, what: str) -> NDArray[np.float64]:
+    """``value`` as an array of shape (n_joints,): a scalar applies to every joint.
+
+    Args:
+        name: Field name used in messages.
+        value: A number or one number per joint.
+        n_joints: Number of joints.
+        what: What the values are, for messages ("boundary values", "limits").
+
+    Raises:
+        InvalidBoundaryError: Not numbers, or the wrong shape (one line naming ``name``).
+    """
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidBoundaryError(f"{name}: {what} must be numbers ({exc})") from None
+    if v.ndim == 0:
+        return np.full(n_joints, float(v))
+    if v.shape != (n_joints,):
+        raise InvalidBoundaryError(
+            f"{name}: expected a scalar or shape ({n_joints},) (one value per joint), "
+            f"got shape {v.shape}")
+    return v
+
+
 def validate_boundary(name: str, value: ArrayLike | None, n_joints: int) -> NDArray[np.float64]:
     """A boundary value (velocity, acceleration or jerk) as an array of shape (n_joints,).
 
@@ -110,15 +135,7 @@ def validate_boundary(name: str, value: ArrayLike | None, n_joints: int) -> NDAr
     """
     if value is None:
         return np.zeros(n_joints)
-    try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidBoundaryError(f"{name}: boundary values must be numbers ({exc})") from None
-    if v.ndim == 0:
-        v = np.full(n_joints, float(v))
-    elif v.shape != (n_joints,):
-        raise InvalidBoundaryError(
-            f"{name}: expected a scalar or shape ({n_joints},) (one value per joint), got shape {v.shape}")
+    v = per_joint_array(name, value, n_joints, "boundary values")
     bad = np.flatnonzero(~np.isfinite(v))
     if bad.size:
         raise InvalidBoundaryError(

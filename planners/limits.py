@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from planners.base import Trajectory
 from planners.errors import InvalidBoundaryError, LimitViolationError
+from planners.knot_system import per_joint_array
 
 #: Relative slack before a value counts as exceeding its limit (rounding, not tolerance).
 RELATIVE_SLACK = 1e-9
@@ -64,15 +65,7 @@ class LimitViolation:
 def _per_joint(name: str, value: ArrayLike | None, n: int) -> NDArray[np.float64] | None:
     if value is None:
         return None
-    try:
-        v = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidBoundaryError(f"{name}: limits must be numbers ({exc})") from None
-    if v.ndim == 0:
-        v = np.full(n, float(v))
-    if v.shape != (n,):
-        raise InvalidBoundaryError(
-            f"{name}: expected a scalar or shape ({n},) (one limit per joint), got shape {v.shape}")
+    v = per_joint_array(name, value, n, "limits")
     if np.any(np.isnan(v)):
         raise InvalidBoundaryError(f"{name}: limits must not be NaN (use inf for no limit)")
     return v
