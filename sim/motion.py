@@ -187,11 +187,9 @@ class CartesianContext:
 
     @property
     def frame0_from_world(self) -> NDArray[np.float64]:
-        T = self.world_from_frame0
-        inv = np.eye(4)
-        inv[:3, :3] = T[:3, :3].T
-        inv[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-        return inv
+        from sim.kinematics.rotations import invert_transform
+
+        return invert_transform(self.world_from_frame0)
 
     def to_frame0(self, p: ArrayLike) -> NDArray[np.float64]:
         T = self.frame0_from_world

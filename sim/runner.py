@@ -35,6 +35,8 @@ from typing import Any, Callable
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
 
 from sim import __version__
 from sim.errors import CellsimError, SimulationError
@@ -386,15 +388,6 @@ def _sim_acceleration(qd: NDArray[np.float64], t: NDArray[np.float64]) -> NDArra
 # --------------------------------------------------------------------------------------------
 
 
-def _quat_to_mat(q: NDArray[np.float64]) -> NDArray[np.float64]:
-    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
-
-
 def _distance_to_path(p: NDArray[np.float64], cart: Any, T: NDArray[np.float64]) -> NDArray[np.float64]:
     """Distance of world points ``p`` (N,3) from the ideal ADNIA path (frame 0 -> world ``T``)."""
     # sample the path densely (every 10 um, at least 2000 points) by time: the path is
@@ -403,7 +396,6 @@ def _distance_to_path(p: NDArray[np.float64], cart: Any, T: NDArray[np.float64])
     tt = np.linspace(0.0, cart.duration, n)
     pts = cart.at(tt).position @ T[:3, :3].T + T[:3, 3]
     # nearest dense sample, refined by projection on the neighbouring chords
-    from scipy.spatial import cKDTree
 
     tree = cKDTree(pts)
     _, idx = tree.query(p)
@@ -442,7 +434,7 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
         v = np.linalg.norm(np.gradient(p, ts, axis=0), axis=1)
         vc = v[cs] if np.count_nonzero(cs) > 2 else v
         dev = _distance_to_path(p, cart, T)
-        R_act = _quat_to_mat(arrays["tcp_quat"][sel])
+        R_act = Rotation.from_quat(arrays["tcp_quat"][sel], scalar_first=True).as_matrix()
         R_ref = T[:3, :3] @ cart.at(np.clip(ts - pm.t0, 0.0, cart.duration)).rotation
         a_act, a_ref = R_act[:, :, torch_axis], R_ref[:, :, torch_axis]
         cosang = np.clip(np.einsum("ij,ij->i", a_act, a_ref), -1.0, 1.0)
@@ -535,10 +527,10 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
 
     built = build(scenario)
     _check_tcp_consistency(built, scenario)
+    video_args = _video_args(scenario, options)
     if options.video:  # refuse bad video settings before simulating, not after
         from sim.render.frames import resolve_cameras, validate_size
 
-        video_args = _video_args(scenario, options)
         resolve_cameras(built.model, video_args.get("cameras", ("overview",)))
         validate_size(video_args.get("width", 640), video_args.get("height", 480))
         fps = video_args.get("fps", 30.0)
@@ -582,7 +574,6 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         if options.video:
             from sim.video import write_video
 
-            video_args = _video_args(scenario, options)
             write_video(tmp, tmp / "video.mp4", progress=options.progress, **video_args)
             summary["video"] = "video.mp4"
             (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
