@@ -5,7 +5,7 @@ reference motion, then times, over the same model and number of steps:
 
 * ``bare``: a plain Python loop ``for k in range(n): mj_step(model, data)`` (ctrl held);
 * ``sim``: the runner's simulation proper (``summary.wall_s``: the chunked mujoco.rollout);
-* ``total``: :func:`sim.runner.simulate` as a whole (inverse dynamics of the reference,
+* ``total``: :func:`sim.pipeline.run.simulate` as a whole (inverse dynamics of the reference,
   controls, rollout, recording).
 
 and prints ``sim/bare`` (target <= 1.5) and ``total/bare`` with the real-time factor.
@@ -21,9 +21,9 @@ import time
 import mujoco
 import numpy as np
 
-from sim.motion import build_motion
-from sim.resources import shipped_scenarios
-from sim.runner import build, simulate
+from sim.simulation.motion import build_motion
+from sim.core.resources import shipped_scenarios
+from sim.pipeline.run import build, simulate
 from sim.scenario import load_scenario
 
 

@@ -1,10 +1,10 @@
-"""Benchmark of parallel sweeps: serial vs process-pool wall time of ``sim.sweep.run_sweep``.
+"""Benchmark of parallel sweeps: serial vs process-pool wall time of ``sim.pipeline.sweep.run_sweep``.
 
 By default every variant runs a stand-in workload that is shaped like ``cellsim run``: a
 two-link MuJoCo arm with the payload on its tip, PD-tracking a sine reference whose period is
 divided by the speed scale, for ``--sim-time`` seconds at 1 kHz, plus the inverse dynamics of
 the reference, written to ``trajectory.npz``. Pass ``--runner module:function`` (and
-``--scenario``) to time the real runner instead; it must accept a :class:`sim.sweep.Variant`
+``--scenario``) to time the real runner instead; it must accept a :class:`sim.pipeline.sweep.Variant`
 and return its run folder.
 
 Usage::
@@ -12,7 +12,7 @@ Usage::
     .venv/bin/python benchmarks/bench_sweep.py                       # stand-in runner
     .venv/bin/python benchmarks/bench_sweep.py --payloads 0,2.5,5 --speeds 0.5,1,1.5 \\
         --workers 2 --json bench_sweep.json
-    .venv/bin/python benchmarks/bench_sweep.py --runner sim.runner:run_variant --scenario weld_5r
+    .venv/bin/python benchmarks/bench_sweep.py --runner sim.pipeline.run:run_variant --scenario weld_5r
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sim.sweep import Variant, parse_float_list, run_sweep  # noqa: E402
+from sim.pipeline.sweep import Variant, parse_float_list, run_sweep  # noqa: E402
 
 _ARM = """
 <mujoco model="two_link">

@@ -4,7 +4,7 @@ For each size (default 320x240, 640x480, 1280x720) it measures, on one camera:
 
 * ``raw``: ``Renderer.update_scene(data, camera)`` + ``Renderer.render()`` per frame, states
   set beforehand (no overlay, no caption, no encoding): what MuJoCo alone can render;
-* ``pipeline``: :func:`sim.video.write_video` (interpolated states, kinematics, trails and
+* ``pipeline``: :func:`sim.render.video.write_video` (interpolated states, kinematics, trails and
   bead, caption, H.264 encoding in the background thread), frames / time of its frame loop
   (first frame to the encoder's last; ``e2e`` adds model load, OpenGL context, ffmpeg start);
 * ``serial``: the same frames rendered and then encoded in one thread (what the background
@@ -35,7 +35,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sim.gl import configure_gl  # noqa: E402  (before anything imports mujoco)
+from sim.render.gl import configure_gl  # noqa: E402  (before anything imports mujoco)
 
 
 def _sizes(text: str) -> list[tuple[int, int]]:
@@ -119,9 +119,9 @@ def main(argv: list[str] | None = None) -> int:
     backend = configure_gl(args.gl)
     import mujoco
 
-    from sim.render.run import load_run
+    from sim.simulation.runfolder import load_run
     from sim.render.synthetic import write_synthetic_run
-    from sim.video import write_video
+    from sim.render.video import write_video
 
     with tempfile.TemporaryDirectory(prefix="bench_video_") as tmp_name:
         tmp = Path(tmp_name)

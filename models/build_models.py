@@ -42,7 +42,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(ROOT))
 
-from sim.robots import ROBOTS, RobotSpec  # noqa: E402
+from sim.robots.registry import ROBOTS, RobotSpec  # noqa: E402
 
 MODELS = ROOT / "models"
 STEEL = 7850.0  # kg/m^3

@@ -61,7 +61,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planners.base import sample_times
-from planners.errors import PlannerError
+from planners.errors import (CoincidentPointsError, CollinearPointsError, InvalidMoveError,
+                             PlannerError)
 from planners.profiles import ConstantSpeedShare, SpeedProfile
 from planners.rotations import (
     ORIENTATION_MODES,
@@ -113,18 +114,6 @@ _COINCIDENT_TOL = 1e-9
 _COLLINEAR_TOL = 1e-9
 #: Largest number of points sample() will build.
 _MAX_SAMPLES = 50_000_000
-
-
-class InvalidMoveError(PlannerError):
-    """A Cartesian move with an unusable input (speed, period, point, step count)."""
-
-
-class CoincidentPointsError(InvalidMoveError):
-    """Two points of a move that must differ coincide (zero-length move)."""
-
-
-class CollinearPointsError(InvalidMoveError):
-    """The three points of an arc lie on one line, so they define no circle."""
 
 
 # --------------------------------------------------------------------------------------------

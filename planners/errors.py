@@ -1,13 +1,65 @@
-"""Exception hierarchy of the planners.
+"""Exception tree of cellsim, rooted here in the bottom layer.
 
-Every message is one line that names the offending field, joint or value, so that the
-command line can print it as it is.
+:class:`CellsimError` is the root of every exception cellsim raises, the planners' and
+``sim``'s alike; it lives in ``planners`` (the dependency-free bottom layer) so that the
+planners need nothing from ``sim`` while ``sim.errors`` re-exports it and adds its own branches.
+
+Two kinds hang from the root:
+
+* user mistakes (everything but :class:`InternalError`): one-line messages that name the
+  offending file, key, joint or value and, where there is a choice, list the valid ones; the
+  command line prints them and exits with code 2;
+* :class:`InternalError`: a fault inside cellsim (an inconsistency no input should cause); the
+  command line prints the traceback and asks for a report.
+
+This module holds every planner exception; :class:`UnknownNameError` (raised by every
+:class:`planners.registry.Registry`) builds the "did you mean" hint in one place.
 """
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
 
-class PlannerError(ValueError):
+
+class CellsimError(Exception):
+    """Root of every cellsim exception (user mistakes and internal faults)."""
+
+
+class InternalError(CellsimError, RuntimeError):
+    """A fault inside cellsim, not a user mistake: please report it with its traceback."""
+
+
+class CellsimWarning(CellsimError, UserWarning):
+    """Root of cellsim's warnings (issued with :func:`warnings.warn`, never raised)."""
+
+
+class UnknownNameError(CellsimError):
+    """An unknown name of something selectable (robot, cell, tool, planner, scenario, ...).
+
+    The message lists the valid names, sorted, with a "did you mean" hint for a close match.
+
+    Attributes:
+        kind: What was looked up (``"robot"``, ``"planner"``, ...).
+        name: The name asked for.
+        valid: The valid names, sorted.
+    """
+
+    #: Text put before the message (subclasses name their field, e.g. ``"planner: "``).
+    prefix = ""
+
+    def __init__(self, kind: str, name: str, valid: Iterable[str]) -> None:
+        valid = sorted(valid)
+        close = difflib.get_close_matches(str(name), valid, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        super().__init__(f"{self.prefix}unknown {kind} {name!r}{hint}; known: {', '.join(valid)}")
+        self.kind = kind
+        self.name = name
+        self.valid = valid
+
+
+# ---------------------------------------------------------------------------- planners
+class PlannerError(CellsimError, ValueError):
     """Base class of every planning error (a user mistake, not a bug)."""
 
 
@@ -19,8 +71,10 @@ class InvalidBoundaryError(PlannerError):
     """Boundary velocities, accelerations or jerks have the wrong shape or are not finite."""
 
 
-class UnknownPlannerError(PlannerError):
+class UnknownPlannerError(UnknownNameError, PlannerError):
     """A planner name that is not registered; the message lists the valid names."""
+
+    prefix = "planner: "
 
 
 class LimitViolationError(PlannerError):
@@ -42,3 +96,27 @@ class LimitViolationError(PlannerError):
         self.time = time
         self.value = value
         self.limit = limit
+
+
+class InvalidOrientationError(PlannerError):
+    """A tool orientation that is not a proper rotation matrix, or an unusable orientation law."""
+
+
+class InvalidProfileError(PlannerError):
+    """A speed, ramp time, acceleration limit or ramp shape that cannot be used."""
+
+
+class MoveTooShortError(InvalidProfileError):
+    """The move is shorter than the distance its start and stop ramps need."""
+
+
+class InvalidMoveError(PlannerError):
+    """A Cartesian move with an unusable input (speed, period, point, step count)."""
+
+
+class CoincidentPointsError(InvalidMoveError):
+    """Two points of a move that must differ coincide (zero-length move)."""
+
+
+class CollinearPointsError(InvalidMoveError):
+    """The three points of an arc lie on one line, so they define no circle."""

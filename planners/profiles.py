@@ -34,7 +34,7 @@ import numpy as np
 from numpy.polynomial import Polynomial
 from numpy.typing import ArrayLike, NDArray
 
-from planners.errors import PlannerError
+from planners.errors import InvalidProfileError, MoveTooShortError, PlannerError
 
 __all__ = [
     "RAMP_SHAPES",
@@ -50,14 +50,6 @@ RAMP_SHAPES: dict[str, tuple[float, ...]] = {
     "quintic": (0.0, 0.0, 0.0, 10.0, -15.0, 6.0),
     "septic": (0.0, 0.0, 0.0, 0.0, 35.0, -84.0, 70.0, -20.0),
 }
-
-
-class InvalidProfileError(PlannerError):
-    """A speed, ramp time, acceleration limit or ramp shape that cannot be used."""
-
-
-class MoveTooShortError(InvalidProfileError):
-    """The move is shorter than the distance its start and stop ramps need."""
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from planners.errors import PlannerError
+from planners.errors import InvalidOrientationError, PlannerError
 
 __all__ = [
     "ORIENTATION_MODES",
@@ -56,10 +56,6 @@ ORIENTATION_MODES = ("geodesic", "carry", "spherical")
 
 #: Largest |R^T R - I| entry accepted for a user-given rotation matrix.
 ORTHONORMAL_TOL = 1e-6
-
-
-class InvalidOrientationError(PlannerError):
-    """A tool orientation that is not a proper rotation matrix, or an unusable orientation law."""
 
 
 def as_rotation(R: ArrayLike, field: str = "rotation", tol: float = ORTHONORMAL_TOL

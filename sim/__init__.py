@@ -10,7 +10,7 @@ def _default_gl() -> str:
 
     MuJoCo reads ``MUJOCO_GL`` once, at import; left unset on Linux it binds GLFW, which needs a
     display. This picks EGL or OSMesa by which library is installed (cheap); rendering
-    commands then probe and, if needed, switch with :func:`sim.gl.configure_gl`.
+    commands then probe and, if needed, switch with :func:`sim.render.gl.configure_gl`.
     """
     import ctypes.util
 

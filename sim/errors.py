@@ -1,34 +1,24 @@
-"""Exception hierarchy of cellsim.
+"""The exception tree of ``sim`` (its root is :class:`planners.errors.CellsimError`).
 
-A :class:`CellsimError` is a user mistake (bad scenario, unknown robot, unreachable pose):
-the command line prints its one-line message and exits with code 2, never a traceback.
+Every exception cellsim defines derives from :class:`CellsimError`, re-exported here from the
+bottom layer so that the planners' errors share it. A user mistake (bad scenario, unknown name,
+unreachable pose, damaged run folder) is printed by the command line as one line, exit code 2;
+an :class:`InternalError` is a fault inside cellsim and is reported with its traceback.
 """
 
 from __future__ import annotations
 
-import difflib
-from collections.abc import Iterable
-
-
-class CellsimError(Exception):
-    """Base class of every user-facing error of cellsim."""
+from planners.errors import (
+    CellsimError,
+    CellsimWarning,
+    InternalError,
+    PlannerError,
+    UnknownNameError,
+)
 
 
 class ScenarioError(CellsimError):
     """A scenario file is malformed or inconsistent; the message names the file and field."""
-
-
-class UnknownNameError(CellsimError):
-    """An unknown robot, cell, tool, camera or scenario name; the message lists valid ones."""
-
-    def __init__(self, kind: str, name: str, valid: Iterable[str]) -> None:
-        valid = sorted(valid)
-        close = difflib.get_close_matches(name, valid, n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        super().__init__(f"unknown {kind} {name!r}{hint}; known: {', '.join(valid)}")
-        self.kind = kind
-        self.name = name
-        self.valid = valid
 
 
 class KinematicsError(CellsimError):
@@ -43,9 +33,36 @@ class UnreachableError(KinematicsError):
         self.distance = distance
 
 
+class SingularityWarning(CellsimWarning):
+    """An IK solution sits on a singularity; one joint was kept at its current value."""
+
+
+class CellError(CellsimError):
+    """A cell cannot be composed as asked (robot, tool, mount or payload it does not take)."""
+
+
 class SimulationError(CellsimError):
     """The simulation became unstable (NaN, MuJoCo warning); names the time and joint."""
 
 
+class RunFolderError(CellsimError):
+    """A run folder is missing, incomplete or inconsistent; names the folder and the file/field."""
+
+
+class SizingError(CellsimError):
+    """Bad sizing input (drive overrides, joints that do not match the robot)."""
+
+
+class SweepError(CellsimError):
+    """Bad sweep input (payloads, speed scales, workers) or failed variants; one line."""
+
+
 class RenderError(CellsimError):
     """No working OpenGL backend, or an unknown camera; says what to install or choose."""
+
+
+__all__ = [
+    "CellError", "CellsimError", "CellsimWarning", "InternalError", "KinematicsError",
+    "PlannerError", "RenderError", "RunFolderError", "ScenarioError", "SimulationError",
+    "SingularityWarning", "SizingError", "SweepError", "UnknownNameError", "UnreachableError",
+]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 
-# Headless rendering: choose EGL by default before anything imports mujoco; sim.gl may
+# Headless rendering: choose EGL by default before anything imports mujoco; sim.render.gl may
 # override this with a working backend.
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -16,7 +16,7 @@ import pytest  # noqa: E402
 def scenario_run(tmp_path_factory):
     """``scenario_run(name) -> (run_dir, summary)``: each shipped scenario simulated once per
     test session (no video, no plots), shared by every test that checks its results."""
-    from sim.runner import RunOptions, run_scenario
+    from sim.pipeline.run import RunOptions, run_scenario
     from sim.scenario import load_scenario
 
     root = tmp_path_factory.mktemp("scenario_runs")

@@ -13,10 +13,10 @@ import pytest
 
 from sim.cells import BARE, CELLS, MOUNTS, Seam, build_cell
 from sim.errors import CellsimError, UnknownNameError
-from sim.kinematics.closed_form import fk_5r
-from sim.kinematics.ik import solve_ik
-from sim.robots import ROBOTS
-from sim.tools import TOOLS
+from sim.robots.closed_form import fk_5r
+from sim.robots.ik import solve_ik
+from sim.robots.registry import ROBOTS
+from sim.cells.tools import TOOLS
 
 COMBOS = [(c, r, mt) for c, s in CELLS.items() for r in s.robots for mt in s.mounts] + \
          [(None, r, mt) for r in sorted(ROBOTS) for mt in BARE.mounts]
@@ -397,7 +397,7 @@ def test_suction_holds_half_kilo_through_fast_swing():
     # 90 deg of J1 in 0.5 s at ~0.5 m radius: peak tcp acceleration ~20 m/s^2
     lift, slip = _pick_run(1.0, mass=0.5, swing=True)
     assert lift == pytest.approx(0.10, abs=3e-3)
-    assert slip < 3e-3  # soft-friction creep only (see sim.tools)
+    assert slip < 3e-3  # soft-friction creep only (see sim.cells.tools)
 
 
 # ---------------------------------------------------------------------------- bad input

@@ -7,13 +7,13 @@ import numpy as np
 import pytest
 
 from sim.errors import KinematicsError
-from sim.kinematics.builder import (RRRT_DIMS, RRRT_Q4, RTT_L1, DHRow, KinematicChain, MDHRow,
+from sim.robots.builder import (RRRT_DIMS, RRRT_Q4, RTT_L1, DHRow, KinematicChain, MDHRow,
                                     ScrewAxis, example_chains, fanuc6_chain, five_r_chain,
                                     rrrt_chain, rrrt_exercise_q, rtt_chain)
-from sim.kinematics.closed_form import fk_5r, fk_fanuc6, mdh_transform
-from sim.kinematics.mujoco_fk import MujocoKinematics
-from sim.resources import models_dir
-from sim.robots import get_robot
+from sim.robots.closed_form import fk_5r, fk_fanuc6, mdh_transform
+from sim.robots.mujoco_fk import MujocoKinematics
+from sim.core.resources import models_dir
+from sim.robots.registry import get_robot
 
 
 def _mj(chain: KinematicChain) -> MujocoKinematics:
@@ -145,7 +145,7 @@ def test_screw_chain_with_tilted_axes_and_rotated_home():
 
 
 def test_shipped_examples_are_up_to_date():
-    """models/examples/*.xml are what `python -m sim.kinematics.builder` generates."""
+    """models/examples/*.xml are what `python -m sim.robots.builder` generates."""
     for name, chain in example_chains().items():
         text = (models_dir() / "examples" / f"{name}.xml").read_text()
         assert chain.to_mjcf() in text

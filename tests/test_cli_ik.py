@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from sim.cli import main
-from sim.kinematics.model import closed_form_model, kinematic_model
-from sim.kinematics.rotations import euler_zyx_to_matrix, matrix_to_euler_zyx
-from sim.robots import ROBOTS
+from sim.robots.model import closed_form_model, kinematic_model
+from sim.core.rotations import euler_zyx_to_matrix, matrix_to_euler_zyx
+from sim.robots.registry import ROBOTS
 
 ALL_ROBOTS = sorted(ROBOTS)
 REPO = Path(__file__).resolve().parents[1]
@@ -147,7 +147,7 @@ def test_workspace_png_and_reach(capsys, tmp_path):
 
 
 def test_reach_definition_against_closed_form():
-    from sim.kinematics.workspace import compute_reach
+    from sim.robots.workspace import compute_reach
 
     m = closed_form_model("lrmate200ic5l")
     m.lower = m.upper = None

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from sim.cli import main
-from sim.resources import shipped_scenarios
+from sim.core.resources import shipped_scenarios
 
 
 def _run(*args: str) -> subprocess.CompletedProcess:

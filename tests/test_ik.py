@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from sim.errors import KinematicsError, UnreachableError
-from sim.kinematics.closed_form import fk_5r, fk_fanuc6
-from sim.kinematics.ik import SingularityWarning, ik_5r_seed, ik_path, solve_ik
-from sim.kinematics.model import KinematicModel, closed_form_model, kinematic_model
-from sim.kinematics.rotations import euler_zyx_to_matrix, make_transform, wrap_to_pi
-from sim.robots import ROBOTS, get_robot
+from sim.robots.closed_form import fk_5r, fk_fanuc6
+from sim.robots.ik import SingularityWarning, ik_5r_seed, ik_path, solve_ik
+from sim.robots.model import KinematicModel, closed_form_model, kinematic_model
+from sim.core.rotations import euler_zyx_to_matrix, make_transform, wrap_to_pi
+from sim.robots.registry import ROBOTS, get_robot
 
 ALL_ROBOTS = sorted(ROBOTS)
 
@@ -258,9 +258,9 @@ def test_5axis_orientation_tolerance_for_typed_angles():
     import pytest
 
     from sim.errors import UnreachableError
-    from sim.kinematics.ik import PLANE_TOL, solve_ik
-    from sim.kinematics.model import closed_form_model
-    from sim.kinematics.rotations import rot_z
+    from sim.robots.ik import PLANE_TOL, solve_ik
+    from sim.robots.model import closed_form_model
+    from sim.core.rotations import rot_z
 
     kin = closed_form_model("lrmate100ib")
     q = np.deg2rad([20.0, 30.0, -10.0, 15.0, 5.0])

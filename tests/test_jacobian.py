@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.kinematics.jacobian import (geometric_jacobian, manipulability, numeric_jacobian,
+from sim.robots.jacobian import (geometric_jacobian, manipulability, numeric_jacobian,
                                      singularity_measures, task_jacobian, task_jacobian_5r)
-from sim.kinematics.model import closed_form_model, kinematic_model
-from sim.kinematics.mujoco_fk import MujocoKinematics
-from sim.robots import ROBOTS
+from sim.robots.model import closed_form_model, kinematic_model
+from sim.robots.mujoco_fk import MujocoKinematics
+from sim.robots.registry import ROBOTS
 
 ALL_ROBOTS = sorted(ROBOTS)
 
@@ -82,7 +82,7 @@ def test_seed004_singular_conditions_give_zero_det():
         assert singularity_measures(m, np.array([0.3, 0.4, t, 0.7, 0.6, -0.2]))["sigma_min"] < 1e-12
     # eq. 25 (as printed): d2 + d3 S2 + C2 (R4 C3 - d4 S3) + S2 (R4 S3 + d4 C3) = 0. Solve it
     # for theta2 at a few theta3 (brentq) and evaluate det J at theta2 -> -theta2 (the seed's
-    # sign of theta2 in eq. 25 is opposite to eq. 6's; see sim.kinematics.jacobian).
+    # sign of theta2 in eq. 25 is opposite to eq. 6's; see sim.robots.jacobian).
     from scipy.optimize import brentq
 
     def eq25(t2, t3):
@@ -129,7 +129,7 @@ def test_5r_task_jacobian_det_and_singularities(name):
     P = m.fk(Q)[:, :3, 3]
     np.testing.assert_allclose(np.abs(s["shoulder"]), np.hypot(P[:, 0], P[:, 1]), atol=1e-12)
     # rows 4-5 of the task Jacobian by finite differences of the Euler angles (eq. 6)
-    from sim.kinematics.rotations import matrix_to_euler_zyx
+    from sim.core.rotations import matrix_to_euler_zyx
 
     q = np.array([0.2, 0.3, -0.4, 0.5, 0.6])
     h = 1e-6

@@ -12,8 +12,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from sim.kinematics.closed_form import fk_5r, fk_fanuc6
-from sim.robots import ROBOTS, RobotSpec, joint_ranges
+from sim.robots.closed_form import fk_5r, fk_fanuc6
+from sim.robots.registry import ROBOTS, RobotSpec, joint_ranges
 
 ROOT = Path(__file__).resolve().parents[1]
 NAMES = list(ROBOTS)

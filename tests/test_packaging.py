@@ -27,7 +27,7 @@ def test_wheel_ships_models_scenarios_and_packages(wheel):
         assert f"sim/_data/scenarios/{scenario.name}" in names
     for xml in (ROOT / "models").rglob("*.xml"):
         assert f"sim/_data/models/{xml.relative_to(ROOT / 'models').as_posix()}" in names
-    assert "sim/cli.py" in names and "planners/__init__.py" in names
+    assert "sim/cli/__init__.py" in names and "planners/__init__.py" in names
     assert not any(n.startswith(("tests/", ".venv/")) for n in names)
 
 
@@ -37,7 +37,7 @@ def test_installed_wheel_runs_from_elsewhere(wheel, tmp_path):
                     str(site), str(wheel)], check=True, capture_output=True, text=True)
     code = (
         "import sys; sys.path.insert(0, sys.argv[1]);"
-        "import sim, sim.resources as r;"
+        "import sim, sim.core.resources as r;"
         "assert sim.__file__.startswith(sys.argv[1]), sim.__file__;"
         "print(r.scenarios_dir()); from sim.cli import main; sys.exit(main(['list']))"
     )

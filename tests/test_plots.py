@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.plots import (
+from sim.analysis.plots import (
     FIGURE_SIZES,
     joint_figure,
     png_size,
@@ -18,7 +18,7 @@ from sim.plots import (
     tracking_error_figure,
     write_plots,
 )
-from sim.render.run import RunFolderError, RunRecord, load_run
+from sim.simulation.runfolder import RunFolderError, RunRecord, load_run
 from sim.render.synthetic import JOINTS, write_synthetic_run
 
 

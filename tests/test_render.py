@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation, Slerp
 
-import sim.gl as gl
+import sim.render.gl as gl
 from sim.errors import RenderError
 from sim.render.interp import QposInterpolator, slerp
 from sim.render.overlay import (
@@ -26,7 +26,7 @@ from sim.render.overlay import (
     draw_caption,
     simplify_polyline,
 )
-from sim.render.run import RunFolderError, RunRecord, load_run
+from sim.simulation.runfolder import RunFolderError, RunRecord, load_run
 from sim.render.synthetic import JOINTS, write_synthetic_run
 
 REPO = Path(__file__).resolve().parents[1]
@@ -111,9 +111,9 @@ def test_no_working_backend_says_what_to_install(monkeypatch: pytest.MonkeyPatch
 def test_backend_is_switched_when_mujoco_was_imported_first() -> None:
     """mujoco imported with MUJOCO_GL unset binds GLFW; configure_gl rebinds it to EGL/OSMesa."""
     code = (
-        "import mujoco, sim.gl\n"
+        "import mujoco, sim.render.gl\n"
         "before = mujoco.rendering.classic.gl_context.GLContext.__module__\n"
-        "name = sim.gl.configure_gl()\n"
+        "name = sim.render.gl.configure_gl()\n"
         "after = mujoco.rendering.classic.gl_context.GLContext.__module__\n"
         "m = mujoco.MjModel.from_xml_string('<mujoco><worldbody><light pos=\"0 0 2\"/>"
         "<geom type=\"sphere\" size=\".1\"/></worldbody></mujoco>')\n"
@@ -137,10 +137,10 @@ def test_backend_is_switched_when_mujoco_was_imported_first() -> None:
 
 def test_pyopengl_bound_elsewhere_is_reported_clearly() -> None:
     code = (
-        "import OpenGL.platform, mujoco, sim.gl\n"
+        "import OpenGL.platform, mujoco, sim.render.gl\n"
         "from sim.errors import RenderError\n"
         "try:\n"
-        "    sim.gl.configure_gl()\n"
+        "    sim.render.gl.configure_gl()\n"
         "except RenderError as exc:\n"
         "    print(exc)\n"
     )

@@ -1,4 +1,4 @@
-"""Tests of sim.report: the files a user hands to a colleague (sizing.csv/json/md, report.html)."""
+"""Tests of sim.analysis.report: the files a user hands to a colleague (sizing.csv/json/md, report.html)."""
 
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ from html.parser import HTMLParser
 import numpy as np
 import pytest
 
-from sim.report import REQUIRED_COLUMNS, write_atomic, write_sizing
-from sim.robots import Drive
-from sim.sizing import size_trajectory
+from sim.analysis.report import REQUIRED_COLUMNS, write_atomic, write_sizing
+from sim.robots.registry import Drive
+from sim.analysis.sizing import size_trajectory
 
 JOINTS = ("j1", "j2", "j3")
 DRIVE = Drive(gear_ratio=100.0, efficiency=0.9, rotor_inertia=1e-4, rated_torque=1.5,

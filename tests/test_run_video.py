@@ -13,7 +13,7 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from sim import gl
+from sim.render import gl
 
 AVAILABLE = gl.available_backends()
 pytestmark = pytest.mark.render

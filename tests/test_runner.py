@@ -13,7 +13,7 @@ import pytest
 
 from sim.cli import main
 from sim.errors import CellsimError, SimulationError
-from sim.runner import RunOptions, run_scenario
+from sim.pipeline.run import RunOptions, run_scenario
 from sim.scenario import load_scenario, parse_scenario
 
 REQUIRED_ARRAYS = {"t", "phase", "q_ref", "qd_ref", "qdd_ref", "qddd_ref", "q", "qd", "tau",
@@ -143,7 +143,7 @@ joints_deg = [[0,0,0,0,0],[10,20,10,10,10],[20,40,20,20,20]]
 def test_instability_stops_with_time_and_joint_and_keeps_failed_folder(tmp_path, monkeypatch):
     """An unstable simulation (here: a servo gain far beyond the time step's stability limit)
     stops the run with the time and the joint; what was recorded goes to DIR.failed/."""
-    import sim.runner as runner
+    import sim.pipeline.run as runner
 
     real_build = runner.build
 

@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
-from sim.resources import shipped_scenarios
+from sim.core.resources import shipped_scenarios
 from sim.scenario import (
     ActionSpec,
     CircularPhaseSpec,

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sim.resources import shipped_scenarios
+from sim.core.resources import shipped_scenarios
 
 SCENARIOS = sorted(shipped_scenarios())
 WELD = [n for n in SCENARIOS if "weld" in n]

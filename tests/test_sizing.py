@@ -1,4 +1,4 @@
-"""Tests of sim.sizing: every statistic is recomputed independently (closed forms, scipy
+"""Tests of sim.analysis.sizing: every statistic is recomputed independently (closed forms, scipy
 quadrature of the analytic signal, hand formulas), never echoed from the code under test."""
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import pytest
 from scipy import integrate, optimize
 
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
-from sim.robots import ROBOTS, Drive
-from sim.sizing import (
+from sim.robots.registry import ROBOTS, Drive
+from sim.analysis.sizing import (
     PEAK_KNEE_FRACTION,
     apply_overrides,
     armature_from_model,
@@ -201,7 +201,7 @@ def test_motor_speed_in_rpm() -> None:
 
 
 def test_envelopes_shape() -> None:
-    from sim.sizing import peak_envelope
+    from sim.analysis.sizing import peak_envelope
 
     n_max, n_k = DRIVE.max_speed_rpm, PEAK_KNEE_FRACTION * DRIVE.max_speed_rpm
     env = peak_envelope(DRIVE, [0.0, n_k, (n_k + n_max) / 2, n_max, -n_max, 1.01 * n_max])

@@ -14,7 +14,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from sim.runner import RunOptions, run_scenario
+from sim.pipeline.run import RunOptions, run_scenario
 from sim.scenario import load_scenario, parse_scenario
 
 HOLD = """
@@ -127,7 +127,7 @@ def test_torque_scales_with_speed_squared_without_gravity(tmp_path, monkeypatch)
     """With gravity, damping and friction removed, every torque of the same path run s times
     faster is s^2 times larger: inverse dynamics at every instant (to 1e-6 of the peak), the
     simulated torque's peak and RMS to 2 %."""
-    import sim.runner as runner
+    import sim.pipeline.run as runner
 
     real_build = runner.build
 

@@ -1,4 +1,4 @@
-"""Tests of sim.sweep with fake module-level runners (picklable) whose torques are known in
+"""Tests of sim.pipeline.sweep with fake module-level runners (picklable) whose torques are known in
 closed form: peak = payload * g * L + k * s^2 (gravity of the payload on a lever L plus an
 inertial part that grows with the square of the speed scale s)."""
 
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from sim.errors import CellsimError, UnknownNameError
-from sim.sweep import (
+from sim.pipeline.sweep import (
     SWEEP_COLUMNS,
     SweepError,
     Variant,

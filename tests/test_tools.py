@@ -10,9 +10,9 @@ import pytest
 
 from sim.cells import build_cell
 from sim.errors import UnknownNameError
-from sim.kinematics.closed_form import fk_5r, fk_fanuc6
-from sim.robots import ROBOTS, get_robot
-from sim.tools import (CUP_BODY, SUCTION_ACTUATOR, TIP_SITE, TOOLS, build_tool, get_tool)
+from sim.robots.closed_form import fk_5r, fk_fanuc6
+from sim.robots.registry import ROBOTS, get_robot
+from sim.cells.tools import (CUP_BODY, SUCTION_ACTUATOR, TIP_SITE, TOOLS, build_tool, get_tool)
 
 RNG = np.random.default_rng(7)
 

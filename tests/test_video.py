@@ -16,7 +16,7 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-import sim.gl as gl
+import sim.render.gl as gl
 from sim.cli import main
 from sim.errors import RenderError
 from sim.render.synthetic import write_synthetic_run
@@ -56,7 +56,7 @@ def test_video_with_each_available_backend(backend: str, run_dir: Path, tmp_path
     out = tmp_path / f"{backend}.mp4"
     code = (
         "import sys\n"
-        "from sim.video import write_video\n"
+        "from sim.render.video import write_video\n"
         f"r = write_video(sys.argv[1], sys.argv[2], width={WIDTH}, height={HEIGHT}, fps={FPS},"
         f" gl={backend!r})\n"
         "print(r.frames, r.backend)\n"
@@ -88,7 +88,7 @@ def test_clean_exit_after_an_error_inside_the_render_loop(run_dir: Path, tmp_pat
     """A failure mid-video (encoder rejects its options) closes everything, leaves no file."""
     code = (
         "import sys\n"
-        "from sim.video import write_video\n"
+        "from sim.render.video import write_video\n"
         "from sim.errors import RenderError\n"
         "try:\n"
         "    write_video(sys.argv[1], sys.argv[2], width=64, height=48, fps=5, preset='nosuch')\n"
@@ -105,7 +105,7 @@ def test_clean_exit_after_an_error_inside_the_render_loop(run_dir: Path, tmp_pat
 
 
 def test_tiled_video_and_result(run_dir: Path, tmp_path: Path) -> None:
-    from sim.video import write_video
+    from sim.render.video import write_video
 
     result = write_video(run_dir, tmp_path / "sub" / "two.mp4", cameras=("overview", "tool"),
                          width=64, height=48, fps=4.0)
@@ -118,7 +118,7 @@ def test_tiled_video_and_result(run_dir: Path, tmp_path: Path) -> None:
 
 
 def test_video_argument_errors(run_dir: Path, tmp_path: Path) -> None:
-    from sim.video import write_video
+    from sim.render.video import write_video
 
     with pytest.raises(RenderError, match=r"must end in \.mp4"):
         write_video(run_dir, tmp_path / "v.avi")

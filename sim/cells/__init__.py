@@ -40,9 +40,9 @@ from sim.cells.compose import (ROBOT_PREFIX, Layout, RobotRig, add_home_keyframe
                                prepare_robot, suction_actuator_name, tip_site_name)
 from sim.cells.seam import Seam
 from sim.errors import CellsimError, UnknownNameError
-from sim.kinematics.model import KinematicModel
-from sim.robots import ROBOTS, RobotSpec, get_robot
-from sim.tools import TOOLS, ToolSpec, get_tool
+from sim.robots.model import KinematicModel
+from sim.robots.registry import ROBOTS, RobotSpec, get_robot
+from sim.cells.tools import TOOLS, ToolSpec, get_tool
 
 #: ``tool="none"`` asks for no tool even where the cell has a default one.
 NO_TOOL = "none"
@@ -175,7 +175,7 @@ def build_cell(cell: str | None, robot: str, *, tool: str | None = None, mount: 
     Args:
         cell: A key of :data:`CELLS`, or None for the robot's bare scene.
         robot: Robot registry name (``sim.robots.ROBOTS``).
-        tool: Tool name (``sim.tools.TOOLS``); None = the cell's default tool (bare scene: no
+        tool: Tool name (``sim.cells.tools.TOOLS``); None = the cell's default tool (bare scene: no
             tool); ``"none"`` = no tool.
         mount: ``"floor"`` or ``"ceiling"`` (each cell lists the ones it supports).
         payload_kg: Lumped payload at the tcp, kg (>= 0).

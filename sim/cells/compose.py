@@ -6,7 +6,7 @@ Steps (:func:`prepare_robot`, :func:`new_world`, :func:`attach_robot`, :func:`fi
    in the composed model is then ``robot/<name>``, e.g. ``robot/j1``). Its keyframes are removed
    (their ``qpos`` would not match the composed model) and its ``home`` keyframe is kept as
    ``home_q``; the cell adds its own ``home`` keyframe covering every degree of freedom.
-2. The tool (:mod:`sim.tools`) is attached with ``site.attach`` at a site ``tool_mount`` placed on
+2. The tool (:mod:`sim.cells.tools`) is attached with ``site.attach`` at a site ``tool_mount`` placed on
    the robot's ``flange`` site and turned so that the tool frame's ``+z`` is the flange approach
    axis. The approach axis is the seeds' (5r: frame 6 x axis; fanuc6: ``a = z6``), which both
    point along frame 0's ``+x`` at ``q = 0``; it is expressed in the flange site's frame from
@@ -20,7 +20,7 @@ Steps (:func:`prepare_robot`, :func:`new_world`, :func:`attach_robot`, :func:`fi
    an attachment frame: ``floor`` mount = upright at a height (a riser or column), ``ceiling`` =
    turned 180 deg about the world x axis (base up, J1 axis pointing down) under a ceiling plate.
 
-Contacts: the cell's static geometry and the parts use the bit masks of :mod:`sim.tools`, so the
+Contacts: the cell's static geometry and the parts use the bit masks of :mod:`sim.cells.tools`, so the
 robot's links (MuJoCo's default ``contype = conaffinity = 1``) never touch the cell: clearance is
 a geometric question, and contact forces must not pollute the joint torques used for sizing.
 Parts touch the fixtures, each other and the suction cup.
@@ -38,10 +38,10 @@ from dm_control import mjcf
 from numpy.typing import NDArray
 
 from sim.errors import CellsimError
-from sim.kinematics.closed_form import fk_5r, fk_fanuc6
-from sim.kinematics.model import KinematicModel, kinematic_model
-from sim.robots import RobotSpec, get_robot
-from sim.tools import CONTACT_FIXTURE, CUP_BODY, SUCTION_ACTUATOR, TIP_SITE, ToolSpec, build_tool
+from sim.robots.closed_form import fk_5r, fk_fanuc6
+from sim.robots.model import KinematicModel, kinematic_model
+from sim.robots.registry import RobotSpec, get_robot
+from sim.cells.tools import CONTACT_FIXTURE, CUP_BODY, SUCTION_ACTUATOR, TIP_SITE, ToolSpec, build_tool
 
 ROBOT_PREFIX = "robot"
 TOOL_PREFIX = "tool"
@@ -264,7 +264,7 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
     robot.model = ROBOT_PREFIX
     if tool is not None and tool.suction_gain_n > 0.0:
         # implicitfast diverged with an adhesion-held 0.5 kg part (the part tumbles); the full
-        # implicit integrator (also supported by mj_inverse's invdiscrete) holds it: see sim.tools
+        # implicit integrator (also supported by mj_inverse's invdiscrete) holds it: see sim.cells.tools
         robot.option.integrator = "implicit"
     flange = robot.find("site", "flange")
     tcp = robot.find("site", "tcp")

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.cells.compose import Layout, RobotRig, add_box, add_cameras, attach_robot, new_world
-from sim.tools import CONTACT_PART_AFFINITY, CONTACT_PART_TYPE
+from sim.cells.tools import CONTACT_PART_AFFINITY, CONTACT_PART_TYPE
 
 RISER = 0.6
 INFEED_TOP = -0.18  #: infeed table top in frame 0, m

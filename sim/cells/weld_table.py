@@ -37,7 +37,7 @@ import numpy as np
 from sim.cells.compose import (Layout, RobotRig, add_box, add_cameras, add_ring, attach_robot,
                                new_world)
 from sim.cells.seam import Seam
-from sim.kinematics.ik import solve_ik
+from sim.robots.ik import solve_ik
 
 RISER = 0.6  #: robot riser height, m
 PLATE_TOP = -0.15  #: base plate top in frame 0, m

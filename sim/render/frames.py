@@ -22,10 +22,10 @@ from typing import Any
 import numpy as np
 
 from sim.errors import RenderError
-from sim.gl import configure_gl
+from sim.render.gl import configure_gl
 from sim.render.interp import QposInterpolator
 from sim.render.overlay import OverlayStyle, PathOverlay, caption_text, draw_caption
-from sim.render.run import REQUIRED_FOR_VIDEO, RunFolderError, RunRecord, as_record
+from sim.simulation.runfolder import REQUIRED_FOR_VIDEO, RunFolderError, RunRecord, as_record
 
 #: Largest tile side accepted, pixels (8K; larger sizes fail in most OpenGL drivers).
 MAX_SIDE = 8192
@@ -88,7 +88,7 @@ class FrameRenderer:
     """Renders a run's frames at chosen times.
 
     Args:
-        run: A run folder or a :class:`~sim.render.run.RunRecord`.
+        run: A run folder or a :class:`~sim.simulation.runfolder.RunRecord`.
         cameras: Camera names, tiled left to right.
         width: Tile width, pixels (even).
         height: Tile height, pixels (even).

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from sim.render.interp import interp_rows, sample_index
-from sim.render.run import RunRecord
+from sim.simulation.runfolder import RunRecord
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 Used by the rendering/plot tests and benchmarks so that they do not depend on the robot
 models or on the simulator. The folder has the layout ``cellsim run`` writes
-(``model.xml``, ``summary.json``, ``trajectory.npz``; see :mod:`sim.render.run`):
+(``model.xml``, ``summary.json``, ``trajectory.npz``; see :mod:`sim.simulation.runfolder`):
 
 * model: a table with a cylindrical part on a free joint (listed first, so the arm's joints
   do not start at ``qpos[0]``), a 4R arm (``j1`` about z, ``j2``/``j3`` about y, ``j4`` about

@@ -1,0 +1,457 @@
+"""Sizing reports of a run: ``sizing.csv``, ``sizing.json``, ``sizing.md``, ``report.html`` and
+charts (``sizing/torques.png``, ``sizing/torque_speed_<joint>.png``).
+
+Everything is written atomically (a temporary file in the same folder, then ``os.replace``),
+so a reader never sees half a file. ``report.html`` is self-contained: the charts are embedded
+as base64 data URIs; the only outside reference is a relative link to ``video.mp4`` when the
+run has one.
+
+Column convention of ``sizing.csv`` (one row per joint): a quantity without suffix is the one
+the checks use (with the default basis ``"worst"``, the larger of the two sources); ``_id`` is
+from inverse dynamics of the reference, ``_sim`` from the simulated actuator torque. Empty cells
+mean "not applicable" (no drive data, no limit).
+"""
+
+from __future__ import annotations
+
+import base64
+import csv
+import html
+import io
+import json
+import os
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sim.analysis.sizing import (
+    CHECK_TITLES,
+    PEAK_KNEE_FRACTION,
+    SOURCE_TITLES,
+    JointSizing,
+    SizingResult,
+    continuous_envelope,
+    load_summary,
+    peak_envelope,
+)
+
+#: Sub-folder of the run folder holding the charts.
+PLOTS_DIR = "sizing"
+
+#: Required leading columns of sizing.csv.
+REQUIRED_COLUMNS = ("joint", "peak_torque_nm", "rms_torque_nm", "peak_speed_rad_s", "peak_power_w",
+                    "margin_pct", "pass")
+
+
+# --------------------------------------------------------------------------------------------
+# Atomic files
+# --------------------------------------------------------------------------------------------
+
+def write_atomic(path: str | Path, data: bytes | str) -> Path:
+    """Write ``data`` to ``path`` through a temporary file and ``os.replace``.
+
+    Args:
+        path: Destination; its folder is created when missing.
+        data: Bytes, or text (written as UTF-8).
+
+    Returns:
+        The destination path.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    raw = data.encode("utf-8") if isinstance(data, str) else data
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(raw)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    return path
+
+
+def csv_text(columns: Sequence[str], rows: Sequence[Mapping[str, Any]]) -> str:
+    """CSV text with a header; floats in their shortest exact form, NaN/None as empty cells."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(columns)
+    for r in rows:
+        w.writerow([_cell(r.get(c)) for c in columns])
+    return buf.getvalue()
+
+
+def _cell(v: Any) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, (bool, np.bool_)):
+        return "true" if v else "false"
+    if isinstance(v, (float, np.floating)):
+        return repr(float(v)) if np.isfinite(v) else ""  # shortest exact round trip
+    return str(v)
+
+
+def figure_png(fig: Any) -> bytes:
+    """PNG bytes of a matplotlib ``Figure`` (no pyplot, no display needed)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    return buf.getvalue()
+
+
+# --------------------------------------------------------------------------------------------
+# Table rows
+# --------------------------------------------------------------------------------------------
+
+def _basis_value(result: SizingResult, a: float, b: float) -> float:
+    if result.basis == "id":
+        return a
+    if result.basis == "sim":
+        return b
+    return max(a, b)
+
+
+def sizing_rows(result: SizingResult) -> tuple[list[str], list[dict[str, Any]]]:
+    """``(columns, rows)`` of ``sizing.csv``, one row per joint."""
+    nan = float("nan")
+    rows = []
+    for j in result.joints:
+        sid, ssim = j.stats["id"], j.stats["sim"]
+        r: dict[str, Any] = {"joint": j.joint, "pass": "PASS" if j.passed else "FAIL",
+                             "margin_pct": j.margin_pct,
+                             "limiting": j.limiting.key if j.limiting else ""}
+        for name, attr, unit in (("peak_torque", "peak_torque", "nm"),
+                                 ("rms_torque", "rms_torque", "nm"),
+                                 ("peak_speed", "peak_speed", "rad_s"),
+                                 ("peak_accel", "peak_accel", "rad_s2"),
+                                 ("peak_power", "peak_power", "w"),
+                                 ("energy", "energy", "j")):
+            a, b = getattr(sid, attr), getattr(ssim, attr)
+            r[f"{name}_{unit}"] = _basis_value(result, a, b)
+            r[f"{name}_id_{unit}"] = a
+            r[f"{name}_sim_{unit}"] = b
+        r["peak_torque_time_id_s"] = sid.peak_torque_time
+        r["peak_torque_time_sim_s"] = ssim.peak_torque_time
+        for name, attr, unit in (("mean_abs_power", "mean_abs_power", "w"),
+                                 ("mean_power", "mean_power", "w"),
+                                 ("net_energy", "net_energy", "j")):
+            r[f"{name}_id_{unit}"] = getattr(sid, attr)
+            r[f"{name}_sim_{unit}"] = getattr(ssim, attr)
+        lo, hi = j.torque_range
+        r["torque_limit_lo_nm"], r["torque_limit_hi_nm"] = lo, hi
+        r["speed_limit_rad_s"] = j.speed_limit
+        d = j.drive
+        r["gear_ratio"] = d.gear_ratio if d else nan
+        r["efficiency"] = d.efficiency if d else nan
+        r["rotor_inertia_kg_m2"] = d.rotor_inertia if d else nan
+        r["armature_kg_m2"] = j.armature
+        for name, attr, unit in (("motor_peak_torque", "peak_torque", "nm"),
+                                 ("motor_rms_torque", "rms_torque", "nm"),
+                                 ("motor_peak_speed", "peak_speed_rpm", "rpm")):
+            if j.motor:
+                a, b = getattr(j.motor["id"], attr), getattr(j.motor["sim"], attr)
+                r[f"{name}_{unit}"] = _basis_value(result, a, b)
+                r[f"{name}_id_{unit}"], r[f"{name}_sim_{unit}"] = a, b
+            else:
+                r[f"{name}_{unit}"] = r[f"{name}_id_{unit}"] = r[f"{name}_sim_{unit}"] = nan
+        r["motor_rated_torque_nm"] = d.rated_torque if d else nan
+        r["motor_peak_torque_limit_nm"] = d.peak_torque if d else nan
+        r["motor_max_speed_rpm"] = d.max_speed_rpm if d else nan
+        for key in CHECK_TITLES:
+            c = j.check(key)
+            r[f"{key}_margin_pct"] = c.margin_pct if c else nan
+        r["saturated"] = j.saturated
+        rows.append(r)
+    columns = list(REQUIRED_COLUMNS[:-2]) + ["margin_pct", "pass", "limiting"]
+    for k in rows[0] if rows else ():
+        if k not in columns:
+            columns.append(k)
+    return columns, rows
+
+
+# --------------------------------------------------------------------------------------------
+# Charts
+# --------------------------------------------------------------------------------------------
+
+_COLORS = {"id": "#1f77b4", "sim": "#d62728"}
+
+
+def chart_torques(result: SizingResult) -> bytes:
+    """PNG: joint torque against time, inverse dynamics and simulation, phases shaded."""
+    from matplotlib.figure import Figure
+
+    s = result.series
+    n = len(result.joints)
+    fig = Figure(figsize=(9, 1.9 * n + 0.8), layout="constrained")
+    axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+    for k, (ax, j) in enumerate(zip(axes, result.joints)):
+        for i, p in enumerate(result.phases):
+            if "t0" in p and "t1" in p:
+                ax.axvspan(float(p["t0"]), float(p["t1"]), color="0.92" if i % 2 else "0.97", lw=0)
+        ax.plot(s["t"], s["tau_id"][:, k], color=_COLORS["id"], lw=1.2, label="inverse dynamics")
+        ax.plot(s["t"], s["tau"][:, k], color=_COLORS["sim"], lw=0.8, alpha=0.8, label="simulated")
+        lo, hi = j.torque_range
+        for v in (lo, hi):
+            if np.isfinite(v):
+                ax.axhline(v, color="k", ls="--", lw=0.8)
+        ax.set_ylabel(f"{j.joint} (N m)")
+        ax.grid(alpha=0.3)
+    if result.phases:
+        for p in result.phases:
+            if "t0" in p and "t1" in p:
+                axes[0].annotate(str(p.get("name", "")),
+                                 ((float(p["t0"]) + float(p["t1"])) / 2, 1.02),
+                                 xycoords=("data", "axes fraction"), ha="center", fontsize=8)
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("time (s)")
+    fig.suptitle("Joint torques (dashed: force range)", fontsize=10)
+    return figure_png(fig)
+
+
+def chart_torque_speed(j: JointSizing, knee_fraction: float = PEAK_KNEE_FRACTION) -> bytes:
+    """PNG: motor operating points against the continuous and peak envelopes (first quadrant,
+    ``|speed|`` and ``|torque|``); joint side against the force range and speed limit when the
+    joint has no drive data."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, 4.6), layout="constrained")
+    ax = fig.subplots()
+    if j.drive is not None and j.points:
+        d = j.drive
+        n = np.linspace(0, d.max_speed_rpm, 400)
+        ax.plot(n, peak_envelope(d, n, knee_fraction), "k-", lw=1.6, label="peak (intermittent)")
+        ax.plot(n, continuous_envelope(d, n), "k--", lw=1.4, label="rated (continuous, S1)")
+        ax.axvline(d.max_speed_rpm, color="0.4", lw=0.8, ls=":")
+        for s in sorted(j.points, key=lambda k: k != "sim"):  # simulation below, ID on top
+            speed, torque = j.points[s]
+            ax.plot(np.abs(speed), np.abs(torque), ".", ms=2, color=_COLORS[s], alpha=0.35,
+                    label=f"operating points ({s})")
+            m = j.motor[s]
+            ax.plot([m.mean_speed_rpm], [m.rms_torque], "D", color=_COLORS[s], mec="k", ms=7,
+                    label=f"RMS torque at mean speed ({s})")
+        ax.set_xlabel("motor speed |n| (rpm)")
+        ax.set_ylabel("motor torque |tau_m| (N m)")
+        ax.set_title(f"{j.joint}: motor torque-speed, ratio {d.gear_ratio:g}, "
+                     f"eta {d.efficiency:g}", fontsize=10)
+    else:
+        s_ = j.stats
+        lo, hi = j.torque_range
+        tl = min(abs(lo), abs(hi))
+        if np.isfinite(tl):
+            ax.axhline(tl, color="k", lw=1.4, label="force range")
+        if np.isfinite(j.speed_limit):
+            ax.axvline(j.speed_limit, color="k", ls="--", lw=1.2, label="speed limit")
+        for s in ("id", "sim"):
+            ax.plot([s_[s].peak_speed], [s_[s].peak_torque], "o", color=_COLORS[s],
+                    label=f"peaks ({s})")
+            ax.plot([0], [s_[s].rms_torque], "D", color=_COLORS[s], mec="k", label=f"RMS ({s})")
+        ax.set_xlabel("joint speed |qd| (rad/s)")
+        ax.set_ylabel("joint torque |tau| (N m)")
+        ax.set_title(f"{j.joint}: joint side (no drive data)", fontsize=10)
+    ax.set_xlim(left=0)
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    return figure_png(fig)
+
+
+def sizing_charts(result: SizingResult) -> dict[str, bytes]:
+    """All charts of a run by file name (relative to the ``sizing/`` folder)."""
+    charts = {"torques.png": chart_torques(result)}
+    for j in result.joints:
+        charts[f"torque_speed_{j.joint}.png"] = chart_torque_speed(j)
+    return charts
+
+
+# --------------------------------------------------------------------------------------------
+# Markdown and HTML
+# --------------------------------------------------------------------------------------------
+
+def _pct(m: float) -> str:
+    """A margin in percent: one decimal, more when it is small (so a fail never reads -0.0)."""
+    if m is None or not np.isfinite(m):
+        return "n/a"
+    return f"{m:.1f}" if abs(m) >= 1 else f"{m:.2g}"
+
+
+def _f(x: float, digits: int = 4) -> str:
+    return f"{x:.{digits}g}" if x is not None and np.isfinite(x) else "n/a"
+
+
+def _pair(j: JointSizing, attr: str, motor: bool = False, digits: int = 4) -> str:
+    src = j.motor if motor else j.stats
+    if not src:
+        return "n/a"
+    return f"{_f(getattr(src['id'], attr), digits)} / {_f(getattr(src['sim'], attr), digits)}"
+
+
+_TABLE_HEAD = ("joint", "peak torque N m (ID / sim)", "RMS torque N m (ID / sim)",
+               "peak speed rad/s (ID / sim)", "peak power W (ID / sim)", "energy J (ID / sim)",
+               "motor peak N m (ID / sim)", "motor RMS N m (ID / sim)", "motor speed rpm (ID / sim)",
+               "limiting check", "margin %", "verdict")
+
+
+def _table_cells(j: JointSizing) -> list[str]:
+    lim = j.limiting
+    return [j.joint, _pair(j, "peak_torque"), _pair(j, "rms_torque"), _pair(j, "peak_speed"),
+            _pair(j, "peak_power"), _pair(j, "energy"), _pair(j, "peak_torque", True),
+            _pair(j, "rms_torque", True), _pair(j, "peak_speed_rpm", True),
+            (lim.title if lim else "n/a") + (" (simulated torque saturated)" if j.saturated else ""),
+            _pct(j.margin_pct), "PASS" if j.passed else "FAIL"]
+
+
+def _checks_cells(j: JointSizing) -> list[list[str]]:
+    rows = []
+    for c in j.checks:
+        rows.append([j.joint, c.title, f"{_f(c.used)} {c.unit}", f"{_f(c.limit)} {c.unit}",
+                     _pct(c.margin_pct), c.source,
+                     "PASS" if c.passed else "FAIL"])
+    return rows
+
+
+_CHECK_HEAD = ("joint", "check", "used", "limit", "margin %", "source", "verdict")
+
+_CONVENTIONS = (
+    "RMS torque is time-weighted over the cycle, sqrt(1/T int tau^2 dt) by the trapezoidal rule. "
+    "Mean power |P| is 1/T int |tau qd| dt, mean power P the net 1/T int tau qd dt; energy is "
+    "int |tau qd| dt per cycle and the net (regenerative) energy int tau qd dt. Motor torque is "
+    "(tau - armature qdd)/(N eta) + J_r N qdd when the motor drives the load and "
+    "(tau - armature qdd) eta/N + J_r N qdd when power flows back. Margin = (limit - used)/limit "
+    "x 100; a check passes at margin >= 0. The peak envelope holds the peak torque up to "
+    f"{PEAK_KNEE_FRACTION:g} x max speed, then falls linearly to the rated torque at max speed "
+    "(generic shape, not catalogue data); the continuous envelope is the rated torque."
+)
+
+
+def _md_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = ()) -> str:
+    """Text of ``sizing.md``: header, verdict paragraph, table, checks, chart links."""
+    parts = [f"# Actuator sizing: {result.scenario or 'run'}", ""]
+    parts.append(f"Robot: {result.robot or 'n/a'}; cycle duration {result.duration:.3f} s; checks "
+                 f"on basis '{result.basis}'.")
+    parts += ["", "## Verdict", "", result.verdict, "", "## Per joint", ""]
+    parts.append(_md_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
+    parts += ["", "## Checks", ""]
+    parts.append(_md_table(_CHECK_HEAD, [r for j in result.joints for r in _checks_cells(j)]))
+    if chart_names:
+        parts += ["", "## Charts", ""]
+        for name in chart_names:
+            parts.append(f"![{name}]({PLOTS_DIR}/{name})")
+            parts.append("")
+    parts += ["", "## Conventions", "", _CONVENTIONS, ""]
+    return "\n".join(parts)
+
+
+def _html_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    h = "".join(f"<th>{html.escape(x)}</th>" for x in head)
+    body = []
+    for r in rows:
+        cls = ' class="fail"' if r[-1] == "FAIL" else ""
+        body.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(x)}</td>" for x in r) + "</tr>")
+    return f"<table><thead><tr>{h}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:2em;max-width:1200px;color:#222}
+table{border-collapse:collapse;margin:1em 0;font-size:0.85em}
+th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}
+th{background:#f0f0f0}td:first-child,th:first-child{text-align:left}
+tr.fail td{background:#fde2e2}
+.verdict{padding:0.8em 1em;border-left:6px solid #2a2;background:#effaef}
+.verdict.fail{border-color:#c22;background:#fdeeee}
+img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}
+.small{font-size:0.85em;color:#555}
+"""
+
+
+def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapping[str, Any],
+                video: str | None = None) -> str:
+    """Text of the self-contained ``report.html`` (charts as base64 data URIs)."""
+    esc = html.escape
+    title = f"cellsim report: {result.scenario or 'run'}"
+    out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+           f"<title>{esc(title)}</title><style>{_CSS}</style></head><body>",
+           f"<h1>{esc(title)}</h1>"]
+    # Run summary: scalar fields of summary.json.
+    scalars = [(k, v) for k, v in summary.items() if isinstance(v, (str, int, float, bool))]
+    if result.robot and "robot" not in summary:
+        scalars.insert(0, ("robot", result.robot))
+    scalars.append(("cycle duration (s)", f"{result.duration:.4g}"))
+    out.append("<h2>Run</h2>")
+    out.append(_html_table(("field", "value"), [(str(k), str(v)) for k, v in scalars]))
+    if summary.get("joints"):
+        out.append(f"<p>Joints: {esc(', '.join(map(str, summary['joints'])))}</p>")
+    if result.phases:
+        out.append(_html_table(("phase", "kind", "t0 (s)", "t1 (s)"),
+                               [(str(p.get("name", "")), str(p.get("kind", "")),
+                                 _f(float(p.get("t0", np.nan))), _f(float(p.get("t1", np.nan))))
+                                for p in result.phases]))
+    if video:
+        out.append(f'<h2>Video</h2><video controls width="720" src="{esc(video)}"></video>'
+                   f'<p><a href="{esc(video)}">{esc(video)}</a></p>')
+    cls = "verdict" if result.passed else "verdict fail"
+    out.append(f'<h2>Verdict</h2><p class="{cls}">{esc(result.verdict)}</p>')
+    out.append("<h2>Per joint</h2>")
+    out.append(_html_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
+    out.append("<h2>Checks</h2>")
+    out.append(_html_table(_CHECK_HEAD, [r for j in result.joints for r in _checks_cells(j)]))
+    out.append("<h2>Charts</h2>")
+    for name, png in charts.items():
+        b64 = base64.b64encode(png).decode("ascii")
+        out.append(f'<figure><img alt="{esc(name)}" src="data:image/png;base64,{b64}">'
+                   f"<figcaption class=\"small\">{esc(name)}</figcaption></figure>")
+    out.append(f'<h2>Conventions</h2><p class="small">{esc(_CONVENTIONS)}</p>')
+    srcs = "; ".join(f"{k}: {v}" for k, v in SOURCE_TITLES.items())
+    out.append(f'<p class="small">Sources: {esc(srcs)}.</p>')
+    out.append("</body></html>")
+    return "\n".join(out)
+
+
+# --------------------------------------------------------------------------------------------
+# Entry point
+# --------------------------------------------------------------------------------------------
+
+def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = True) -> dict[str, Path]:
+    """Write the sizing files of a run into ``run_dir``.
+
+    Args:
+        run_dir: The run folder (``summary.json`` and ``video.mp4`` are read from it when
+            present).
+        result: From :func:`sim.analysis.sizing.size_run`.
+        charts: Draw the charts (PNG files in ``run_dir/sizing/``, embedded in the HTML).
+
+    Returns:
+        Paths written, by name: ``csv``, ``json``, ``md``, ``html`` and one per chart.
+    """
+    run_dir = Path(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    written: dict[str, Path] = {}
+    columns, rows = sizing_rows(result)
+    written["csv"] = write_atomic(run_dir / "sizing.csv", csv_text(columns, rows))
+    written["json"] = write_atomic(run_dir / "sizing.json",
+                                   json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
+    pngs = sizing_charts(result) if charts else {}
+    for name, png in pngs.items():
+        written[name] = write_atomic(run_dir / PLOTS_DIR / name, png)
+    written["md"] = write_atomic(run_dir / "sizing.md", sizing_markdown(result, list(pngs)))
+    summary = load_summary(run_dir)
+    video = "video.mp4" if (run_dir / "video.mp4").is_file() else None
+    written["html"] = write_atomic(run_dir / "report.html",
+                                   sizing_html(result, pngs, summary, video))
+    return written

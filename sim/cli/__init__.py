@@ -1,0 +1,61 @@
+"""CLI layer: the ``cellsim`` command line (also ``python -m sim``).
+
+Each sub-command lives in its own module of this package with ``register(sub)`` (adds its
+parser) and sets ``func(args) -> int``. User mistakes (every :class:`CellsimError` but
+:class:`InternalError`, planners' errors included) are printed as one line and exit with code
+2; an :class:`InternalError` (a fault inside cellsim) prints its traceback and exits with 3.
+May import every layer below.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import traceback
+from collections.abc import Sequence
+
+from sim import __version__
+from sim.errors import CellsimError, InternalError
+
+#: Sub-command modules, in the order ``--help`` lists them.
+COMMANDS = ("list", "plan", "ik", "workspace", "run", "size", "render")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cellsim",
+        description="Physics simulation of industrial robot welding and pick cells on MuJoCo.",
+    )
+    parser.add_argument("--version", action="version", version=f"cellsim {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in COMMANDS:
+        importlib.import_module(f"sim.cli.{name}").register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except InternalError as exc:
+        traceback.print_exc()
+        print(f"cellsim: internal error: {exc} (a fault in cellsim, not in your input: please "
+              "report it with the traceback above)", file=sys.stderr)
+        return 3
+    except CellsimError as exc:
+        print(f"cellsim: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("cellsim: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # e.g. `cellsim plan ... | head`: stop quietly
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,103 @@
+"""``cellsim ik ROBOT X Y Z [--euler-zyx-deg A B G] [--all] [--json]``: analytic inverse kinematics.
+
+Position in mm in the robot's ``frame0``; orientation of its ``tcp`` frame as Z-Y-X Euler
+angles in degrees, ``R = Rz(A) Ry(B) Rx(G)`` (seed 000 eq. 6); default: the tcp orientation at
+the home configuration (q = 0). Solutions are printed best first (inside the joint ranges,
+then closest to home; see :mod:`sim.robots.ik`), in degrees, only the best unless
+``--all``. For the 5-axis robots A is implied by the position: a disagreeing A is replaced
+(one note on stderr). ``--json`` prints::
+
+    {"robot": str, "solutions": [{"joints_deg": [..], "within_limits": bool}]}
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import warnings
+
+import numpy as np
+
+from sim.errors import KinematicsError
+from sim.robots.ik import solve_ik
+from sim.robots.model import kinematic_model
+from sim.core.rotations import euler_zyx_to_matrix, make_transform, matrix_to_euler_zyx
+from sim.robots.registry import get_robot
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "ik", help="inverse kinematics of a tcp pose",
+        description="Analytic inverse kinematics: joint values (deg) that put the robot's tcp "
+                    "at X Y Z (mm, frame0) with orientation R = Rz(A) Ry(B) Rx(G) (deg). "
+                    "Solutions are listed best first: inside the joint ranges, then closest "
+                    "to home (joint distance weighted by 1/max speed).")
+    p.add_argument("robot", metavar="ROBOT", help="robot name (see `cellsim list`)")
+    for axis in "XYZ":
+        p.add_argument(axis.lower(), metavar=axis, type=float,
+                       help=f"tcp {axis.lower()} in frame0, mm")
+    p.add_argument("--euler-zyx-deg", metavar=("A", "B", "G"), nargs=3, type=float, default=None,
+                   help="tcp orientation, Z-Y-X Euler angles in degrees (default: the home "
+                        "orientation); for 5-axis robots A is implied by the position")
+    p.add_argument("--all", action="store_true", help="print every solution, not only the best")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=run)
+
+
+def _check_finite(label: str, values: list[float]) -> None:
+    for name, v in zip(label.split(), values):
+        if not math.isfinite(v):
+            raise KinematicsError(f"{name} must be a finite number, got {v}")
+
+
+def run(args: argparse.Namespace) -> int:
+    spec = get_robot(args.robot)
+    position = [args.x, args.y, args.z]
+    _check_finite("X Y Z", position)
+    if args.euler_zyx_deg is not None:
+        _check_finite("A B G", args.euler_zyx_deg)
+    model = kinematic_model(spec.name)
+    p = np.asarray(position, dtype=float) / 1000.0
+    if args.euler_zyx_deg is None:
+        R = model.fk(np.zeros(model.n_joints))[:3, :3]
+        if model.family == "5r" and np.hypot(p[0], p[1]) > 1e-12:
+            # home orientation turned into the arm plane of the target
+            alpha, beta, gamma = matrix_to_euler_zyx(R)
+            R = euler_zyx_to_matrix(np.arctan2(p[1], p[0]) + alpha, beta, gamma)
+    else:
+        a, b, g = np.deg2rad(args.euler_zyx_deg)
+        if model.family == "5r" and np.hypot(p[0], p[1]) > 1e-12:
+            implied = float(np.arctan2(p[1], p[0]))
+            off_plane = np.cos(b) * np.sin(a - implied)
+            if abs(off_plane) > 1e-9:
+                # nearest of the two consistent values: implied or implied + 180 deg
+                cands = [implied, implied + np.pi]
+                a_new = min(cands, key=lambda c: abs(np.angle(np.exp(1j * (a - c)))))
+                print(f"cellsim: note: {spec.name} has 5 axes: A is implied by the position "
+                      f"(A = {np.rad2deg(a_new):.3f} deg, not {args.euler_zyx_deg[0]:g})",
+                      file=sys.stderr)
+                a = a_new
+        R = euler_zyx_to_matrix(a, b, g)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sols = solve_ik(model, make_transform(R, p))
+    for w in caught:
+        print(f"cellsim: warning: {w.message}", file=sys.stderr)
+    shown = sols if args.all else sols[:1]
+    if args.json:
+        doc = {"robot": spec.name,
+               "solutions": [{"joints_deg": [float(v) for v in np.rad2deg(s.q)],
+                              "within_limits": bool(s.within_limits)} for s in shown]}
+        print(json.dumps(doc))
+        return 0
+    print(f"{spec.title} ({spec.name}): {len(sols)} solution(s), best first; joints "
+          f"{' '.join(spec.joints)} in deg")
+    for i, s in enumerate(shown, 1):
+        joints = " ".join(f"{v:9.3f}" for v in np.rad2deg(s.q))
+        flag = "within limits" if s.within_limits else "OUTSIDE joint limits"
+        print(f"  {i:2d}: {joints}   {flag}  [{s.branch}]")
+    if not args.all and len(sols) > 1:
+        print(f"  ({len(sols) - 1} more with --all)")
+    return 0

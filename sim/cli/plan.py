@@ -1,0 +1,128 @@
+"""``cellsim plan SCENARIO``: the planned polynomial coefficients of every phase.
+
+Prints, per phase and joint (hold phases have no polynomial and are left out), each
+segment's duration and its coefficients in normalized time
+(t in [0, 1], the last segment in t_bar = t - 1 in [-1, 0]) and in real time (powers of the
+absolute time tau, s), like seed 000 Tables 4-5. Text output is in degrees as the seeds print
+them; ``--json`` gives radians, ascending powers, in this shape::
+
+    {"scenario": str, "phases": [{"name": str, "planner": "434"|"546", "time_s": [..],
+      "joints": [{"index": int, "segments": [{"t0": s, "t1": s, "normalized": [a0, a1, ..],
+      "real": [b0, b1, ..]}]}]}]}
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+import numpy as np
+
+from sim.simulation.motion import HoldTrajectory, Motion, PhaseMotion, build_motion, limit_violations
+from sim.scenario import CartesianPhase, Scenario, load_scenario
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "plan",
+        help="print the planned polynomial coefficients of a scenario",
+        description="Plan every phase of SCENARIO and print, per phase and joint, each "
+                    "segment's duration and coefficients in normalized and real time "
+                    "(degrees in text, radians with --json).",
+    )
+    p.add_argument("scenario", metavar="SCENARIO",
+                   help="a scenario file, or a shipped scenario's name (see `cellsim list`)")
+    p.add_argument("--json", action="store_true",
+                   help="print JSON (coefficients in radians, ascending powers)")
+    p.set_defaults(func=run)
+
+
+def planned_phases(scenario: Scenario) -> list[PhaseMotion]:
+    """The scenario's polynomial phases on one clock (Cartesian ones through the cell's IK)."""
+    context = None
+    if any(isinstance(p, CartesianPhase) or getattr(p, "target", None) is not None
+           for p in scenario.phases):
+        from sim.pipeline.run import build
+
+        context = build(scenario).context
+    motion: Motion = build_motion(scenario, context)
+    for line in limit_violations(scenario, motion,
+                                 speed=True):
+        print(f"cellsim: warning: {line}", file=sys.stderr)
+    return [pm for pm in motion.phases if not isinstance(pm.trajectory, HoldTrajectory)]
+
+
+def plan_json(scenario: Scenario, planned: list[PhaseMotion]) -> dict[str, Any]:
+    """The ``--json`` document of a planned scenario (coefficients in radians)."""
+    phases = []
+    for pp in planned:
+        traj = pp.trajectory
+        knots = np.asarray(traj.knots, dtype=float)
+        joints = []
+        for j in range(traj.n_joints):
+            segments = []
+            for s in range(traj.n_segments):
+                segments.append({
+                    "t0": float(knots[s]),
+                    "t1": float(knots[s + 1]),
+                    "normalized": [float(c) for c in traj.normalized_coefficients[s][j]],
+                    "real": [float(c) for c in traj.real_coefficients[s][j]],
+                })
+            joints.append({"index": j + 1, "segments": segments})
+        phases.append({
+            "name": pp.phase.name,
+            "planner": pp.phase.planner,
+            "time_s": [float(t) for t in knots],
+            "joints": joints,
+        })
+    return {"scenario": scenario.name, "phases": phases}
+
+
+def _poly_text(coeffs: np.ndarray, var: str) -> str:
+    terms = []
+    for k in range(len(coeffs) - 1, -1, -1):
+        c = float(coeffs[k])
+        if c == 0.0:
+            continue
+        power = "" if k == 0 else (f" {var}" if k == 1 else f" {var}^{k}")
+        terms.append(f"{c:+.6g}{power}")
+    return " ".join(terms) if terms else "0"
+
+
+def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
+    """Human-readable tables (degrees), one block per phase and joint."""
+    lines = [f"scenario {scenario.name}: robot {scenario.robot.name} "
+             f"({scenario.robot.n_joints} joints), {len(planned)} polynomial phase(s)",
+             "coefficients in degrees; normalized time t = (tau - tau_k-1)/t_k, "
+             "last segment in t_bar = t - 1; real time in powers of tau [s]"]
+    deg = 180.0 / np.pi
+    for pp in planned:
+        traj = pp.trajectory
+        knots = np.asarray(traj.knots, dtype=float)
+        lines.append("")
+        lines.append(f"phase {pp.phase.index + 1} {pp.phase.name!r}: planner {pp.phase.planner}, "
+                     f"knots at {', '.join(f'{t:g}' for t in knots)} s")
+        for j, jname in enumerate(scenario.robot.joints[: traj.n_joints]):
+            lines.append(f"  joint {jname}")
+            for s in range(traj.n_segments):
+                var = traj.segment_variable(s)
+                lines.append(f"    segment {s + 1}: {knots[s]:g} -> {knots[s + 1]:g} s "
+                             f"(t_{s + 1} = {knots[s + 1] - knots[s]:g} s)")
+                lines.append("      normalized: "
+                             + _poly_text(np.asarray(traj.normalized_coefficients[s][j]) * deg, var))
+                lines.append("      real:       "
+                             + _poly_text(np.asarray(traj.real_coefficients[s][j]) * deg, "tau"))
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    scenario = load_scenario(args.scenario)
+    planned = planned_phases(scenario)
+    if args.json:
+        json.dump(plan_json(scenario, planned), sys.stdout, indent=1)
+        sys.stdout.write("\n")
+    else:
+        print(format_plan(scenario, planned))
+    return 0

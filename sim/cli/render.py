@@ -1,0 +1,96 @@
+"""``cellsim render RUN_DIR``: re-render a finished run into an MP4 (and plots) without simulating.
+
+Reads ``RUN_DIR/model.xml`` and ``RUN_DIR/trajectory.npz`` (see :mod:`sim.simulation.runfolder`),
+renders the recorded states at the video's frame times with the tool-point trails, weld bead
+and caption, and writes ``RUN_DIR/video.mp4`` (or ``--out``). ``--plots`` also writes the
+PNG plots into ``RUN_DIR/plots/``. The OpenGL backend is chosen before mujoco is imported
+(``--gl`` forces one). A progress bar is shown on long renders when stderr is a terminal;
+``--quiet`` hides it and the summary line.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from sim.errors import RenderError
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number of pixels, got {text!r}"
+        ) from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number of pixels, got {value}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text}")
+    return value
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "render",
+        help="re-render a finished run (RUN_DIR) into an MP4 video, without simulating",
+        description="Render the recorded states of a finished run (RUN_DIR/model.xml and "
+                    "RUN_DIR/trajectory.npz) into an H.264 MP4: tool-point reference path "
+                    "(green), actual path (red), weld bead (gold), caption with time, phase "
+                    "and the highest joint torque. Several --camera views are tiled side by side.",
+    )
+    p.add_argument("run_dir", metavar="RUN_DIR", help="folder written by `cellsim run`")
+    p.add_argument("--out", metavar="FILE", default=None,
+                   help="output .mp4 (default: RUN_DIR/video.mp4)")
+    p.add_argument("--gl", choices=("egl", "osmesa"), default=None,
+                   help="OpenGL backend (default: EGL if it works, else OSMesa)")
+    p.add_argument("--width", type=_positive_int, default=640,
+                   help="width of each camera view, pixels, even (default 640)")
+    p.add_argument("--height", type=_positive_int, default=480,
+                   help="height, pixels, even (default 480)")
+    p.add_argument("--fps", type=_positive_float, default=30.0,
+                   help="frames per second (default 30); frames = floor(duration*fps)+1")
+    p.add_argument("--camera", action="append", metavar="NAME", dest="cameras", default=None,
+                   help="camera of the cell to render (repeatable; default: overview)")
+    p.add_argument("--plots", action="store_true",
+                   help="also write the PNG plots into RUN_DIR/plots/")
+    p.add_argument("--quiet", action="store_true", help="no progress bar, no summary line")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from sim.render.gl import configure_gl
+    from sim.simulation.runfolder import load_run
+
+    record = load_run(args.run_dir)  # one-line error (exit 2) for a missing/invalid folder
+    backend = configure_gl(args.gl)  # before anything imports mujoco
+    from sim.render.video import write_video
+
+    out = Path(args.out) if args.out else Path(args.run_dir) / "video.mp4"
+    if out.suffix.lower() != ".mp4":
+        raise RenderError(f"--out {str(out)!r} must end in .mp4")
+    result = write_video(
+        record, out, cameras=tuple(args.cameras or ("overview",)), width=args.width,
+        height=args.height, fps=args.fps, gl=backend, progress=not args.quiet,
+    )
+    if not args.quiet:
+        print(
+            f"wrote {result.path} ({result.frames} frames, {result.width}x{result.height}, "
+            f"{result.fps:g} fps, {result.seconds:.1f} s, {result.frames_per_second:.1f} "
+            f"frames/s, OpenGL {result.backend})"
+        )
+    if args.plots:
+        from sim.analysis.plots import write_plots
+
+        paths = write_plots(record)
+        if not args.quiet:
+            print(f"wrote {len(paths)} plots into {paths[0].parent}")
+    return 0

@@ -1,0 +1,88 @@
+"""``cellsim run SCENARIO``: simulate a scenario and write its run folder.
+
+The folder (default ``runs/<scenario name>/``) holds ``summary.json``, ``trajectory.npz`` and
+``trajectory.csv``, ``model.xml`` (the compiled cell exactly as simulated), ``scenario.toml``,
+``manifest.json``, the actuator-sizing report (``sizing.csv``/``.json``/``.md``,
+``report.html``), ``plots/`` and ``video.mp4``. It is written atomically: a failed run leaves
+no ``summary.json``; a run that fails mid-simulation keeps what it recorded in
+``<folder>.failed/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "run", help="simulate a scenario: results, sizing report, plots and video",
+        description="Build the scenario's cell, plan every phase, drive the robot with position "
+                    "actuators in MuJoCo, and write the run folder (summary.json, "
+                    "trajectory.npz/.csv, model.xml, sizing report, plots, video.mp4).")
+    p.add_argument("scenario", metavar="SCENARIO",
+                   help="a scenario file, or a shipped scenario's name (see `cellsim list`)")
+    p.add_argument("--out", type=Path, metavar="DIR",
+                   help="run folder (default: runs/<scenario name>)")
+    p.add_argument("--no-video", action="store_true", help="do not render video.mp4")
+    p.add_argument("--no-plots", action="store_true", help="do not write plots/*.png")
+    p.add_argument("--no-feedforward", action="store_true",
+                   help="position actuators alone (no inverse-dynamics torque feed-forward)")
+    p.add_argument("--gl", choices=("egl", "osmesa"),
+                   help="OpenGL backend for the video (default: the first that works)")
+    p.add_argument("--width", type=int, help="video width per camera, pixels")
+    p.add_argument("--height", type=int, help="video height, pixels")
+    p.add_argument("--fps", type=float, help="video frames per second")
+    p.add_argument("--camera", action="append", metavar="NAME",
+                   help="cell camera to film (repeat to tile several side by side)")
+    p.add_argument("--quiet", action="store_true", help="no progress bars, only the result line")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if not args.no_video:
+        from sim.render.gl import configure_gl
+
+        configure_gl(args.gl)
+    from sim.pipeline.run import RunOptions, default_out_dir, run_scenario
+    from sim.scenario import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    options = RunOptions(
+        out_dir=args.out,
+        video=not args.no_video,
+        plots=not args.no_plots,
+        feedforward=False if args.no_feedforward else None,
+        video_args={"width": args.width, "height": args.height, "fps": args.fps,
+                    "cameras": tuple(args.camera) if args.camera else None, "gl": args.gl},
+        progress=not args.quiet,
+    )
+    summary = run_scenario(scenario, options)
+    out = (args.out or default_out_dir(scenario))
+    track = max(summary["max_tracking_error_deg"])
+    line = (f"{scenario.name}: {summary['duration_s']:.3f} s simulated in {summary['wall_s']:.2f} s "
+            f"(x{summary['realtime_factor']:.1f} real time); max tracking error {track:.4f} deg; "
+            f"max tcp deviation {summary['max_tcp_deviation_mm']:.3f} mm")
+    print(line)
+    for weld in summary.get("weld", []):
+        print(f"  weld {weld['phase']}: {weld['seam_length_mm']:.1f} mm at "
+              f"{weld['travel_speed_mm_s']:.2f} mm/s (cv {weld['travel_speed_cv']:.4f}), path "
+              f"deviation {weld['max_path_deviation_mm']:.3f} mm, torch angle error "
+              f"{weld['torch_angle_error_deg']:.3f} deg")
+    sing = summary.get("singularity")
+    if sing:
+        extra = (f", |sin theta5| >= {sing['min_abs_wrist']:.3f}" if "min_abs_wrist" in sing
+                 else "")
+        print(f"  closest to a singularity: sigma_min {sing['min_sigma']:.4g} at "
+              f"{sing['t']:.2f} s ({sing['phase']}){extra}")
+    if "placed" in summary:
+        print(f"  parts placed: {sum(summary['placed'])}/{len(summary['placed'])}, errors "
+              + ", ".join(f"{e:.2f}" for e in summary["place_error_mm"]) + " mm")
+    if "sizing" in summary:
+        s = summary["sizing"]
+        print(f"  sizing: hardest joint {s['hardest_joint']} (margin {s['hardest_margin_pct']:.1f} %),"
+              f" {'all pass' if s['pass'] else 'FAIL'}")
+    print(f"  results in {out}/")
+    return 0

@@ -1,0 +1,255 @@
+"""The scenario runner: build the cell, plan, simulate with position actuators, record.
+
+``run_scenario`` is what ``cellsim run`` does:
+
+1. compose the cell (robot, tool, fixtures, cameras) with ``dm_control.mjcf`` and compile it;
+2. plan every phase into one reference motion (:mod:`sim.simulation.motion`);
+3. simulate: the robot's position actuators track the reference (``ctrl = q_ref(t)``). With
+   feed-forward on (the default) the drives also apply ``tau_id``, the inverse dynamics of the
+   reference (``mj_inverse``), and the set-point carries the velocity feed-forward
+   ``ctrl = q_ref + (kv/kp) qd_ref``, so the servo force ``kp (q_ref - q) + kv (qd_ref - qd)``
+   only corrects errors. Without feed-forward the arm lags by about ``(kv/kp) qd`` plus
+   ``tau/kp`` (the position servo alone; see the README's tracking figures). Steps run
+   in C through ``mujoco.rollout`` in chunks, with the controls precomputed (they do not depend
+   on the state), and every chunk is checked for NaN and MuJoCo warnings;
+4. record the tool-point path and the joint torques, compute the summary metrics, and write
+   the run folder atomically.
+
+Recorded torque ``tau`` is what the joint's drive delivers: the position actuator's force plus
+the feed-forward torque. ``tau_id`` is the inverse dynamics of the reference motion.
+"""
+
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim import __version__
+from sim.errors import CellsimError, InternalError
+from sim.scenario import Scenario
+from sim.simulation.compile import BuiltCell, build
+from sim.simulation.metrics import make_summary
+from sim.simulation.motion import build_motion, check_motion_limits
+from sim.simulation.simulate import simulate
+
+
+@dataclass
+class RunOptions:
+    """Options of one run.
+
+    Attributes:
+        out_dir: Run folder (default ``runs/<scenario name>``).
+        video: Write ``video.mp4``.
+        feedforward: Override the scenario's ``simulation.feedforward``.
+        video_args: Keyword arguments for :func:`sim.render.video.write_video` (cameras, width,
+            height, fps, gl).
+        plots: Write ``plots/*.png``.
+        sizing: Write the actuator-sizing report.
+        progress: Show progress bars (they are silent anyway when stderr is not a terminal).
+    """
+
+    out_dir: Path | None = None
+    video: bool = True
+    feedforward: bool | None = None
+    video_args: dict[str, Any] = field(default_factory=dict)
+    plots: bool = True
+    sizing: bool = True
+    progress: bool = True
+
+
+# --------------------------------------------------------------------------------------------
+# Run folder
+# --------------------------------------------------------------------------------------------
+
+
+def _git_commit() -> str | None:
+    try:
+        res = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                             cwd=Path(__file__).resolve().parent, timeout=5)
+        return res.stdout.strip() or None if res.returncode == 0 else None
+    except (OSError, subprocess.SubprocessError):
+        return None
+
+
+def manifest(scenario: Scenario) -> dict[str, Any]:
+    import mujoco
+
+    return {
+        "cellsim": __version__,
+        "mujoco": mujoco.__version__,
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "git_commit": _git_commit(),
+        "scenario": scenario.name,
+        "scenario_sha256": scenario.sha256,
+    }
+
+
+def write_csv(path: Path, arrays: dict[str, NDArray[Any]], joints: tuple[str, ...]) -> None:
+    cols: list[tuple[str, NDArray[Any]]] = [("t", arrays["t"]), ("phase", arrays["phase"])]
+    for key in ("q_ref", "qd_ref", "qdd_ref", "q", "qd", "tau", "tau_id"):
+        for j, name in enumerate(joints):
+            cols.append((f"{key}_{name}", arrays[key][:, j]))
+    for key in ("tcp_pos", "tcp_pos_ref"):
+        for a, axis in enumerate("xyz"):
+            cols.append((f"{key}_{axis}", arrays[key][:, a]))
+    for key in ("arc_on", "suction"):
+        cols.append((key, arrays[key].astype(int)))
+    header = ",".join(c for c, _ in cols)
+    data = np.column_stack([np.asarray(v, dtype=float) for _, v in cols])
+    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.9g")
+
+
+def default_out_dir(scenario: Scenario) -> Path:
+    return Path("runs") / scenario.name
+
+
+def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[str, Any]:
+    """Run a scenario and write its run folder; returns the summary.
+
+    The folder is built in a temporary sibling and moved into place at the end, so a failed
+    run never leaves a ``summary.json``. A run that fails mid-simulation keeps what it recorded
+    in ``<out_dir>.failed/`` with ``error.txt``.
+
+    Raises:
+        CellsimError: A user mistake or an unstable simulation (one-line message).
+    """
+    options = options or RunOptions()
+    out_dir = Path(options.out_dir) if options.out_dir else default_out_dir(scenario)
+    out_dir = out_dir.resolve()
+    feedforward = (scenario.simulation.feedforward if options.feedforward is None
+                   else options.feedforward)
+
+    built = build(scenario)
+    _check_tcp_consistency(built, scenario)
+    video_args = _video_args(scenario, options)
+    if options.video:  # refuse bad video settings before simulating, not after
+        from sim.render.frames import resolve_cameras, validate_size
+
+        resolve_cameras(built.model, video_args.get("cameras", ("overview",)))
+        validate_size(video_args.get("width", 640), video_args.get("height", 480))
+        fps = video_args.get("fps", 30.0)
+        if not (np.isfinite(fps) and fps > 0):
+            from sim.errors import RenderError
+
+            raise RenderError(f"--fps must be a positive number, got {fps!r}")
+    motion = build_motion(scenario, built.context)
+    check_motion_limits(scenario, motion)
+
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    try:
+        (tmp / "model.xml").write_text(built.xml)
+        (tmp / "scenario.toml").write_text(scenario.text)
+        (tmp / "manifest.json").write_text(json.dumps(manifest(scenario), indent=1) + "\n")
+
+        def keep_failed(partial: dict[str, NDArray[Any]], message: str) -> None:
+            np.savez_compressed(tmp / "trajectory.npz", **partial)
+            (tmp / "error.txt").write_text(message + "\n")
+            failed = out_dir.with_name(out_dir.name + ".failed")
+            if failed.exists():
+                shutil.rmtree(failed)
+            os.replace(tmp, failed)
+
+        rec = simulate(built, motion, feedforward=feedforward,
+                       settle_s=scenario.simulation.settle_s, progress=options.progress,
+                       on_failure=keep_failed)
+        arrays = rec.arrays
+        np.savez_compressed(tmp / "trajectory.npz", **arrays)
+        write_csv(tmp / "trajectory.csv", arrays, scenario.robot.joints)
+
+        summary = make_summary(scenario, built, motion, rec, feedforward)
+        # written now for the report writers, rewritten complete at the end; the folder only
+        # becomes visible (moved into place) once everything succeeded
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+        if options.plots:
+            from sim.analysis.plots import write_plots
+
+            write_plots(tmp)
+        if options.video:
+            from sim.render.video import write_video
+
+            write_video(tmp, tmp / "video.mp4", progress=options.progress, **video_args)
+            summary["video"] = "video.mp4"
+            (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+        if options.sizing:  # last: report.html links the video when there is one
+            _write_sizing(tmp, scenario, built, arrays, summary)
+        (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+    except BaseException:
+        if tmp.exists():
+            shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    if out_dir.exists():
+        trash = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.", dir=out_dir.parent))
+        os.replace(out_dir, trash / "old")
+        shutil.rmtree(trash, ignore_errors=True)
+    os.replace(tmp, out_dir)
+    stale = out_dir.with_name(out_dir.name + ".failed")
+    if stale.exists():
+        shutil.rmtree(stale, ignore_errors=True)
+    return summary
+
+
+def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:
+    v = scenario.video
+    args: dict[str, Any] = {}
+    if v.cameras:
+        args["cameras"] = tuple(v.cameras)
+    for key in ("width", "height", "fps"):
+        if getattr(v, key) is not None:
+            args[key] = getattr(v, key)
+    args.update({k: val for k, val in options.video_args.items() if val is not None})
+    return args
+
+
+def _write_sizing(tmp: Path, scenario: Scenario, built: BuiltCell, arrays: dict[str, Any],
+                  summary: dict[str, Any]) -> None:
+    from sim.analysis.report import write_sizing
+    from sim.analysis.sizing import apply_overrides, armature_from_model, forcerange_from_model, size_run
+
+    drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
+    joints = built.cell.joint_names
+    result = size_run(tmp, scenario.robot, drives, forcerange_from_model(built.model, joints),
+                      armature=armature_from_model(built.model, joints))
+    write_sizing(tmp, result)
+    summary["sizing"] = {"hardest_joint": result.hardest_joint,
+                         "hardest_margin_pct": result.hardest_margin_pct,
+                         "pass": bool(result.all_pass),
+                         "verdict": result.verdict}
+
+
+def _check_tcp_consistency(built: BuiltCell, scenario: Scenario) -> None:
+    """The closed-form kinematics (with the tool) must place the tcp where MuJoCo does."""
+    import mujoco
+
+    model = built.model
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(0)
+    lo = model.jnt_range[[model.joint(n).id for n in built.cell.joint_names], 0]
+    hi = model.jnt_range[[model.joint(n).id for n in built.cell.joint_names], 1]
+    q = lo + (hi - lo) * rng.uniform(0.3, 0.7, size=lo.size)
+    data.qpos[built.robot_qpos] = q
+    mujoco.mj_kinematics(model, data)
+    site = model.site(built.cell.tcp_site).id
+    T0 = built.context.world_from_frame0
+    T = np.asarray(built.context.kinematics.fk(q), dtype=float)
+    p_cf = T0[:3, :3] @ T[:3, 3] + T0[:3, 3]
+    R_cf = T0[:3, :3] @ T[:3, :3]
+    err = float(np.linalg.norm(data.site_xpos[site] - p_cf))
+    rerr = float(np.max(np.abs(data.site_xmat[site].reshape(3, 3) - R_cf)))
+    if err > 1e-6 or rerr > 1e-6:
+        raise InternalError(f"closed-form tcp and MuJoCo tcp differ by "
+                           f"{err * 1e3:.3f} mm / {rerr:.2e} in rotation for robot "
+                           f"{scenario.robot.name} with tool {scenario.tool!r}")
+

@@ -1,0 +1,485 @@
+"""Parameter sweeps: the same cycle over payloads and speeds, run in parallel.
+
+A sweep runs every combination of a list of payloads (kg) and a list of speed scales. A
+*variant* is one ``(payload_kg, speed_scale)`` pair (:class:`Variant`, which also carries the
+base scenario and a suggested run folder). The runner is any picklable callable (a module-level
+function) ``runner(variant) -> run_dir`` that simulates the variant and returns the folder
+holding its ``trajectory.npz`` (and ``summary.json``, ``sizing.json`` when it sized the run).
+
+Speed scale ``s`` divides every knot time of the base scenario (:func:`scale_knot_times`):
+``s = 2`` runs the cycle twice as fast (half the duration), so joint speeds scale by ``s``,
+accelerations by ``s^2`` and the inertial part of the torques by ``s^2``; ``s = 0.5`` is half
+speed. The payload is the mass at the tool (kg), added by the runner.
+
+Variants run over a ``concurrent.futures.ProcessPoolExecutor`` (start method ``spawn`` by
+default: safe with MuJoCo and OpenGL state in the parent); results are gathered in variant
+order whatever the completion order, so a parallel sweep gives exactly the table a serial one
+gives. A failing variant does not stop the others: the outputs are written for those that
+succeeded, then :class:`SweepError` names the failures.
+
+Outputs in ``out_dir``: ``sweep.csv`` (one row per variant and joint), ``sweep.md`` (pivot
+tables of peak and RMS torque, failures), ``sweep.png`` (peak and RMS torque per joint against
+payload and against speed scale) and ``sweep.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import multiprocessing
+import os
+import re
+import time
+import traceback
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sim.errors import CellsimError, SweepError
+from sim.analysis.report import csv_text, figure_png, write_atomic
+from sim.analysis.sizing import load_summary, load_trajectory, peak_abs, rms
+
+
+#: Columns of sweep.csv, in order.
+SWEEP_COLUMNS = ("payload_kg", "speed_scale", "joint", "peak_torque_nm", "rms_torque_nm",
+                 "peak_torque_id_nm", "peak_torque_sim_nm", "rms_torque_id_nm", "rms_torque_sim_nm",
+                 "peak_speed_rad_s", "peak_power_w", "duration_s", "margin_pct", "pass",
+                 "limiting", "run_dir")
+
+
+# --------------------------------------------------------------------------------------------
+# Input parsing and validation
+# --------------------------------------------------------------------------------------------
+
+def _number(token: str, field: str) -> float:
+    try:
+        value = float(token)
+    except ValueError:
+        raise SweepError(f"{field}: {token!r} is not a number (expected a comma-separated list "
+                         "like 0,2.5,5 or a range start:stop:step like 0:10:2.5)") from None
+    if not math.isfinite(value):
+        raise SweepError(f"{field}: {token!r} is not a finite number")
+    return value
+
+
+def parse_float_list(text: str, field: str = "value") -> list[float]:
+    """Numbers from a command-line list: ``"0,2.5,5"`` or an inclusive range ``"0:10:2.5"``
+    (items may mix: ``"0,1:3:1"``). Duplicates are dropped, the order kept.
+
+    Args:
+        text: The option's text.
+        field: Option name for error messages (``"--payload"``).
+
+    Returns:
+        The numbers, in order of appearance.
+
+    Raises:
+        SweepError: Empty list, empty item, non-number, or a bad range (names ``field``).
+    """
+    if text is None or not str(text).strip():
+        raise SweepError(f"{field}: empty list (expected numbers like 0,2.5,5)")
+    out: list[float] = []
+    for item in str(text).split(","):
+        item = item.strip()
+        if not item:
+            raise SweepError(f"{field}: empty item in {text!r} (expected numbers like 0,2.5,5)")
+        if ":" in item:
+            parts = item.split(":")
+            if len(parts) != 3:
+                raise SweepError(f"{field}: range {item!r} must be start:stop:step")
+            a, b, step = (_number(p.strip(), field) for p in parts)
+            if step <= 0:
+                raise SweepError(f"{field}: range {item!r} needs a positive step")
+            if b < a:
+                raise SweepError(f"{field}: range {item!r} has stop < start")
+            count = int(math.floor((b - a) / step + 1e-9)) + 1
+            if count > 10_000:
+                raise SweepError(f"{field}: range {item!r} has {count} values (at most 10000)")
+            out.extend(round(a + k * step, 12) for k in range(count))
+        else:
+            out.append(_number(item, field))
+    return list(dict.fromkeys(out))
+
+
+def validate_payloads(payloads: Sequence[float], field: str = "payload") -> list[float]:
+    """Payloads in kg: finite, >= 0, at least one; duplicates dropped.
+
+    Raises:
+        SweepError: One line naming ``field`` and the bad value.
+    """
+    values = [float(p) for p in payloads]
+    if not values:
+        raise SweepError(f"{field}: no payload given (expected kg values like 0,2.5,5)")
+    for p in values:
+        if not math.isfinite(p) or p < 0:
+            raise SweepError(f"{field}: payload must be a finite mass >= 0 kg, got {p:g}")
+    return list(dict.fromkeys(values))
+
+
+def validate_speed_scales(scales: Sequence[float], field: str = "speed scale") -> list[float]:
+    """Speed scales: finite, > 0, at least one; duplicates dropped.
+
+    Raises:
+        SweepError: One line naming ``field`` and the bad value.
+    """
+    values = [float(s) for s in scales]
+    if not values:
+        raise SweepError(f"{field}: no speed scale given (expected factors like 0.5,1,1.5)")
+    for s in values:
+        if not math.isfinite(s) or s <= 0:
+            raise SweepError(f"{field}: speed scale must be a finite factor > 0 "
+                             f"(1 = as planned, 2 = twice as fast), got {s:g}")
+    return list(dict.fromkeys(values))
+
+
+def scale_knot_times(times: ArrayLike, speed_scale: float) -> NDArray[np.float64]:
+    """Knot times of a variant: the base knot times divided by ``speed_scale``.
+
+    Args:
+        times: Base knot times, s, any shape.
+        speed_scale: Factor > 0 (2 = twice as fast).
+
+    Returns:
+        ``times / speed_scale``, s.
+    """
+    validate_speed_scales([speed_scale])
+    return np.asarray(times, dtype=float) / float(speed_scale)
+
+
+# --------------------------------------------------------------------------------------------
+# Variants and their results
+# --------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Variant:
+    """One point of a sweep.
+
+    Attributes:
+        payload_kg: Payload at the tool, kg.
+        speed_scale: Knot times are divided by this factor.
+        scenario: The base scenario, passed to the runner unchanged (a name, a path or a
+            loaded scenario object; must be picklable).
+        run_dir: Suggested run folder for this variant (inside the sweep's ``out_dir``).
+        index: Position in the sweep (payload-major order).
+    """
+
+    payload_kg: float
+    speed_scale: float
+    scenario: Any = None
+    run_dir: Path = Path(".")
+    index: int = 0
+
+    @property
+    def label(self) -> str:
+        return f"payload {self.payload_kg:g} kg, speed x{self.speed_scale:g}"
+
+    @property
+    def slug(self) -> str:
+        """Folder-safe name, e.g. ``payload_2.5kg_speed_1.5x``."""
+        return re.sub(r"[^A-Za-z0-9_.-]", "_",
+                      f"payload_{self.payload_kg:g}kg_speed_{self.speed_scale:g}x")
+
+
+def make_variants(base_scenario: Any, payloads: Sequence[float], speed_scales: Sequence[float],
+                  out_dir: str | Path) -> list[Variant]:
+    """Every ``(payload, speed_scale)`` combination, payload-major, validated."""
+    ps = validate_payloads(payloads)
+    ss = validate_speed_scales(speed_scales)
+    out = Path(out_dir)
+    combos = [(p, s) for p in ps for s in ss]
+    return [Variant(p, s, base_scenario, out / Variant(p, s).slug, i)
+            for i, (p, s) in enumerate(combos)]
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What one variant gave: its rows of sweep.csv, or the error that stopped it."""
+
+    variant: Variant
+    run_dir: str | None
+    rows: tuple[dict[str, Any], ...] = ()
+    error: str | None = None
+    traceback: str | None = None
+    wall_s: float = 0.0
+
+
+def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
+    """Rows of sweep.csv for one finished variant (one per joint).
+
+    Peak and RMS torques are recomputed from ``trajectory.npz`` (both sources; the unsuffixed
+    value is the larger of the two); the margin, verdict and limiting check are copied from
+    ``sizing.json`` when the runner wrote one.
+    """
+    traj = load_trajectory(run_dir)
+    summary = load_summary(run_dir)
+    n = traj["tau"].shape[1]
+    names = list(summary.get("joints") or [f"j{k + 1}" for k in range(n)])
+    sizing_path = Path(run_dir) / "sizing.json"
+    sized: dict[str, dict[str, Any]] = {}
+    if sizing_path.is_file():
+        try:
+            sized = {j["joint"]: j for j in json.loads(sizing_path.read_text()).get("joints", [])}
+        except (json.JSONDecodeError, KeyError, TypeError):
+            sized = {}
+    t = traj["t"]
+    rows = []
+    for k, name in enumerate(names):
+        pk_id, _ = peak_abs(t, traj["tau_id"][:, k])
+        pk_sim, _ = peak_abs(t, traj["tau"][:, k])
+        rms_id = float(rms(t, traj["tau_id"][:, k]))
+        rms_sim = float(rms(t, traj["tau"][:, k]))
+        speed = max(peak_abs(t, traj["qd_ref"][:, k])[0], peak_abs(t, traj["qd"][:, k])[0])
+        power = max(peak_abs(t, traj["tau_id"][:, k] * traj["qd_ref"][:, k])[0],
+                    peak_abs(t, traj["tau"][:, k] * traj["qd"][:, k])[0])
+        s = sized.get(name, {})
+        margin = s.get("margin_pct")
+        rows.append({
+            "payload_kg": variant.payload_kg, "speed_scale": variant.speed_scale, "joint": name,
+            "peak_torque_nm": max(pk_id, pk_sim), "rms_torque_nm": max(rms_id, rms_sim),
+            "peak_torque_id_nm": pk_id, "peak_torque_sim_nm": pk_sim,
+            "rms_torque_id_nm": rms_id, "rms_torque_sim_nm": rms_sim,
+            "peak_speed_rad_s": speed, "peak_power_w": power,
+            "duration_s": float(t[-1] - t[0]),
+            "margin_pct": float("nan") if margin is None else float(margin),
+            "pass": ("PASS" if s["pass"] else "FAIL") if "pass" in s else "",
+            "limiting": s.get("limiting") or "",
+            "run_dir": str(run_dir),
+        })
+    return rows
+
+
+def run_variant(runner: Callable[[Variant], Any], variant: Variant) -> Outcome:
+    """Run one variant and read its results; never raises (errors go into the outcome, as
+    text, so that unpicklable exceptions cannot break the process pool)."""
+    t0 = time.perf_counter()
+    try:
+        run_dir = runner(variant)
+        if run_dir is None:
+            raise CellsimError("the runner returned no run folder")
+        rows = variant_rows(variant, run_dir)
+        return Outcome(variant, str(run_dir), tuple(rows), wall_s=time.perf_counter() - t0)
+    except BaseException as exc:  # noqa: BLE001 - reported per variant
+        if isinstance(exc, KeyboardInterrupt):
+            raise
+        msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        return Outcome(variant, None, (), msg, traceback.format_exc(),
+                       wall_s=time.perf_counter() - t0)
+
+
+@dataclass
+class SweepResult:
+    """A finished sweep.
+
+    Attributes:
+        outcomes: One per variant, in variant order.
+        workers: Worker processes used (1 = serial, in this process).
+        wall_s: Wall-clock time of the runs, s.
+        files: Files written, by name.
+    """
+
+    outcomes: list[Outcome]
+    workers: int
+    wall_s: float
+    files: dict[str, Path] = field(default_factory=dict)
+
+    @property
+    def rows(self) -> list[dict[str, Any]]:
+        return [r for o in self.outcomes for r in o.rows]
+
+    @property
+    def failures(self) -> list[Outcome]:
+        return [o for o in self.outcomes if o.error is not None]
+
+
+def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Sequence[float],
+              runner: Callable[[Variant], Any], workers: int | None = None,
+              out_dir: str | Path = "sweep", *, mp_context: str = "spawn",
+              progress: bool = True, write: bool = True, raise_on_failure: bool = True
+              ) -> SweepResult:
+    """Run every ``(payload, speed_scale)`` variant of ``base_scenario`` and tabulate them.
+
+    Args:
+        base_scenario: Passed to the runner inside each :class:`Variant`.
+        payloads: Payloads, kg (>= 0).
+        speed_scales: Speed factors (> 0); knot times are divided by them.
+        runner: Module-level function ``runner(variant) -> run_dir``.
+        workers: Worker processes (default ``os.cpu_count()``, capped at the number of
+            variants); 1 runs serially in this process.
+        out_dir: Folder for the sweep outputs (and the suggested variant run folders).
+        mp_context: Start method of the worker processes (``"spawn"``, ``"forkserver"``,
+            ``"fork"``).
+        progress: Show a progress bar (tqdm; silent when not a terminal).
+        write: Write ``sweep.csv``, ``sweep.md``, ``sweep.json``, ``sweep.png``.
+        raise_on_failure: Raise :class:`SweepError` after writing when a variant failed.
+
+    Returns:
+        The :class:`SweepResult`.
+
+    Raises:
+        SweepError: Bad payloads, speed scales or workers; failed variants (after writing).
+    """
+    if not callable(runner):
+        raise SweepError(f"runner: {runner!r} is not callable")
+    variants = make_variants(base_scenario, payloads, speed_scales, out_dir)
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise SweepError(f"workers: must be a whole number >= 1, got {workers!r}")
+    workers = min(workers, len(variants))
+    if mp_context not in multiprocessing.get_all_start_methods():
+        raise SweepError(f"mp_context: unknown start method {mp_context!r}; known: "
+                         f"{', '.join(multiprocessing.get_all_start_methods())}")
+    Path(out_dir).mkdir(parents=True, exist_ok=True)
+
+    from tqdm import tqdm
+
+    bar = tqdm(total=len(variants), desc="sweep", unit="run", disable=None if progress else True)
+    t0 = time.perf_counter()
+    results: list[Outcome | None] = [None] * len(variants)
+    try:
+        if workers == 1:
+            for v in variants:
+                results[v.index] = run_variant(runner, v)
+                bar.update()
+        else:
+            ctx = multiprocessing.get_context(mp_context)
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+                futures = {pool.submit(run_variant, runner, v): v for v in variants}
+                for fut in as_completed(futures):
+                    v = futures[fut]
+                    try:
+                        results[v.index] = fut.result()
+                    except Exception as exc:  # the worker died (BrokenProcessPool, pickling)
+                        results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {exc}")
+                    bar.update()
+    finally:
+        bar.close()
+    result = SweepResult(outcomes=[r for r in results if r is not None], workers=workers,
+                         wall_s=time.perf_counter() - t0)
+    if write:
+        result.files = write_sweep(out_dir, result)
+    failures = result.failures
+    if failures and raise_on_failure:
+        first = failures[0]
+        where = f"; see {result.files['md']}" if "md" in result.files else ""
+        raise SweepError(f"{len(failures)} of {len(result.outcomes)} sweep variants failed; first: "
+                         f"{first.variant.label}: {first.error}{where}")
+    return result
+
+
+# --------------------------------------------------------------------------------------------
+# Outputs
+# --------------------------------------------------------------------------------------------
+
+def _pivot(rows: Sequence[dict[str, Any]], key: str, joints: Sequence[str]) -> list[list[str]]:
+    table: dict[tuple[float, float], dict[str, float]] = {}
+    for r in rows:
+        table.setdefault((r["payload_kg"], r["speed_scale"]), {})[r["joint"]] = r[key]
+    out = []
+    for (p, s), vals in table.items():
+        cells = [f"{vals[j]:.4g}" if j in vals and np.isfinite(vals[j]) else "n/a" for j in joints]
+        out.append([f"{p:g}", f"{s:g}", *cells])
+    return out
+
+
+def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
+    """Text of ``sweep.md``: pivot tables (variant rows, joint columns), failures, chart."""
+    rows = result.rows
+    joints = list(dict.fromkeys(r["joint"] for r in rows))
+    ok = len(result.outcomes) - len(result.failures)
+    parts = ["# Sweep", "",
+             f"{len(result.outcomes)} variants ({ok} succeeded), {result.workers} worker(s), "
+             f"{result.wall_s:.1f} s wall-clock. Speed scale s divides the knot times "
+             "(s = 2: twice as fast). Torques are the larger of inverse dynamics and simulation.",
+             ""]
+    head = ["payload kg", "speed scale", *joints]
+
+    def table(title: str, key: str) -> None:
+        parts.extend([f"## {title}", "",
+                      "| " + " | ".join(head) + " |", "|" + "---|" * len(head)])
+        parts.extend("| " + " | ".join(r) + " |" for r in _pivot(rows, key, joints))
+        parts.append("")
+
+    if rows:
+        table("Peak |torque| (N m)", "peak_torque_nm")
+        table("RMS torque (N m)", "rms_torque_nm")
+        if any(np.isfinite(r["margin_pct"]) for r in rows):
+            table("Sizing margin (%)", "margin_pct")
+    if result.failures:
+        parts += ["## Failed variants", ""]
+        parts += [f"- {o.variant.label}: {o.error}" for o in result.failures]
+        parts.append("")
+    if chart and rows:
+        parts += ["## Chart", "", f"![peak and RMS torque]({chart})", ""]
+    return "\n".join(parts)
+
+
+def sweep_chart(result: SweepResult) -> bytes:
+    """PNG: per joint (rows), peak (solid) and RMS (dashed) torque against payload (left, one
+    line per speed scale) and against speed scale (right, one line per payload)."""
+    import matplotlib
+    from matplotlib.figure import Figure
+
+    rows = result.rows
+    joints = list(dict.fromkeys(r["joint"] for r in rows))
+    payloads = sorted({r["payload_kg"] for r in rows})
+    scales = sorted({r["speed_scale"] for r in rows})
+    idx = {(r["payload_kg"], r["speed_scale"], r["joint"]): r for r in rows}
+    fig = Figure(figsize=(10, 2.3 * len(joints) + 0.8), layout="constrained")
+    axes = fig.subplots(len(joints), 2, squeeze=False)
+    cmap = matplotlib.colormaps["viridis"]
+
+    def lines(ax, xs, series_keys, label_fmt, make_key):
+        for i, other in enumerate(series_keys):
+            color = cmap(i / max(len(series_keys) - 1, 1))
+            for key, style in (("peak_torque_nm", "-o"), ("rms_torque_nm", "--s")):
+                pts = [(x, idx[make_key(x, other)][key]) for x in xs if make_key(x, other) in idx]
+                if pts:
+                    x, y = zip(*pts)
+                    ax.plot(x, y, style, color=color, ms=3.5, lw=1.2,
+                            label=label_fmt(other) if key == "peak_torque_nm" else None)
+
+    for k, j in enumerate(joints):
+        ax_p, ax_s = axes[k]
+        lines(ax_p, payloads, scales, lambda s: f"speed x{s:g}", lambda x, s: (x, s, j))
+        lines(ax_s, scales, payloads, lambda p: f"{p:g} kg", lambda x, p: (p, x, j))
+        ax_p.set_ylabel(f"{j} torque (N m)")
+        for ax in (ax_p, ax_s):
+            ax.grid(alpha=0.3)
+        if k == 0:
+            ax_p.set_title("against payload (solid: peak, dashed: RMS)", fontsize=9)
+            ax_s.set_title("against speed scale (solid: peak, dashed: RMS)", fontsize=9)
+            ax_p.legend(fontsize=7)
+            ax_s.legend(fontsize=7)
+    axes[-1][0].set_xlabel("payload (kg)")
+    axes[-1][1].set_xlabel("speed scale")
+    return figure_png(fig)
+
+
+def write_sweep(out_dir: str | Path, result: SweepResult) -> dict[str, Path]:
+    """Write ``sweep.csv``, ``sweep.json``, ``sweep.png`` (when any variant succeeded) and
+    ``sweep.md`` into ``out_dir`` (atomically). Returns the paths by name."""
+    out = Path(out_dir)
+    files: dict[str, Path] = {}
+    rows = result.rows
+    files["csv"] = write_atomic(out / "sweep.csv", csv_text(SWEEP_COLUMNS, rows))
+    payload = {
+        "workers": result.workers, "wall_s": result.wall_s,
+        "variants": [{"payload_kg": o.variant.payload_kg, "speed_scale": o.variant.speed_scale,
+                      "run_dir": o.run_dir, "error": o.error, "wall_s": o.wall_s}
+                     for o in result.outcomes],
+        "rows": [{k: (v if not isinstance(v, float) or math.isfinite(v) else None)
+                  for k, v in r.items()} for r in rows],
+    }
+    files["json"] = write_atomic(out / "sweep.json", json.dumps(payload, indent=2) + "\n")
+    chart = None
+    if rows:
+        files["png"] = write_atomic(out / "sweep.png", sweep_chart(result))
+        chart = "sweep.png"
+    files["md"] = write_atomic(out / "sweep.md", sweep_markdown(result, chart))
+    return files

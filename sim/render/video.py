@@ -1,0 +1,218 @@
+"""MP4 videos of recorded runs (H.264, yuv420p) with background encoding.
+
+:func:`write_video` renders the run at the video's own frame times ``t0 + k / fps``,
+``k = 0 .. floor(duration * fps)`` (so ``floor(duration * fps) + 1`` frames), interpolating
+the recorded states between samples (it does not render every physics step). Frames go
+through a bounded queue to a background thread that feeds imageio's ffmpeg writer
+(imageio-ffmpeg's static ffmpeg, libx264), so encoding (and drawing the caption) overlaps
+rendering. The file is
+written under a temporary name in the same folder and renamed when complete; on error or
+interruption the partial file is removed.
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import sys
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sim.errors import RenderError
+from sim.render.overlay import OverlayStyle, draw_caption
+from sim.simulation.runfolder import RunRecord
+
+
+@dataclass(frozen=True)
+class VideoResult:
+    """What :func:`write_video` wrote.
+
+    Attributes:
+        path: The MP4 file.
+        frames: Number of frames, ``floor(duration * fps) + 1``.
+        fps: Frames per second of the video.
+        width: Frame width, pixels (tile width x number of cameras).
+        height: Frame height, pixels.
+        seconds: Wall-clock time of the whole call (model load, OpenGL context, ffmpeg start,
+            rendering, encoding), s.
+        loop_seconds: Wall-clock time from the first frame to the encoder's last, s.
+        backend: OpenGL backend used.
+    """
+
+    path: Path
+    frames: int
+    fps: float
+    width: int
+    height: int
+    seconds: float
+    loop_seconds: float
+    backend: str
+
+    @property
+    def frames_per_second(self) -> float:
+        """Throughput of the whole call, frames per wall-clock second."""
+        return self.frames / self.seconds if self.seconds > 0 else float("inf")
+
+    @property
+    def loop_frames_per_second(self) -> float:
+        """Throughput of the render + encode loop (set-up excluded), frames per second."""
+        return self.frames / self.loop_seconds if self.loop_seconds > 0 else float("inf")
+
+
+class _Encoder:
+    """Background thread appending frames to an imageio writer, fed by a bounded queue.
+
+    Items are ``(frame, caption)``; a non-empty caption is drawn in this thread (Pillow), in
+    parallel with the next frame's rendering (MuJoCo releases the GIL while rendering).
+    """
+
+    _STOP = object()
+
+    def __init__(self, writer: Any, maxsize: int) -> None:
+        self.writer = writer
+        self.queue: queue.Queue[Any] = queue.Queue(maxsize=max(1, maxsize))
+        self.error: BaseException | None = None
+        self.thread = threading.Thread(target=self._run, name="cellsim-video-encoder", daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        while True:
+            item = self.queue.get()
+            if item is self._STOP:
+                return
+            if self.error is not None:
+                continue  # drain after a failure so put() never blocks forever
+            try:
+                frame, caption = item
+                if caption:
+                    draw_caption(frame, caption)
+                self.writer.append_data(frame)
+            except BaseException as exc:  # noqa: BLE001 - reported to the producer
+                self.error = exc
+
+    def put(self, frame: np.ndarray, caption: str = "") -> None:
+        if self.error is not None:
+            raise RenderError(f"video encoding failed: {self.error}") from self.error
+        self.queue.put((frame, caption))
+
+    def finish(self) -> None:
+        self.queue.put(self._STOP)
+        self.thread.join()
+        if self.error is not None:
+            raise RenderError(f"video encoding failed: {self.error}") from self.error
+
+
+def _partial_path(path: Path) -> Path:
+    return path.with_name(f".{path.stem}.partial{path.suffix}")
+
+
+def write_video(
+    run: str | Path | RunRecord,
+    path: str | Path,
+    *,
+    cameras: Sequence[str] = ("overview",),
+    width: int = 640,
+    height: int = 480,
+    fps: float = 30.0,
+    gl: str | None = None,
+    progress: bool = False,
+    overlay: bool = True,
+    caption: bool = True,
+    style: OverlayStyle | None = None,
+    crf: int = 20,
+    preset: str = "veryfast",
+    queue_size: int = 8,
+) -> VideoResult:
+    """Renders a recorded run into an H.264 MP4.
+
+    Args:
+        run: A run folder (``model.xml`` + ``summary.json`` + ``trajectory.npz``) or a
+            :class:`~sim.simulation.runfolder.RunRecord`.
+        path: Output file; must end in ``.mp4``; parent folders are created.
+        cameras: Camera names of the model, tiled left to right.
+        width: Width of one camera tile, pixels (even, 16..8192).
+        height: Height, pixels (even, 16..8192).
+        fps: Frames per second (> 0).
+        gl: OpenGL backend ``"egl"`` / ``"osmesa"``, or None for automatic.
+        progress: Show a progress bar on stderr (only when stderr is a terminal).
+        overlay: Draw the tool-point trails and the weld bead.
+        caption: Draw the caption (time, phase, highest joint torque).
+        style: Overlay colours and sizes.
+        crf: x264 constant rate factor (0 lossless .. 51 worst; 18-23 looks good).
+        preset: x264 speed preset (``ultrafast`` .. ``veryslow``).
+        queue_size: Frames buffered between renderer and encoder.
+
+    Returns:
+        A :class:`VideoResult`.
+
+    Raises:
+        RenderError: Bad path/size/fps/camera, no OpenGL backend, or the encoder failed.
+        RunFolderError: The run folder is missing or malformed.
+    """
+    import imageio.v2 as imageio
+    from tqdm import tqdm
+
+    from sim.render.gl import active_backend
+    from sim.render.frames import FrameRenderer
+
+    out_path = Path(path)
+    if out_path.suffix.lower() != ".mp4":
+        raise RenderError(f"video file {str(out_path)!r} must end in .mp4 (H.264 MP4)")
+    if not (isinstance(crf, int) and 0 <= crf <= 51):
+        raise RenderError(f"crf must be an integer in 0..51, got {crf!r}")
+    started = time.perf_counter()
+    with FrameRenderer(
+        run, cameras=cameras, width=width, height=height, overlay=overlay, caption=caption,
+        gl=gl, style=style,
+    ) as frames:
+        times = frames.frame_times(fps)
+        h, w, _ = frames.frame_shape
+        out_path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = _partial_path(out_path)
+        ok = False
+        try:
+            writer = imageio.get_writer(
+                tmp, format="FFMPEG", mode="I", fps=float(fps), codec="libx264",
+                pixelformat="yuv420p", quality=None, macro_block_size=2,
+                ffmpeg_log_level="error",
+                output_params=["-crf", str(crf), "-preset", preset, "-movflags", "+faststart"],
+            )
+            loop_start = time.perf_counter()
+            try:
+                encoder = _Encoder(writer, queue_size)
+                bar = tqdm(total=len(times), unit="frame", desc="render", file=sys.stderr,
+                           disable=not (progress and sys.stderr.isatty()), leave=False,
+                           delay=1.0)  # only renders longer than a second show a bar
+                try:
+                    for t in times:
+                        t = float(t)
+                        text = frames.caption_at(t) if caption else ""
+                        encoder.put(frames.render(t, caption=False), text)
+                        bar.update(1)
+                finally:
+                    bar.close()
+                    encoder.finish()
+            except BaseException:
+                try:
+                    writer.close()
+                except Exception:  # noqa: BLE001 - keep the first error
+                    pass
+                raise
+            writer.close()  # waits for ffmpeg to encode the last frames
+            loop_seconds = time.perf_counter() - loop_start
+            os.replace(tmp, out_path)
+            ok = True
+        finally:
+            if not ok and tmp.exists():
+                tmp.unlink()
+    return VideoResult(
+        path=out_path, frames=len(times), fps=float(fps), width=w, height=h,
+        seconds=time.perf_counter() - started, loop_seconds=loop_seconds,
+        backend=active_backend() or "",
+    )

@@ -1,0 +1,889 @@
+"""Scenario files: loading, validation and planning.
+
+A scenario is a TOML file (stdlib :mod:`tomllib`) that names a robot and a list of phases.
+The structure is declared once, with pydantic models below, so that unknown keys, wrong types
+and NaN are rejected with one line naming the key; the format reference
+(``docs/scenario-format.md``) documents the same keys and a test keeps the two in step.
+
+Inside cellsim everything is SI; the file may use degrees or millimetres where the key says so
+(``joints_deg``, ``points_mm``). Every error is a :class:`sim.errors.ScenarioError` whose message
+starts with the file name and the dotted path of the offending key, e.g.
+``bugnar.toml: phases[0].time_s: knot times must increase (index 2: 3.33 s after 6.67 s)``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Annotated, Any, Literal, Union
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError
+
+from planners.errors import PlannerError
+from sim.errors import ScenarioError, UnknownNameError
+from sim.core.resources import shipped_scenarios
+from sim.robots.registry import RobotSpec, get_robot
+
+# --------------------------------------------------------------------------------------------
+# Declared structure (what the file may contain)
+# --------------------------------------------------------------------------------------------
+
+_NAME_PATTERN = r"^[A-Za-z0-9_.-]+$"
+
+#: Boundary-condition keys of a joint phase: (quantity, end, unit suffix) -> planner keyword.
+_BOUNDARY_KEYS: dict[str, tuple[str, float]] = {}
+for _end, _kw in (("start", "0"), ("end", "f")):
+    for _qty, _sym, _order in (("velocity", "v", 1), ("acceleration", "a", 2), ("jerk", "j", 3)):
+        _unit = "_s" if _order == 1 else f"_s{_order}"
+        _BOUNDARY_KEYS[f"{_end}_{_qty}_deg{_unit}"] = (f"{_sym}{_kw}", math.pi / 180.0)
+        _BOUNDARY_KEYS[f"{_end}_{_qty}_rad{_unit}"] = (f"{_sym}{_kw}", 1.0)
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
+
+
+Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+PlannerName = Literal["434", "546"]
+
+
+class JointPhaseSpec(_Strict):
+    """A joint-space phase: via points, joined by a piecewise polynomial."""
+
+    name: str = Field(pattern=_NAME_PATTERN, description="phase name, unique in the scenario")
+    kind: Literal["joint"] = Field("joint", description='phase kind: "joint"')
+    planner: PlannerName = Field(description='"434" (seed 001) or "546" (seed 000)')
+    time_s: list[float] | None = Field(None, description="absolute knot times, s")
+    durations_s: list[float] | None = Field(None, description="segment durations, s")
+    joints_deg: list[list[float]] | None = Field(None, description="one row per knot, deg")
+    joints_rad: list[list[float]] | None = Field(None, description="one row per knot, rad")
+    start_velocity_deg_s: list[float] | None = None
+    start_velocity_rad_s: list[float] | None = None
+    end_velocity_deg_s: list[float] | None = None
+    end_velocity_rad_s: list[float] | None = None
+    start_acceleration_deg_s2: list[float] | None = None
+    start_acceleration_rad_s2: list[float] | None = None
+    end_acceleration_deg_s2: list[float] | None = None
+    end_acceleration_rad_s2: list[float] | None = None
+    start_jerk_deg_s3: list[float] | None = None
+    start_jerk_rad_s3: list[float] | None = None
+    end_jerk_deg_s3: list[float] | None = None
+    end_jerk_rad_s3: list[float] | None = None
+    to_mm: Vec3 | None = None
+    to_seam: str | None = None
+    euler_zyx_deg: Vec3 | None = None
+    note: str | None = Field(None, description="free text (e.g. which seed value was chosen)")
+
+
+class _CartesianSpec(_Strict):
+    name: str = Field(pattern=_NAME_PATTERN)
+    planner: PlannerName = "434"
+    seam: str | None = None
+    to_mm: Vec3 | None = None
+    speed_mm_s: float = Field(gt=0)
+    sample_period_s: float = Field(0.1, gt=0)
+    ramp_s: float | None = Field(None, gt=0)
+    euler_zyx_deg: Vec3 | None = None
+    note: str | None = None
+
+
+class LinearPhaseSpec(_CartesianSpec):
+    """A straight move of the tool point at constant speed (ADNIA, seed 003 eq. 1-7)."""
+
+    kind: Literal["linear"]
+    orientation: Literal["keep", "seam", "euler"] = "keep"
+
+
+class CircularPhaseSpec(_CartesianSpec):
+    """A circular arc of the tool point at constant tangential speed (ADNIA, seed 003)."""
+
+    kind: Literal["circular"]
+    via_mm: Vec3 | None = None
+    center_mm: Vec3 | None = None
+    axis: Vec3 | None = None
+    sweep_deg: float | None = None
+    orientation: Literal["keep", "follow", "seam", "euler"] = "follow"
+
+
+class HoldPhaseSpec(_Strict):
+    """The robot holds its pose (e.g. while suction builds up, or to measure static torques)."""
+
+    name: str = Field(pattern=_NAME_PATTERN)
+    kind: Literal["hold"]
+    duration_s: float = Field(gt=0)
+    note: str | None = None
+
+
+def _phase_kind(value: Any) -> str | None:
+    if isinstance(value, dict):
+        kind = value.get("kind", "joint")
+        return kind if isinstance(kind, str) else None
+    return getattr(value, "kind", None)
+
+
+PhaseSpec = Annotated[
+    Union[
+        Annotated[JointPhaseSpec, Tag("joint")],
+        Annotated[LinearPhaseSpec, Tag("linear")],
+        Annotated[CircularPhaseSpec, Tag("circular")],
+        Annotated[HoldPhaseSpec, Tag("hold")],
+    ],
+    Discriminator(_phase_kind),
+]
+PHASE_KINDS: dict[str, type[BaseModel]] = {
+    "joint": JointPhaseSpec, "linear": LinearPhaseSpec, "circular": CircularPhaseSpec,
+    "hold": HoldPhaseSpec,
+}
+
+
+class ActionSpec(_Strict):
+    """A tool action at a time: absolute ``time_s``, or at the start/end of a named phase."""
+
+    action: Literal["arc_on", "arc_off", "suction_on", "suction_off"]
+    time_s: float | None = None
+    phase: str | None = None
+    at: Literal["start", "end"] = "start"
+
+
+class SimulationSpec(_Strict):
+    """Simulation settings."""
+
+    timestep_s: float | None = Field(None, gt=0, le=0.01)
+    feedforward: bool = True
+    settle_s: float = Field(0.0, ge=0)
+    enforce_speed_limits: bool = True
+
+
+class VideoSpec(_Strict):
+    """Default video settings (command-line flags override them)."""
+
+    cameras: list[str] | None = None
+    width: int | None = Field(None, gt=0)
+    height: int | None = Field(None, gt=0)
+    fps: float | None = Field(None, gt=0)
+
+
+class DriveOverrideSpec(_Strict):
+    """Drive-train values of one joint that replace the robot's defaults."""
+
+    gear_ratio: float | None = Field(None, gt=0)
+    efficiency: float | None = Field(None, gt=0, le=1)
+    rotor_inertia_kg_m2: float | None = Field(None, ge=0)
+    rated_torque_nm: float | None = Field(None, gt=0)
+    peak_torque_nm: float | None = Field(None, gt=0)
+    max_speed_rpm: float | None = Field(None, gt=0)
+
+
+class ScenarioSpec(_Strict):
+    """Top level of a scenario file."""
+
+    name: str = Field(pattern=_NAME_PATTERN, description="scenario name")
+    description: str = Field(description="one paragraph shown by `cellsim list`")
+    robot: str = Field(description="robot name (`cellsim list` shows them)")
+    note: str | None = Field(None, description="free text: sources, choices made")
+    cell: str | None = None
+    tool: str | None = None
+    mount: Literal["floor", "ceiling"] = "floor"
+    payload_kg: float = Field(0.0, ge=0)
+    simulation: SimulationSpec = SimulationSpec()
+    video: VideoSpec = VideoSpec()
+    drives: dict[str, DriveOverrideSpec] = {}
+    actions: list[ActionSpec] = []
+    phases: list[PhaseSpec] = Field(min_length=1, description="the work cycle, in order")
+
+
+# --------------------------------------------------------------------------------------------
+# Validated, SI-unit result
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class JointPhase:
+    """A validated joint-space phase in SI units.
+
+    Attributes:
+        index: Position of the phase in the scenario (0-based).
+        name: Phase name.
+        planner: ``"434"`` or ``"546"``.
+        times: Absolute knot times, s, shape (m+1,); ``None`` when the phase was given by
+            segment durations (it then starts whenever the previous phase ends).
+        durations: Segment durations, s, shape (m,).
+        q: Knot values, rad, shape (m+1, n_joints); with ``durations_s`` the first row is
+            ``NaN`` until the previous phase's end fills it in (see :meth:`with_start`).
+        boundary: Planner keywords (``v0``, ``vf``, ``a0``, ``af``, ``j0``, ``jf``) with arrays
+            of shape (n_joints,) in rad/s^k; absent keys default to 0 in the planner.
+    """
+
+    index: int
+    name: str
+    planner: str
+    times: NDArray[np.float64] | None
+    durations: NDArray[np.float64]
+    q: NDArray[np.float64]
+    boundary: dict[str, NDArray[np.float64]] = field(default_factory=dict)
+    kind: str = "joint"
+    target: "PoseTarget | None" = None
+
+    @property
+    def t0(self) -> float:
+        if self.times is None:
+            raise ValueError(f"phase {self.name} has relative times")
+        return float(self.times[0])
+
+    @property
+    def t1(self) -> float:
+        if self.times is None:
+            raise ValueError(f"phase {self.name} has relative times")
+        return float(self.times[-1])
+
+    @property
+    def starts_from_previous(self) -> bool:
+        return self.times is None
+
+    def with_start(self, t0: float, q0: NDArray[np.float64]) -> "JointPhase":
+        """This phase placed at ``t0`` and, if it starts from the previous phase, from ``q0``."""
+        import dataclasses
+
+        q = self.q.copy()
+        if self.starts_from_previous:
+            q[0] = q0
+        times = (self.times if self.times is not None
+                 else t0 + np.concatenate([[0.0], np.cumsum(self.durations)]))
+        placed = dataclasses.replace(self, times=times, q=q)
+        return placed if self.target is not None else placed.with_end(q[-1])
+
+    def with_end(self, q_end: NDArray[np.float64]) -> "JointPhase":
+        """This phase ending at ``q_end`` (its pose target solved); an automatic via point
+        (NaN row) becomes the joint-space midpoint of start and end."""
+        import dataclasses
+
+        q = self.q.copy()
+        q[-1] = q_end
+        for r in range(1, q.shape[0] - 1):
+            if np.isnan(q[r]).all():
+                q[r] = 0.5 * (q[0] + q_end)
+        return dataclasses.replace(self, q=q)
+
+
+@dataclass(frozen=True)
+class PoseTarget:
+    """Where a joint phase ends, in Cartesian terms (solved by inverse kinematics).
+
+    Attributes:
+        position: tcp position in frame 0, m, (3,), or ``None`` with ``seam``.
+        rotation: tcp orientation in frame 0, (3, 3); ``None`` keeps the previous one.
+        seam: A cell seam whose start (and torch posture) is the target.
+    """
+
+    position: NDArray[np.float64] | None = None
+    rotation: NDArray[np.float64] | None = None
+    seam: str | None = None
+
+
+@dataclass(frozen=True)
+class CartesianPhase:
+    """A validated Cartesian phase (``linear`` or ``circular``), lengths in metres, frame0.
+
+    Attributes:
+        kind: ``"linear"`` or ``"circular"``.
+        seam: Name of a cell seam to follow, or ``None``.
+        to: End point in frame0, m, shape (3,), or ``None`` when ``seam`` gives it.
+        via: Circular only: a point on the arc, frame0, m.
+        center, axis, sweep: Circular only: centre (m), axis (unit), sweep (rad).
+        speed: Travel speed, m/s. sample_period: ADNIA sampling period, s. ramp: ramp time, s.
+        orientation: ``keep``, ``follow``, ``seam`` or ``euler``; ``euler``: R = Rz Ry Rx (rad).
+    """
+
+    index: int
+    name: str
+    kind: str
+    planner: str
+    speed: float
+    sample_period: float
+    ramp: float | None
+    orientation: str
+    seam: str | None = None
+    to: NDArray[np.float64] | None = None
+    via: NDArray[np.float64] | None = None
+    center: NDArray[np.float64] | None = None
+    axis: NDArray[np.float64] | None = None
+    sweep: float | None = None
+    euler_zyx: NDArray[np.float64] | None = None
+
+
+@dataclass(frozen=True)
+class HoldPhase:
+    """The robot holds the pose where the previous phase ended, for ``duration`` s."""
+
+    index: int
+    name: str
+    duration: float
+    kind: str = "hold"
+
+
+@dataclass(frozen=True)
+class Action:
+    """A tool action; ``time`` absolute (s) or ``phase``/``at`` resolved when the run is timed."""
+
+    action: str
+    time: float | None
+    phase: str | None
+    at: str
+
+
+Phase = JointPhase | CartesianPhase | HoldPhase
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario (SI units).
+
+    Attributes:
+        name: Scenario name.
+        description: Free text.
+        robot: The robot's registry entry.
+        phases: Phases in order.
+        source: File the scenario came from.
+        text: The file's text (copied into run folders, hashed into manifests).
+        cell, tool, mount, payload_kg: The cell the robot works in (``None``: bare scene).
+        simulation, video: Settings tables (pydantic models, defaults filled in).
+        drives: Drive-train overrides by joint name: {field: value}, SI units.
+        actions: Tool actions in file order.
+    """
+
+    name: str
+    description: str
+    robot: RobotSpec
+    phases: tuple[Phase, ...]
+    source: Path
+    text: str
+    cell: str | None = None
+    tool: str | None = None
+    mount: str = "floor"
+    payload_kg: float = 0.0
+    simulation: SimulationSpec = SimulationSpec()
+    video: VideoSpec = VideoSpec()
+    drives: dict[str, dict[str, float]] = field(default_factory=dict)
+    actions: tuple[Action, ...] = ()
+
+    @property
+    def sha256(self) -> str:
+        return hashlib.sha256(self.text.encode()).hexdigest()
+
+    def scaled(self, speed_scale: float = 1.0, payload_kg: float | None = None) -> "Scenario":
+        """This scenario run ``speed_scale`` times faster, optionally with another payload.
+
+        Knot times, segment durations, hold durations and action times are divided by
+        ``speed_scale``; Cartesian speeds are multiplied by it (sampling periods and ramps
+        divided), and boundary velocities, accelerations and jerks scale by its 1st, 2nd and 3rd
+        power, so the joint paths are the same, traversed faster. Without gravity, friction and
+        damping, joint torques then scale exactly as ``speed_scale**2``.
+
+        Raises:
+            ScenarioError: ``speed_scale`` not positive, or negative ``payload_kg``.
+        """
+        import dataclasses
+
+        if not (np.isfinite(speed_scale) and speed_scale > 0):
+            raise ScenarioError(f"speed scale must be a positive number, got {speed_scale!r}")
+        if payload_kg is not None and not (np.isfinite(payload_kg) and payload_kg >= 0):
+            raise ScenarioError(f"payload_kg must be >= 0, got {payload_kg!r}")
+        s = float(speed_scale)
+        order = {"v": 1, "a": 2, "j": 3}
+        phases: list[Phase] = []
+        for p in self.phases:
+            if isinstance(p, JointPhase):
+                phases.append(dataclasses.replace(
+                    p, times=None if p.times is None else p.times / s,
+                    durations=p.durations / s,
+                    boundary={k: v * s ** order[k[0]] for k, v in p.boundary.items()}))
+            elif isinstance(p, CartesianPhase):
+                phases.append(dataclasses.replace(
+                    p, speed=p.speed * s, sample_period=p.sample_period / s,
+                    ramp=None if p.ramp is None else p.ramp / s))
+            else:
+                phases.append(dataclasses.replace(p, duration=p.duration / s))
+        actions = tuple(dataclasses.replace(a, time=None if a.time is None else a.time / s)
+                        for a in self.actions)
+        return dataclasses.replace(
+            self, phases=tuple(phases), actions=actions,
+            payload_kg=self.payload_kg if payload_kg is None else float(payload_kg))
+
+    @property
+    def fixed_timing(self) -> bool:
+        """True when every phase is a joint phase with absolute times (no timing to resolve)."""
+        return all(isinstance(p, JointPhase) and p.times is not None for p in self.phases)
+
+    @property
+    def duration(self) -> float:
+        """Total duration, s (joint phases with absolute times only; see ``sim.simulation.motion``)."""
+        first, last = self.phases[0], self.phases[-1]
+        if not (isinstance(first, JointPhase) and isinstance(last, JointPhase)
+                and first.times is not None and last.times is not None):
+            raise ValueError("duration depends on Cartesian planning; plan the motion first")
+        return last.t1 - first.t0
+
+
+# --------------------------------------------------------------------------------------------
+# Loading
+# --------------------------------------------------------------------------------------------
+
+
+def resolve_scenario(ref: str | Path) -> Path:
+    """Path of a scenario given as a file path or as a shipped scenario's name.
+
+    Raises:
+        UnknownNameError: Neither an existing file nor a shipped scenario; lists the shipped ones.
+    """
+    path = Path(ref)
+    if path.is_file():
+        return path
+    shipped = shipped_scenarios()
+    if str(ref) in shipped:
+        return shipped[str(ref)]
+    if path.suffix == ".toml" or path.parent != Path("."):
+        raise ScenarioError(f"{ref}: no such scenario file")
+    raise UnknownNameError("scenario", str(ref), shipped)
+
+
+def load_scenario(ref: str | Path) -> Scenario:
+    """Load and validate a scenario file (path or shipped name).
+
+    Raises:
+        ScenarioError: Unreadable or malformed file, or inconsistent content; one line naming
+            the file and the key.
+        UnknownNameError: Unknown scenario name or robot.
+    """
+    path = resolve_scenario(ref)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ScenarioError(f"{path}: cannot read scenario file ({exc})") from None
+    return parse_scenario(text, source=path)
+
+
+def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
+    """Validate scenario TOML text; see :func:`load_scenario`."""
+    where = Path(source).name if str(source) != "<scenario>" else "<scenario>"
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"{where}: invalid TOML: {exc}") from None
+    try:
+        spec = ScenarioSpec.model_validate(raw)
+    except ValidationError as exc:
+        raise ScenarioError(f"{where}: {_describe_validation_error(exc, raw)}") from None
+    try:
+        robot = get_robot(spec.robot)
+    except UnknownNameError as exc:
+        raise ScenarioError(f"{where}: robot: {exc}") from None
+
+    phases: list[Phase] = []
+    seen: dict[str, int] = {}
+    for i, pspec in enumerate(spec.phases):
+        key = f"{where}: phases[{i}]"
+        if pspec.name in seen:
+            raise ScenarioError(
+                f"{key}.name: {pspec.name!r} is already the name of phases[{seen[pspec.name]}]")
+        seen[pspec.name] = i
+        phase: Phase
+        prev = phases[-1] if phases else None
+        if isinstance(pspec, JointPhaseSpec):
+            timed_prev = prev is None or (isinstance(prev, JointPhase) and prev.times is not None)
+            if pspec.time_s is not None and not timed_prev:
+                assert prev is not None
+                raise ScenarioError(
+                    f"{key}.time_s: after a {prev.kind} phase the start time is only known once "
+                    "the motion is planned; give durations_s (and the knots after the start)")
+            if pspec.durations_s is not None and prev is None:
+                raise ScenarioError(
+                    f"{key}.durations_s: the first phase must give time_s and its start knot")
+            phase = _build_joint_phase(i, pspec, robot, key)
+            if (isinstance(prev, JointPhase) and prev.times is not None and phase.times is not None
+                    and prev.target is None):
+                _check_continuity(prev, phase, key, robot)
+        elif prev is None:
+            raise ScenarioError(f"{key}.kind: the first phase must be a joint phase (it sets the "
+                                "start pose)")
+        elif isinstance(pspec, (LinearPhaseSpec, CircularPhaseSpec)):
+            phase = _build_cartesian_phase(i, pspec, key)
+        else:
+            phase = HoldPhase(index=i, name=pspec.name, duration=pspec.duration_s)
+        phases.append(phase)
+
+    _check_registry_name(where, "cell", spec.cell, "sim.cells", "CELLS")
+    _check_registry_name(where, "tool", spec.tool, "sim.cells.tools", "TOOLS")
+    effective_tool, tool_kind = _effective_tool(spec)
+    drives: dict[str, dict[str, float]] = {}
+    for joint, override in spec.drives.items():
+        if joint not in robot.joints:
+            close = difflib.get_close_matches(joint, robot.joints, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ScenarioError(f"{where}: drives.{joint}: unknown joint{hint}; robot "
+                                f"{robot.name} has {', '.join(robot.joints)}")
+        drives[joint] = {k: v for k, v in override.model_dump().items() if v is not None}
+    actions = []
+    for i, a in enumerate(spec.actions):
+        if (a.time_s is None) == (a.phase is None):
+            raise ScenarioError(f"{where}: actions[{i}]: give exactly one of time_s or phase")
+        if a.phase is not None and a.phase not in seen:
+            close = difflib.get_close_matches(a.phase, list(seen), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ScenarioError(f"{where}: actions[{i}].phase: no phase named {a.phase!r}{hint}; "
+                                f"phases: {', '.join(seen)}")
+        need = "gripper" if a.action.startswith("suction") else "torch"
+        if tool_kind != need:
+            raise ScenarioError(f"{where}: actions[{i}].action: {a.action} needs a {need} tool "
+                                f"(the tool is {effective_tool or 'none'})")
+        actions.append(Action(a.action, a.time_s, a.phase, a.at))
+    return Scenario(
+        name=spec.name,
+        description=spec.description,
+        robot=robot,
+        phases=tuple(phases),
+        source=Path(source),
+        text=text,
+        cell=spec.cell,
+        tool=spec.tool,
+        mount=spec.mount,
+        payload_kg=spec.payload_kg,
+        simulation=spec.simulation,
+        video=spec.video,
+        drives=drives,
+        actions=tuple(actions),
+    )
+
+
+def _effective_tool(spec: ScenarioSpec) -> tuple[str | None, str | None]:
+    """The tool a scenario ends up with (its own, or its cell's default) and that tool's kind."""
+    from sim.cells import CELLS
+    from sim.cells.tools import TOOLS
+
+    tool = spec.tool
+    if tool is None and spec.cell is not None:
+        tool = CELLS[spec.cell].default_tool
+    if tool in (None, "none"):
+        return None, None
+    return tool, TOOLS[tool].kind
+
+
+def _check_registry_name(where: str, kind: str, name: str | None, module: str, attr: str) -> None:
+    """Unknown cell/tool names are user mistakes; the message lists the known ones."""
+    if name is None:
+        return
+    import importlib
+
+    try:
+        registry = getattr(importlib.import_module(module), attr)
+    except ModuleNotFoundError:
+        registry = {}
+    if name not in registry:
+        raise ScenarioError(f"{where}: {kind}: {UnknownNameError(kind, name, registry)}")
+
+
+def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where: str) -> JointPhase:
+    if (spec.time_s is None) == (spec.durations_s is None):
+        raise ScenarioError(f"{where}: give exactly one of time_s or durations_s")
+    if spec.time_s is not None:
+        times = np.asarray(spec.time_s, dtype=float)
+        if times.size < 3:
+            raise ScenarioError(
+                f"{where}.time_s: {times.size} knot time(s) given; a {spec.planner} phase needs "
+                "at least 3 (start, one via point, end); for a single move give "
+                "durations_s = [T] in a later phase")
+        steps = np.diff(times)
+        if np.any(steps <= 0):
+            k = int(np.argmax(steps <= 0)) + 1
+            raise ScenarioError(
+                f"{where}.time_s: knot times must increase (index {k}: {times[k]:g} s after "
+                f"{times[k - 1]:g} s)")
+        durations = steps
+        n_rows = times.size
+    else:
+        durations = np.asarray(spec.durations_s, dtype=float)
+        times = None
+        if durations.size < 1:
+            raise ScenarioError(f"{where}.durations_s: empty; give at least one segment duration")
+        if np.any(durations <= 0):
+            k = int(np.argmax(durations <= 0))
+            raise ScenarioError(f"{where}.durations_s[{k}]: segment durations must be positive, "
+                                f"got {durations[k]:g} s")
+        n_rows = durations.size  # the start knot is the previous phase's end
+
+    target = _pose_target(spec, where)
+    if target is not None:
+        n_rows -= 1  # the last knot comes from the pose target
+    n = robot.n_joints
+    if spec.joints_deg is not None and spec.joints_rad is not None:
+        raise ScenarioError(f"{where}: give exactly one of joints_deg or joints_rad")
+    if spec.joints_deg is None and spec.joints_rad is None:
+        if target is None:
+            raise ScenarioError(f"{where}: give joints_deg (or joints_rad), or a pose target "
+                                "(to_mm or to_seam)")
+        if times is not None:
+            raise ScenarioError(f"{where}.joints_deg: required: its first row is the start knot")
+        rows_q = np.zeros((0, n))
+    else:
+        key, rows, scale = (("joints_deg", spec.joints_deg, math.pi / 180.0)
+                            if spec.joints_deg is not None else ("joints_rad", spec.joints_rad, 1.0))
+        assert rows is not None
+        if len(rows) != n_rows:
+            if target is not None:
+                what = ("rows (the start knot and the via points; the end is the pose target)"
+                        if times is not None else "rows (the via points; the start is the previous "
+                        "phase's end and the end is the pose target)")
+                raise ScenarioError(f"{where}.{key}: {len(rows)} rows, expected {n_rows} {what}")
+            what = ("knot times; give one row per time" if times is not None else
+                    "segments; give one row per segment end (the start is the previous phase's end)")
+            raise ScenarioError(f"{where}.{key}: {len(rows)} rows for {n_rows} {what}")
+        for r, row in enumerate(rows):
+            if len(row) != n:
+                raise ScenarioError(
+                    f"{where}.{key}[{r}]: {len(row)} values; robot {robot.name} has {n} joints "
+                    f"({', '.join(robot.joints)})")
+        rows_q = np.asarray(rows, dtype=float).reshape(-1, n) * scale
+    if target is None and rows_q.shape[0] == 0:
+        raise ScenarioError(f"{where}: no knots")
+    blocks = []
+    if times is None:
+        blocks.append(np.full((1, n), np.nan))  # start: the previous phase's end
+    blocks.append(rows_q)
+    if target is not None:
+        blocks.append(np.full((1, n), np.nan))  # end: solved from the pose target
+    q = np.vstack(blocks)
+    if durations.size == 1:
+        # a single segment: the joint-space midpoint is the via point (4-4 / 5-6 polynomial),
+        # filled in once start and end are known (JointPhase.with_start / with_end)
+        durations = np.array([durations[0] / 2, durations[0] / 2])
+        if times is not None:
+            times = np.array([times[0], times[0] + durations[0], times[1]])
+        q = np.vstack([q[:1], np.full((1, n), np.nan), q[1:]])
+    if target is not None and times is not None and np.isnan(q[0]).any():
+        raise ScenarioError(f"{where}.joints_deg: the first row is the start knot")
+
+    boundary: dict[str, NDArray[np.float64]] = {}
+    for bkey, (kw, bscale) in _BOUNDARY_KEYS.items():
+        values = getattr(spec, bkey)
+        if values is None:
+            continue
+        if kw in boundary:
+            raise ScenarioError(f"{where}.{bkey}: the same boundary value is also given in other units")
+        if kw.startswith("j") and spec.planner != "546":
+            raise ScenarioError(
+                f"{where}.{bkey}: the {spec.planner} planner has no jerk boundary conditions "
+                "(only 546 does)")
+        if len(values) != n:
+            raise ScenarioError(
+                f"{where}.{bkey}: {len(values)} values; robot {robot.name} has {n} joints")
+        boundary[kw] = np.asarray(values, dtype=float) * bscale
+    return JointPhase(index=index, name=spec.name, planner=spec.planner, times=times,
+                      durations=durations, q=q, boundary=boundary, target=target)
+
+
+def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
+    if spec.to_mm is not None and spec.to_seam is not None:
+        raise ScenarioError(f"{where}: give one of to_mm or to_seam")
+    if spec.euler_zyx_deg is not None and spec.to_mm is None:
+        raise ScenarioError(f"{where}.euler_zyx_deg: only used with to_mm")
+    if spec.to_seam is not None:
+        return PoseTarget(seam=spec.to_seam)
+    if spec.to_mm is None:
+        return None
+    rot = None
+    if spec.euler_zyx_deg is not None:
+        from sim.core.rotations import euler_zyx_to_matrix
+
+        rot = euler_zyx_to_matrix(*np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)))
+    return PoseTarget(position=np.asarray(spec.to_mm, dtype=float) * 1e-3, rotation=rot)
+
+
+def _build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec,
+                           where: str) -> CartesianPhase:
+    def vec_m(v: list[float] | None) -> NDArray[np.float64] | None:
+        return None if v is None else np.asarray(v, dtype=float) * 1e-3
+
+    if spec.orientation == "euler" and spec.euler_zyx_deg is None:
+        raise ScenarioError(f"{where}.euler_zyx_deg: required with orientation = \"euler\"")
+    if spec.euler_zyx_deg is not None and spec.orientation != "euler":
+        raise ScenarioError(f"{where}.euler_zyx_deg: only used with orientation = \"euler\"")
+    if spec.orientation == "seam" and spec.seam is None:
+        raise ScenarioError(f"{where}.orientation: \"seam\" needs a seam to follow (seam = ...)")
+    common = dict(index=index, name=spec.name, kind=spec.kind, planner=spec.planner,
+                  speed=spec.speed_mm_s * 1e-3, sample_period=spec.sample_period_s,
+                  ramp=spec.ramp_s, orientation=spec.orientation, seam=spec.seam,
+                  euler_zyx=None if spec.euler_zyx_deg is None
+                  else np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)))
+    if isinstance(spec, LinearPhaseSpec):
+        if (spec.seam is None) == (spec.to_mm is None):
+            raise ScenarioError(f"{where}: give exactly one of seam or to_mm")
+        return CartesianPhase(**common, to=vec_m(spec.to_mm))
+    if spec.seam is not None:
+        extra = [k for k in ("to_mm", "via_mm", "center_mm", "axis", "sweep_deg")
+                 if getattr(spec, k) is not None]
+        if extra:
+            raise ScenarioError(f"{where}.{extra[0]}: not used with seam (the seam gives the arc)")
+        return CartesianPhase(**common)
+    if spec.via_mm is not None:
+        if spec.to_mm is None:
+            raise ScenarioError(f"{where}.to_mm: required with via_mm (arc through 3 points)")
+        if spec.center_mm is not None or spec.sweep_deg is not None or spec.axis is not None:
+            raise ScenarioError(f"{where}: give either via_mm and to_mm, or center_mm, axis and "
+                                "sweep_deg")
+        return CartesianPhase(**common, to=vec_m(spec.to_mm), via=vec_m(spec.via_mm))
+    if spec.center_mm is not None:
+        missing = [k for k in ("axis", "sweep_deg") if getattr(spec, k) is None]
+        if missing:
+            raise ScenarioError(f"{where}.{missing[0]}: required with center_mm")
+        axis = np.asarray(spec.axis, dtype=float)
+        norm = float(np.linalg.norm(axis))
+        if norm < 1e-12:
+            raise ScenarioError(f"{where}.axis: must be a non-zero vector")
+        if spec.sweep_deg == 0 or spec.to_mm is not None:
+            raise ScenarioError(f"{where}.sweep_deg: must be non-zero (and to_mm is not used "
+                                "with center_mm)")
+        return CartesianPhase(**common, center=vec_m(spec.center_mm), axis=axis / norm,
+                              sweep=math.radians(spec.sweep_deg))
+    raise ScenarioError(f"{where}: give seam, or via_mm and to_mm, or center_mm, axis and "
+                        "sweep_deg")
+
+
+def _check_continuity(prev: JointPhase, phase: JointPhase, where: str, robot: RobotSpec) -> None:
+    if abs(phase.t0 - prev.t1) > 1e-9:
+        raise ScenarioError(
+            f"{where}.time_s: starts at {phase.t0:g} s but phases[{prev.index}] ({prev.name}) ends "
+            f"at {prev.t1:g} s; each phase starts where the previous one ended")
+    gap = np.abs(phase.q[0] - prev.q[-1])
+    if np.any(gap > 1e-9):
+        j = int(np.argmax(gap))
+        raise ScenarioError(
+            f"{where}: first knot of joint {robot.joints[j]} is {np.rad2deg(phase.q[0, j]):.6g} deg "
+            f"but phases[{prev.index}] ({prev.name}) ends at {np.rad2deg(prev.q[-1, j]):.6g} deg; "
+            "each phase starts where the previous one ended")
+
+
+def _describe_validation_error(exc: ValidationError, raw: Any) -> str:
+    """One line for the first pydantic error: dotted key path and what is wrong."""
+    errors = exc.errors(include_url=False)
+    # A misspelt key also makes the right key "missing": report the unknown key first.
+    err = min(errors, key=lambda e: e["type"] != "extra_forbidden")
+    loc = _strip_tags(err["loc"])
+    path = _format_loc(loc)
+    kind = err["type"]
+    if kind == "extra_forbidden":
+        parent_model = _model_at(loc[:-1], raw)
+        valid = sorted(parent_model.model_fields) if parent_model else []
+        close = difflib.get_close_matches(str(loc[-1]), valid, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        return f"{path}: unknown key{hint}; valid keys: {', '.join(valid)}"
+    if kind == "missing":
+        return f"{path}: required key is missing"
+    if kind == "finite_number":
+        return f"{path}: must be a finite number (NaN and inf are not allowed)"
+    msg = err["msg"]
+    if kind == "literal_error":
+        msg = msg.replace("Input should be", "must be")
+    elif kind in ("union_tag_invalid", "union_tag_not_found"):
+        return f"{path}.kind: must be one of {', '.join(repr(k) for k in PHASE_KINDS)}"
+    elif kind in ("greater_than", "greater_than_equal", "less_than_equal", "less_than"):
+        msg = msg.replace("Input should be", "must be")
+    elif kind in ("too_short", "too_long"):
+        msg = msg.replace("List should have", "must have")
+    elif kind in ("float_type", "int_type", "string_type", "list_type", "bool_type", "model_type"):
+        expected = {"float_type": "a number", "int_type": "an integer", "string_type": "a string",
+                    "list_type": "an array", "bool_type": "true or false",
+                    "model_type": "a table"}[kind]
+        msg = f"must be {expected}, got {_toml_type(err.get('input'))}"
+    return f"{path}: {msg}"
+
+
+def _strip_tags(loc: tuple[Any, ...]) -> tuple[Any, ...]:
+    """Drop pydantic's union tags (``phases, 0, "joint", key`` -> ``phases, 0, key``)."""
+    out: list[Any] = []
+    for i, part in enumerate(loc):
+        if (i >= 2 and loc[i - 2] == "phases" and isinstance(loc[i - 1], int)
+                and part in PHASE_KINDS):
+            continue
+        out.append(part)
+    return tuple(out)
+
+
+def _format_loc(loc: tuple[Any, ...]) -> str:
+    out = ""
+    for part in _strip_tags(loc):
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out or "(top level)"
+
+
+def _model_at(loc: tuple[Any, ...], raw: Any) -> type[BaseModel] | None:
+    """The pydantic model class that validates the table at ``loc`` (for key suggestions)."""
+    loc = _strip_tags(loc)
+    if not loc:
+        return ScenarioSpec
+    head = loc[0]
+    if head == "phases" and len(loc) == 2 and isinstance(loc[1], int):
+        try:
+            kind = raw["phases"][loc[1]].get("kind", "joint")
+        except (KeyError, IndexError, TypeError, AttributeError):
+            return None
+        return PHASE_KINDS.get(kind) if isinstance(kind, str) else None
+    if head == "actions" and len(loc) == 2:
+        return ActionSpec
+    if head == "drives" and len(loc) == 2:
+        return DriveOverrideSpec
+    if len(loc) == 1:
+        return {"simulation": SimulationSpec, "video": VideoSpec}.get(head)
+    return None
+
+
+def _toml_type(value: Any) -> str:
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, str):
+        return f"the string {value!r}"
+    if isinstance(value, (int, float)):
+        return f"the number {value!r}"
+    if isinstance(value, list):
+        return "an array"
+    if isinstance(value, dict):
+        return "a table"
+    return type(value).__name__
+
+
+# --------------------------------------------------------------------------------------------
+# Planning
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PlannedPhase:
+    """A phase with its trajectory."""
+
+    phase: JointPhase
+    trajectory: Any  # planners.trajectory.PiecewisePolynomialTrajectory
+
+
+def plan_phase(phase: JointPhase, where: str = "") -> Any:
+    """Plan one joint phase with its planner.
+
+    Raises:
+        ScenarioError: The planner rejected the phase (message prefixed with ``where``).
+    """
+    from planners.registry import get_planner
+
+    try:
+        return get_planner(phase.planner)(phase.times, phase.q, **phase.boundary)
+    except PlannerError as exc:
+        prefix = f"{where}: " if where else ""
+        raise ScenarioError(f"{prefix}phases[{phase.index}] ({phase.name}): {exc}") from None
+
+
+def plan_scenario(scenario: Scenario) -> list[PlannedPhase]:
+    """Plan every phase of a scenario, in order."""
+    where = scenario.source.name
+    return [PlannedPhase(p, plan_phase(p, where)) for p in scenario.phases]

@@ -1,0 +1,119 @@
+"""Compile a scenario's cell for simulation: the MuJoCo model, its sensors and the ids.
+
+:func:`build` composes the scenario's cell (:mod:`sim.cells`), adds the sensors the runner
+records (actuator forces, tcp position and orientation) and compiles it once; the returned
+:class:`BuiltCell` hands out every id the simulation needs (joint qpos/dof addresses,
+actuators, suction actuator, part free joints), resolved here and nowhere else.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.errors import InternalError
+from sim.simulation.motion import CartesianContext
+from sim.scenario import Scenario
+
+
+@dataclass
+class BuiltCell:
+    """A compiled cell and the handles the runner needs."""
+
+    cell: Any
+    model: Any
+    xml: str
+    robot_qpos: NDArray[np.int64]
+    robot_dof: NDArray[np.int64]
+    robot_act: NDArray[np.int64]
+    suction_act: int | None
+    sensor_slices: dict[str, slice]
+    part_qpos: list[NDArray[np.int64]]
+    context: CartesianContext
+
+
+# --------------------------------------------------------------------------------------------
+# Cell compilation
+# --------------------------------------------------------------------------------------------
+
+
+def build(scenario: Scenario) -> BuiltCell:
+    """Compose and compile the scenario's cell, with the sensors the runner records."""
+    import mujoco
+
+    from sim.cells import build_cell
+    from sim.robots.model import closed_form_model
+
+    cell = build_cell(scenario.cell, scenario.robot.name, tool=scenario.tool,
+                      mount=scenario.mount, payload_kg=scenario.payload_kg)
+    root = cell.mjcf
+    if scenario.simulation.timestep_s is not None:
+        root.option.timestep = scenario.simulation.timestep_s
+    sensors: list[tuple[str, int]] = []
+    for i, name in enumerate(cell.actuator_names):
+        root.sensor.add("actuatorfrc", name=f"cellsim_tau{i}", actuator=root.find("actuator", name))
+        sensors.append((f"tau{i}", 1))
+    tcp = root.find("site", cell.tcp_site)
+    root.sensor.add("framepos", name="cellsim_tcp_pos", objtype="site", objname=tcp)
+    root.sensor.add("framequat", name="cellsim_tcp_quat", objtype="site", objname=tcp)
+    sensors += [("tcp_pos", 3), ("tcp_quat", 4)]
+    xml = root.to_xml_string()
+    try:
+        model = mujoco.MjModel.from_xml_string(xml, root.get_assets())
+    except ValueError as exc:  # a bug in a cell builder, not a user mistake
+        raise InternalError(f"cell {scenario.cell!r} does not compile: {exc}") from exc
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "model.xml"
+        mujoco.mj_saveLastXML(str(path), model)
+        saved_xml = path.read_text()
+
+    slices, start = {}, 0
+    for name, size in sensors:
+        slices[name] = slice(start, start + size)
+        start += size
+    jids = [model.joint(n).id for n in cell.joint_names]
+    robot_qpos = np.array([model.jnt_qposadr[j] for j in jids])
+    robot_dof = np.array([model.jnt_dofadr[j] for j in jids])
+    robot_act = np.array([model.actuator(n).id for n in cell.actuator_names])
+    suction = (model.actuator(cell.adhesion_actuator).id
+               if getattr(cell, "adhesion_actuator", None) else None)
+    part_qpos = [np.arange(model.jnt_qposadr[model.body(p).jntadr[0]],
+                           model.jnt_qposadr[model.body(p).jntadr[0]] + 7)
+                 for p in getattr(cell, "parts", [])]
+    kin = _tool_kinematics(closed_form_model(scenario.robot.name), model, cell, robot_qpos)
+    ctx = CartesianContext(kinematics=kin, seams=dict(getattr(cell, "seams", {})),
+                           world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float))
+    return BuiltCell(cell, model, saved_xml, robot_qpos, robot_dof, robot_act, suction, slices,
+                     part_qpos, ctx)
+
+
+def _tool_kinematics(kin: Any, model: Any, cell: Any, robot_qpos: NDArray[np.int64]) -> Any:
+    """The closed-form kinematics with the attached tool, measured from the compiled cell.
+
+    Tools are straight (their tip lies on the seeds' tool axis), so the tool changes one
+    number: ``l3`` of the 5R family (seed 000 Table 1, J4 axis to the tool point) or the tool
+    length ``r`` of the 200iC (seed 004, along z6 beyond R6). It is read off MuJoCo's ``tcp``
+    in ``frame0`` at q = 0, where the seeds put the tool point at ``(l1 + l2 + l3, 0, d1)`` and
+    ``(d2 + R4 + R6 + r, 0, d3 + d4)``; :func:`_check_tcp_consistency` then checks the whole pose.
+    """
+    import dataclasses
+
+    import mujoco
+
+    data = mujoco.MjData(model)
+    data.qpos[robot_qpos] = 0.0
+    mujoco.mj_kinematics(model, data)
+    f0 = model.site(cell.frame0_site).id
+    tcp = model.site(cell.tcp_site).id
+    p = data.site_xmat[f0].reshape(3, 3).T @ (data.site_xpos[tcp] - data.site_xpos[f0])
+    dims = dict(kin.dims)
+    if kin.family == "5r":
+        dims["l3"] = float(p[0] - dims["l1"] - dims["l2"])
+        return dataclasses.replace(kin, dims=dims)
+    return dataclasses.replace(kin, tool_length=float(p[0] - dims["d2"] - dims["R4"] - dims["R6"]))
+

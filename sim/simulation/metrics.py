@@ -1,0 +1,155 @@
+"""Metrics of a simulated run: tracking, weld seams, placed parts, singularities; the summary.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
+
+from sim.scenario import Scenario
+from sim.simulation.compile import BuiltCell
+from sim.simulation.motion import Motion
+from sim.simulation.simulate import SimulationRecord
+
+
+def _distance_to_path(p: NDArray[np.float64], cart: Any, T: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Distance of world points ``p`` (N,3) from the ideal ADNIA path (frame 0 -> world ``T``)."""
+    # sample the path densely (every 10 um, at least 2000 points) by time: the path is
+    # traversed monotonically, so nearest samples plus chord projection give the distance
+    n = max(2000, int(cart.length / 1e-5))
+    tt = np.linspace(0.0, cart.duration, n)
+    pts = cart.at(tt).position @ T[:3, :3].T + T[:3, 3]
+    # nearest dense sample, refined by projection on the neighbouring chords
+
+    tree = cKDTree(pts)
+    _, idx = tree.query(p)
+    best = np.full(p.shape[0], np.inf)
+    for off in (-1, 0):
+        i0 = np.clip(idx + off, 0, pts.shape[0] - 2)
+        a, b = pts[i0], pts[i0 + 1]
+        ab = b - a
+        u = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab),
+                                                                  1e-30), 0.0, 1.0)
+        d = np.linalg.norm(p - (a + u[:, None] * ab), axis=1)
+        best = np.minimum(best, d)
+    return best
+
+
+def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell,
+                 torch_axis: int) -> list[dict[str, Any]]:
+    """Per weld phase (a Cartesian phase with the arc on): seam length, travel speed and its
+    coefficient of variation on the constant-speed part, path deviation and torch angle error."""
+    t = arrays["t"]
+    T = built.context.world_from_frame0
+    out = []
+    for k, pm in enumerate(motion.phases):
+        if pm.cartesian is None:
+            continue
+        sel = (arrays["phase"] == k)
+        if not np.any(arrays["arc_on"][sel]):
+            continue
+        cart = pm.cartesian
+        p = arrays["tcp_pos"][sel]
+        ts = t[sel]
+        share = cart.constant_speed_fraction
+        ramp = float(cart.profile.ramp_time)
+        tc0, tc1 = pm.t0 + ramp, pm.t1 - ramp
+        cs = (ts >= tc0 + 1e-9) & (ts <= tc1 - 1e-9)
+        v = np.linalg.norm(np.gradient(p, ts, axis=0), axis=1)
+        vc = v[cs] if np.count_nonzero(cs) > 2 else v
+        dev = _distance_to_path(p, cart, T)
+        R_act = Rotation.from_quat(arrays["tcp_quat"][sel], scalar_first=True).as_matrix()
+        R_ref = T[:3, :3] @ cart.at(np.clip(ts - pm.t0, 0.0, cart.duration)).rotation
+        a_act, a_ref = R_act[:, :, torch_axis], R_ref[:, :, torch_axis]
+        cosang = np.clip(np.einsum("ij,ij->i", a_act, a_ref), -1.0, 1.0)
+        out.append({
+            "phase": pm.name,
+            "seam_length_mm": float(cart.length * 1e3),
+            "set_speed_mm_s": float(cart.speed * 1e3),
+            "travel_speed_mm_s": float(np.mean(vc) * 1e3),
+            "travel_speed_cv": float(np.std(vc) / max(np.mean(vc), 1e-12)),
+            "constant_speed_share": float(share.time),
+            "max_path_deviation_mm": float(np.max(dev) * 1e3),
+            "torch_angle_error_deg": float(np.degrees(np.max(np.arccos(cosang)))),
+        })
+    return out
+
+
+def pick_metrics(arrays: dict[str, NDArray[Any]], built: BuiltCell, tol_mm: float = 5.0
+                 ) -> dict[str, Any] | None:
+    """For pick cells: final part positions against their slots."""
+    slots = np.asarray(getattr(built.cell, "slots", np.zeros((0, 3))), dtype=float)
+    if "part_pos" not in arrays or slots.size == 0:
+        return None
+    final = arrays["part_pos"][-1]
+    err = np.linalg.norm(final[: slots.shape[0]] - slots, axis=1) * 1e3
+    return {"placed": [bool(e <= tol_mm) for e in err], "place_error_mm": [float(e) for e in err]}
+
+
+def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: SimulationRecord,
+                 feedforward: bool) -> dict[str, Any]:
+    a = rec.arrays
+    sim_time = rec.steps * rec.timestep
+    track = np.max(np.abs(a["q"] - a["q_ref"]), axis=0)
+    dev = np.linalg.norm(a["tcp_pos"] - a["tcp_pos_ref"], axis=1)
+    peak_id = np.max(np.abs(a["tau_id"]), axis=0)
+    rms_diff = np.sqrt(np.mean((a["tau"] - a["tau_id"]) ** 2, axis=0))
+    torch_axis = 0 if scenario.robot.family == "5r" else 2
+    summary: dict[str, Any] = {
+        "scenario": scenario.name,
+        "robot": scenario.robot.name,
+        "cell": scenario.cell,
+        "tool": scenario.tool,
+        "mount": scenario.mount,
+        "payload_kg": scenario.payload_kg,
+        "joints": list(scenario.robot.joints),
+        "phases": [{"name": pm.name, "kind": pm.kind, "t0": pm.t0, "t1": pm.t1}
+                   for pm in motion.phases],
+        "duration_s": motion.duration,
+        "timestep_s": rec.timestep,
+        "steps": rec.steps,
+        "wall_s": rec.wall_s,
+        "realtime_factor": sim_time / rec.wall_s if rec.wall_s > 0 else None,
+        "feedforward": feedforward,
+        "max_tracking_error_rad": [float(x) for x in track],
+        "max_tracking_error_deg": [float(np.degrees(x)) for x in track],
+        "max_tcp_deviation_mm": float(np.max(dev) * 1e3),
+        "torque_rms_diff_pct_of_peak": [float(100 * d / p) if p > 0 else 0.0
+                                        for d, p in zip(rms_diff, peak_id)],
+        "actions": [{"t": t, "action": act} for t, act in motion.actions],
+        "weld": weld_metrics(a, motion, built, torch_axis),
+    }
+    summary["singularity"] = singularity_summary(a, motion, built, rec.timestep)
+    pick = pick_metrics(a, built)
+    if pick is not None:
+        summary.update(pick)
+    return summary
+
+
+def singularity_summary(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell,
+                        dt: float) -> dict[str, Any]:
+    """Closest approach of the reference to a singularity (sampled every 10 ms).
+
+    ``min_sigma`` is the smallest singular value of the task Jacobian (0 at a singularity,
+    mixed units; :func:`sim.robots.jacobian.singularity_measures`), with its time and
+    phase; ``min_abs_<factor>`` are the explicit factors of det J (200iC: ``wrist`` = sin
+    theta5, ``elbow``, ``shoulder`` = wrist-centre distance from the J1 axis in m; 5R:
+    ``elbow`` = cos q3, ``shoulder`` = reach in m).
+    """
+    from sim.robots.jacobian import singularity_measures
+
+    step = max(1, int(round(0.01 / dt)))
+    t = arrays["t"][::step]
+    m = singularity_measures(built.context.kinematics, arrays["q_ref"][::step])
+    i = int(np.argmin(m["sigma_min"]))
+    out: dict[str, Any] = {"min_sigma": float(m["sigma_min"][i]), "t": float(t[i]),
+                           "phase": motion.phases[int(np.atleast_1d(motion.phase_index(t[i]))[0])].name,
+                           "min_manipulability": float(np.min(m["manipulability"]))}
+    for factor in ("wrist", "elbow", "shoulder"):
+        if factor in m:
+            out[f"min_abs_{factor}"] = float(np.min(np.abs(m[factor])))
+    return out
