@@ -21,10 +21,10 @@ import time
 import mujoco
 import numpy as np
 
-from sim.simulation.motion import build_motion
 from sim.core.resources import shipped_scenarios
 from sim.pipeline.run import build, simulate
 from sim.scenario import load_scenario
+from sim.simulation.motion import build_motion
 
 
 def bare_loop(model: mujoco.MjModel, n: int, q0: np.ndarray, built) -> float:

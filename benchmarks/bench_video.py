@@ -119,9 +119,9 @@ def main(argv: list[str] | None = None) -> int:
     backend = configure_gl(args.gl)
     import mujoco
 
-    from sim.simulation.runfolder import load_run
     from sim.render.synthetic import write_synthetic_run
     from sim.render.video import write_video
+    from sim.simulation.runfolder import load_run
 
     with tempfile.TemporaryDirectory(prefix="bench_video_") as tmp_name:
         tmp = Path(tmp_name)

@@ -53,16 +53,19 @@ Units: SI (m, s, rad) throughout; the discrete functions work in any consistent 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 import math
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planners.base import sample_times
-from planners.errors import (CoincidentPointsError, CollinearPointsError, InvalidMoveError,
-                             PlannerError)
+from planners.errors import (
+    CoincidentPointsError,
+    CollinearPointsError,
+    InvalidMoveError,
+)
 from planners.profiles import ConstantSpeedShare, SpeedProfile
 from planners.rotations import (
     ORIENTATION_MODES,

@@ -26,15 +26,15 @@ Both have ``integral(h, 0, 1) = 1/2``, so each ramp covers ``v T / 2`` and the m
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
-import math
 
 import numpy as np
 from numpy.polynomial import Polynomial
 from numpy.typing import ArrayLike, NDArray
 
-from planners.errors import InvalidProfileError, MoveTooShortError, PlannerError
+from planners.errors import InvalidProfileError, MoveTooShortError
 
 __all__ = [
     "RAMP_SHAPES",

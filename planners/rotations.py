@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from planners.errors import InvalidOrientationError, PlannerError
+from planners.errors import InvalidOrientationError
 
 __all__ = [
     "ORIENTATION_MODES",

@@ -12,11 +12,12 @@ import numpy as np
 import pytest
 
 from sim.cells import BARE, CELLS, MOUNTS, Seam, build_cell
+from sim.cells.tools import TOOLS
 from sim.errors import CellsimError, UnknownNameError
 from sim.robots.closed_form import fk_5r
+from sim.robots.families import Fanuc6, FiveR
 from sim.robots.ik import solve_ik
 from sim.robots.registry import ROBOTS
-from sim.cells.tools import TOOLS
 
 COMBOS = [(c, r, mt) for c, s in CELLS.items() for r in s.robots for mt in s.mounts] + \
          [(None, r, mt) for r in sorted(ROBOTS) for mt in BARE.mounts]
@@ -276,7 +277,7 @@ def test_weld_table_seams_reachable(robot):
     q = c.home_q
     for seam in c.seams.values():
         for s in np.linspace(0.0, seam.length(), 13):
-            if c.robot.family == "5r":  # the 5-axis torch stays in the plane through J1
+            if isinstance(c.robot.family, FiveR):  # the 5-axis torch stays in the plane through J1
                 assert seam.plane_deviation_deg(s) < 1e-9
             T = seam.pose(s)
             q = ik_in_limits(c, T, q)
@@ -285,7 +286,7 @@ def test_weld_table_seams_reachable(robot):
             R, p = site_pose(d, c.tcp_site)
             assert np.linalg.norm(p - T[:3, 3]) < 1e-4
             np.testing.assert_allclose(R, T[:3, :3], atol=1e-6)
-            if c.robot.family == "fanuc6":  # clear of the wrist singularity theta5 = 0
+            if isinstance(c.robot.family, Fanuc6):  # clear of the wrist singularity theta5 = 0
                 assert abs(q[4]) > np.deg2rad(20.0)
     assert c.start_q is not None
     set_q(m, d, c, c.start_q)

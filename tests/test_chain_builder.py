@@ -6,13 +6,25 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from sim.core.resources import models_dir
 from sim.errors import KinematicsError
-from sim.robots.builder import (RRRT_DIMS, RRRT_Q4, RTT_L1, DHRow, KinematicChain, MDHRow,
-                                    ScrewAxis, example_chains, fanuc6_chain, five_r_chain,
-                                    rrrt_chain, rrrt_exercise_q, rtt_chain)
+from sim.robots.builder import (
+    RRRT_DIMS,
+    RRRT_Q4,
+    RTT_L1,
+    DHRow,
+    KinematicChain,
+    MDHRow,
+    ScrewAxis,
+    example_chains,
+    fanuc6_chain,
+    five_r_chain,
+    rrrt_chain,
+    rrrt_exercise_q,
+    rtt_chain,
+)
 from sim.robots.closed_form import fk_5r, fk_fanuc6, mdh_transform
 from sim.robots.mujoco_fk import MujocoKinematics
-from sim.core.resources import models_dir
 from sim.robots.registry import get_robot
 
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from sim.cli import main
-from sim.robots.model import closed_form_model, kinematic_model
 from sim.core.rotations import euler_zyx_to_matrix, matrix_to_euler_zyx
+from sim.robots.model import closed_form_model, kinematic_model
 from sim.robots.registry import ROBOTS
 
 ALL_ROBOTS = sorted(ROBOTS)
@@ -27,7 +27,7 @@ def _run(capsys, *argv: str) -> tuple[int, str, str]:
 
 
 def _pose_args(name: str, q: np.ndarray) -> list[str]:
-    T = kinematic_model(name).fk(q)
+    T = kinematic_model(ROBOTS[name]).fk(q)
     a, b, g = np.rad2deg(matrix_to_euler_zyx(T[:3, :3]))
     return [*(f"{v:.12f}" for v in 1e3 * T[:3, 3]), "--euler-zyx-deg",
             *(f"{v:.12f}" for v in (a, b, g))]
@@ -35,7 +35,7 @@ def _pose_args(name: str, q: np.ndarray) -> list[str]:
 
 @pytest.mark.parametrize("name", ALL_ROBOTS)
 def test_ik_json_round_trip(capsys, name):
-    m = kinematic_model(name)
+    m = kinematic_model(ROBOTS[name])
     q = np.deg2rad([10.0, 20.0, -15.0, 25.0, 30.0, 40.0][: m.n_joints])
     code, out, err = _run(capsys, "ik", name, *_pose_args(name, q), "--all", "--json")
     assert code == 0, err
@@ -66,7 +66,7 @@ def test_ik_text_seed000_table2_point1(capsys):
 
 
 def test_ik_5axis_disagreeing_alpha_note(capsys):
-    m = kinematic_model("lrmate100ib")
+    m = kinematic_model(ROBOTS["lrmate100ib"])
     q = np.deg2rad([30.0, 20.0, -10.0, 15.0, 5.0])
     T = m.fk(q)
     x, y, z = 1e3 * T[:3, 3]
@@ -83,7 +83,7 @@ def test_ik_5axis_disagreeing_alpha_note(capsys):
 
 
 def test_ik_default_orientation_is_home(capsys):
-    m = kinematic_model("lrmate200ic5l")
+    m = kinematic_model(ROBOTS["lrmate200ic5l"])
     p = 1e3 * m.fk(np.zeros(6))[:3, 3]
     code, out, err = _run(capsys, "ik", "lrmate200ic5l", *(f"{v:.9f}" for v in p), "--json")
     assert code == 0
@@ -149,13 +149,13 @@ def test_workspace_png_and_reach(capsys, tmp_path):
 def test_reach_definition_against_closed_form():
     from sim.robots.workspace import compute_reach
 
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     m.lower = m.upper = None
     d = m.dims
     r = compute_reach(m)
     assert r.wrist == pytest.approx(d["d2"] + d["d3"] + np.hypot(d["R4"], d["d4"]), abs=1e-6)
     assert r.tcp == pytest.approx(r.wrist + d["R6"], abs=1e-6)
-    m5 = closed_form_model("robot_5r")
+    m5 = closed_form_model(ROBOTS["robot_5r"])
     m5.lower = m5.upper = None
     d5 = m5.dims
     r5 = compute_reach(m5)

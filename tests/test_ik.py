@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
+from sim.core.rotations import euler_zyx_to_matrix, make_transform, wrap_to_pi
 from sim.errors import KinematicsError, UnreachableError
 from sim.robots.closed_form import fk_5r, fk_fanuc6
+from sim.robots.families import Fanuc6, FiveR
 from sim.robots.ik import SingularityWarning, ik_5r_seed, ik_path, solve_ik
 from sim.robots.model import KinematicModel, closed_form_model, kinematic_model
-from sim.core.rotations import euler_zyx_to_matrix, make_transform, wrap_to_pi
 from sim.robots.registry import ROBOTS, get_robot
 
 ALL_ROBOTS = sorted(ROBOTS)
@@ -24,14 +23,14 @@ TABLE3 = [(0.0, 0.0, 0.0), (28.79, -1.2, 2.41), (57.59, -2.41, 4.83), (86.38, -3
 # Joint ranges used where a test needs them independent of the MJCF (deg):
 # 200iC after seed 004 Table 2 / the FANUC manual, the 5R robots a generous symmetric set.
 RANGES_DEG = {
-    "fanuc6": [(-170, 170), (-100, 130), (-230, 90), (-190, 190), (-120, 120), (-360, 360)],
-    "5r": [(-160, 160), (-35, 150), (-120, 120), (-180, 180), (-200, 200)],
+    Fanuc6: [(-170, 170), (-100, 130), (-230, 90), (-190, 190), (-120, 120), (-360, 360)],
+    FiveR: [(-160, 160), (-35, 150), (-120, 120), (-180, 180), (-200, 200)],
 }
 
 
 def _model_with_ranges(name: str) -> KinematicModel:
-    m = closed_form_model(name)
-    r = np.deg2rad(np.array(RANGES_DEG[m.family]))
+    m = closed_form_model(ROBOTS[name])
+    r = np.deg2rad(np.array(RANGES_DEG[type(m.family)]))
     m.lower, m.upper = r[:, 0], r[:, 1]
     return m
 
@@ -47,7 +46,7 @@ def test_seed000_table3_from_table2():
 
     The configurations are chosen by branch continuity from home (no knowledge of Table 3).
     """
-    m = closed_form_model("lrmate100ib")
+    m = closed_form_model(ROBOTS["lrmate100ib"])
     assert m.dims == {"l1": 0.150, "d1": 0.250, "l2": 0.220, "l3": 0.225}
     poses = [make_transform(euler_zyx_to_matrix(*np.deg2rad(row[3:])), np.array(row[:3]) / 1e3)
              for row in TABLE2]
@@ -62,7 +61,7 @@ def test_seed000_table3_from_table2():
 
 def test_seed000_eq14_rederived_against_eq5():
     """The corrected eq. (14): sin q3 from the wrist point equals sin q3 of the source config."""
-    m = closed_form_model("lrmate100ib")
+    m = closed_form_model(ROBOTS["lrmate100ib"])
     d = m.dims
     rng = np.random.default_rng(3)
     for q in rng.uniform(-1.2, 1.2, size=(20, 5)):
@@ -90,7 +89,7 @@ def test_fk_of_ik_round_trip(name):
         dist = min(np.abs(wrap_to_pi(s.q - q)).max() for s in sols)
         assert dist < 1e-9
         # the closed forms of the seeds agree with the model's forward kinematics
-        R, p = fk_5r(q, m.dims) if m.family == "5r" else fk_fanuc6(q, m.dims)
+        R, p = fk_5r(q, m.dims) if isinstance(m.family, FiveR) else fk_fanuc6(q, m.dims)
         np.testing.assert_allclose(T[:3, :3], R, atol=1e-12)
         np.testing.assert_allclose(T[:3, 3], p, atol=1e-12)
 
@@ -98,7 +97,7 @@ def test_fk_of_ik_round_trip(name):
 @pytest.mark.parametrize("name", ALL_ROBOTS)
 def test_fk_of_ik_with_mjcf_tcp(name):
     """Same round trip on the model whose tool frame is the MJCF ``tcp`` site."""
-    m = kinematic_model(name)
+    m = kinematic_model(ROBOTS[name])
     rng = np.random.default_rng(5)
     for q in rng.uniform(-1.0, 1.0, size=(20, m.n_joints)):
         T = m.fk(q)
@@ -109,7 +108,7 @@ def test_fk_of_ik_with_mjcf_tcp(name):
 def test_200ic_eight_solutions_and_2pi_representations():
     """Seed 004: 8 solutions away from singularities (shoulder x elbow x wrist flip); J4/J6
     also in their theta +- 2 pi representation where the ranges allow it."""
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     m.lower = m.upper = None  # no ranges: one representation each
     q = np.deg2rad([20.0, 10.0, -20.0, 30.0, 40.0, 50.0])
     sols = solve_ik(m, m.fk(q), q)
@@ -151,7 +150,7 @@ def test_5r_shoulder_flip_and_elbows(name):
     The target is near the J1 axis with the tool pointing down (beta = 90 deg), its wrist point
     at mid-reach of J2, so that both shoulder branches reach it.
     """
-    m = closed_form_model(name)
+    m = closed_form_model(ROBOTS[name])
     d = m.dims
     mid = (abs(d["d1"] - d["l2"]) + d["d1"] + d["l2"]) / 2
     p = np.array([0.02, 0.01, mid - d["l3"]])
@@ -168,7 +167,7 @@ def test_5r_shoulder_flip_and_elbows(name):
 
 def test_200ic_unreachable_distance_in_mm():
     """A pose beyond reach: UnreachableError with the wrist centre's distance outside (m)."""
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     d = m.dims
     p = np.array([1.5, 0.0, 0.3])
     R = np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])  # a along +x
@@ -181,7 +180,7 @@ def test_200ic_unreachable_distance_in_mm():
 
 
 def test_5r_unreachable_and_wrong_orientation():
-    m = closed_form_model("lrmate100ib")
+    m = closed_form_model(ROBOTS["lrmate100ib"])
     d = m.dims
     T = make_transform(np.eye(3), [1.0, 0.0, 0.25])
     with pytest.raises(UnreachableError) as err:
@@ -196,7 +195,7 @@ def test_5r_unreachable_and_wrong_orientation():
 
 def test_wrist_singularity_keeps_j4_and_warns():
     """theta5 = 0 (seed 004 eq. 23): a valid solution with J4 = current J4, and a warning."""
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     q = np.deg2rad([15.0, 10.0, -25.0, 40.0, 0.0, -20.0])
     current = np.deg2rad([14.0, 9.0, -24.0, 33.0, 2.0, -10.0])
     with pytest.warns(SingularityWarning, match="theta5"):
@@ -227,7 +226,7 @@ def test_ik_path_branch_continuity_and_error_index():
 
 def test_ik_path_5r_follows_a_line():
     """A straight weld line for the 5R robot: FK of the path IK reproduces every pose."""
-    m = closed_form_model("robot_5r")
+    m = closed_form_model(ROBOTS["robot_5r"])
     P = np.linspace([1.2, -0.3, 0.2], [1.2, 0.4, 0.2], 15)
     poses = [make_transform(euler_zyx_to_matrix(np.arctan2(p[1], p[0]), 0.6, 0.1), p) for p in P]
     Q = ik_path(m, poses, q_start=np.array([0.0, 0.5, -0.2, 0.3, 0.1]), respect_limits=False)
@@ -236,7 +235,7 @@ def test_ik_path_5r_follows_a_line():
 
 
 def test_bad_pose_input():
-    m = closed_form_model("robot_5r")
+    m = closed_form_model(ROBOTS["robot_5r"])
     with pytest.raises(KinematicsError):
         solve_ik(m, np.full((4, 4), np.nan))
     with pytest.raises(KinematicsError):
@@ -247,7 +246,7 @@ def test_bad_pose_input():
 
 def test_registry_dims_used():
     for name in ALL_ROBOTS:
-        assert closed_form_model(name).dims == get_robot(name).dims
+        assert closed_form_model(ROBOTS[name]).dims == get_robot(name).dims
 
 
 def test_5axis_orientation_tolerance_for_typed_angles():
@@ -257,12 +256,12 @@ def test_5axis_orientation_tolerance_for_typed_angles():
     import numpy as np
     import pytest
 
+    from sim.core.rotations import rot_z
     from sim.errors import UnreachableError
     from sim.robots.ik import PLANE_TOL, solve_ik
     from sim.robots.model import closed_form_model
-    from sim.core.rotations import rot_z
 
-    kin = closed_form_model("lrmate100ib")
+    kin = closed_form_model(ROBOTS["lrmate100ib"])
     q = np.deg2rad([20.0, 30.0, -10.0, 15.0, 5.0])
     T = np.asarray(kin.fk(q), dtype=float)
     for angle, ok in ((0.5 * np.degrees(np.arcsin(PLANE_TOL)), True), (1.0, False)):

@@ -5,8 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.robots.jacobian import (geometric_jacobian, manipulability, numeric_jacobian,
-                                     singularity_measures, task_jacobian, task_jacobian_5r)
+from sim.robots.jacobian import (
+    geometric_jacobian,
+    manipulability,
+    numeric_jacobian,
+    singularity_measures,
+    task_jacobian,
+    task_jacobian_5r,
+)
 from sim.robots.model import closed_form_model, kinematic_model
 from sim.robots.mujoco_fk import MujocoKinematics
 from sim.robots.registry import ROBOTS
@@ -16,7 +22,7 @@ ALL_ROBOTS = sorted(ROBOTS)
 
 @pytest.mark.parametrize("name", ALL_ROBOTS)
 def test_jacobian_matches_finite_differences(name):
-    m = closed_form_model(name)
+    m = closed_form_model(ROBOTS[name])
     rng = np.random.default_rng(1)
     for q in rng.uniform(-2.0, 2.0, size=(10, m.n_joints)):
         np.testing.assert_allclose(geometric_jacobian(m, q), numeric_jacobian(m, q), atol=1e-7)
@@ -24,7 +30,7 @@ def test_jacobian_matches_finite_differences(name):
 
 @pytest.mark.parametrize("name", ALL_ROBOTS)
 def test_jacobian_vectorized_equals_loop(name):
-    m = closed_form_model(name)
+    m = closed_form_model(ROBOTS[name])
     Q = np.random.default_rng(2).uniform(-2.0, 2.0, size=(7, m.n_joints))
     J = geometric_jacobian(m, Q)
     assert J.shape == (7, 6, m.n_joints)
@@ -40,8 +46,8 @@ def test_jacobian_vectorized_equals_loop(name):
 @pytest.mark.parametrize("name", ALL_ROBOTS)
 def test_mujoco_fk_and_jacobian_match_closed_form(name):
     """MJCF (site tcp in site frame0, mj_jacSite) against seed 000 eq. 5 / seed 004 eq. 6-7."""
-    m = kinematic_model(name)
-    mj = MujocoKinematics.for_robot(name)
+    m = kinematic_model(ROBOTS[name])
+    mj = MujocoKinematics.for_robot(ROBOTS[name])
     Q = np.random.default_rng(3).uniform(m.lower, m.upper, size=(25, m.n_joints))
     np.testing.assert_allclose(mj.fk(Q), m.fk(Q), atol=1e-12)
     np.testing.assert_allclose(mj.jacobian(Q), geometric_jacobian(m, Q), atol=1e-12)
@@ -52,7 +58,7 @@ def test_mujoco_fk_and_jacobian_match_closed_form(name):
 def test_200ic_det_factorization():
     """Seed 004 eq. 22: det J = det(A) det(C); here, at the tcp,
     det J = -d3 (R4 c3 - d4 s3) rho_w s5 (eq. 23-25 factors), checked on random configs."""
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     d = m.dims
     Q = np.random.default_rng(4).uniform(-3.0, 3.0, size=(40, 6))
     s = singularity_measures(m, Q)
@@ -67,7 +73,7 @@ def _det(m, q):
 
 def test_seed004_singular_conditions_give_zero_det():
     """Seed 004: theta5 = 0 (eq. 23), theta3 = atan2(R4, d4) and + pi (eq. 24), eq. 25."""
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     d = m.dims
     regular = [0.3, 0.4, -0.5, 0.7, 0.6, -0.2]
     scale = abs(_det(m, regular))
@@ -106,7 +112,7 @@ def test_seed004_singular_conditions_give_zero_det():
 
 
 def test_seed004_eq25_printed_equals_shoulder_factor_with_theta2_negated():
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     d = m.dims
     Q = np.random.default_rng(5).uniform(-3, 3, size=(30, 6))
     t2, t3 = Q[:, 1], Q[:, 2]
@@ -118,7 +124,7 @@ def test_seed004_eq25_printed_equals_shoulder_factor_with_theta2_negated():
 @pytest.mark.parametrize("name", ["lrmate100ib", "robot_5r"])
 def test_5r_task_jacobian_det_and_singularities(name):
     """5R: det of the Jacobian of seed 000's task vector (eq. 8) = reach * d1 * l2 * cos q3."""
-    m = closed_form_model(name)
+    m = closed_form_model(ROBOTS[name])
     d = m.dims
     Q = np.random.default_rng(6).uniform(-2, 2, size=(30, 5))
     Jt = task_jacobian_5r(m, Q)
@@ -145,7 +151,7 @@ def test_5r_task_jacobian_det_and_singularities(name):
 
 
 def test_manipulability_matches_singular_values():
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     J = geometric_jacobian(m, np.random.default_rng(7).uniform(-2, 2, size=(5, 6)))
     sv = np.linalg.svd(J, compute_uv=False)
     np.testing.assert_allclose(manipulability(J), np.prod(sv, axis=-1), rtol=1e-9)
@@ -154,7 +160,7 @@ def test_manipulability_matches_singular_values():
 def test_measures_along_a_trajectory_through_the_wrist_singularity():
     """Vectorized measures along a joint path crossing theta5 = 0: the wrist measure changes
     sign, the smallest singular value dips to ~0 exactly there."""
-    m = closed_form_model("lrmate200ic5l")
+    m = closed_form_model(ROBOTS["lrmate200ic5l"])
     Q = np.linspace([0.1, 0.2, -0.3, 0.4, -0.5, 0.1], [0.2, 0.3, -0.2, 0.5, 0.5, 0.2], 101)
     s = singularity_measures(m, Q)
     i = int(np.argmin(s["sigma_min"]))

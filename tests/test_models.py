@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from sim.robots.closed_form import fk_5r, fk_fanuc6
+from sim.robots.families import FiveR
 from sim.robots.registry import ROBOTS, RobotSpec, joint_ranges
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,7 +36,7 @@ def _readme_number(spec: RobotSpec, label: str) -> float:
 
 
 def _fk(spec: RobotSpec, q) -> tuple[np.ndarray, np.ndarray]:
-    if spec.family == "5r":
+    if isinstance(spec.family, FiveR):
         return fk_5r(q, spec.dims)
     return fk_fanuc6(q, spec.dims)
 
@@ -257,7 +258,7 @@ def test_readme_reach_closed_form(name):
     892 mm."""
     spec = ROBOTS[name]
     d = spec.dims
-    if spec.family == "5r":
+    if isinstance(spec.family, FiveR):
         closed = d["l1"] + d["d1"] + d["l2"]
         q_stretch = np.array([0, 90, -90, 0, 0]) * DEG
         rng = joint_ranges(spec)
@@ -276,7 +277,7 @@ def test_joint_ranges_match_readme_and_admit_seed_motions(name):
     assert [r[0] for r in rows] == list(spec.joints)
     documented = np.array([[float(a), float(b)] for _, a, b in rows]) * DEG
     np.testing.assert_allclose(model.jnt_range, documented, atol=1e-8)
-    np.testing.assert_allclose(joint_ranges(name), documented, atol=1e-8)
+    np.testing.assert_allclose(joint_ranges(ROBOTS[name]), documented, atol=1e-8)
     assert np.all(model.jnt_limited == 1)
     np.testing.assert_allclose(model.actuator_ctrlrange, model.jnt_range, atol=0)
     # motions the seeds run on these robots (deg)

@@ -18,8 +18,8 @@ from sim.analysis.plots import (
     tracking_error_figure,
     write_plots,
 )
-from sim.simulation.runfolder import RunFolderError, RunRecord, load_run
 from sim.render.synthetic import JOINTS, write_synthetic_run
+from sim.simulation.runfolder import RunFolderError, RunRecord, load_run
 
 
 @pytest.fixture(scope="module")

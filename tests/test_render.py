@@ -26,8 +26,8 @@ from sim.render.overlay import (
     draw_caption,
     simplify_polyline,
 )
-from sim.simulation.runfolder import RunFolderError, RunRecord, load_run
 from sim.render.synthetic import JOINTS, write_synthetic_run
+from sim.simulation.runfolder import RunFolderError, RunRecord, load_run
 
 REPO = Path(__file__).resolve().parents[1]
 pytestmark = pytest.mark.render

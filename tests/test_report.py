@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from sim.analysis.report import REQUIRED_COLUMNS, write_atomic, write_sizing
-from sim.robots.registry import Drive
 from sim.analysis.sizing import size_trajectory
+from sim.robots.registry import Drive
 
 JOINTS = ("j1", "j2", "j3")
 DRIVE = Drive(gear_ratio=100.0, efficiency=0.9, rotor_inertia=1e-4, rated_torque=1.5,

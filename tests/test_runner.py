@@ -4,7 +4,6 @@ atomic run folders and instability handling."""
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import mujoco

@@ -12,8 +12,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.core.resources import shipped_scenarios
+from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.scenario import (
     ActionSpec,
     CircularPhaseSpec,

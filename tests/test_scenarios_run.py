@@ -8,7 +8,6 @@ simulated vs inverse-dynamics torque, parts placed in their slots.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -10,8 +10,6 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize
 
-from sim.errors import CellsimError, ScenarioError, UnknownNameError
-from sim.robots.registry import ROBOTS, Drive
 from sim.analysis.sizing import (
     PEAK_KNEE_FRACTION,
     apply_overrides,
@@ -28,6 +26,8 @@ from sim.analysis.sizing import (
     size_trajectory,
     time_integral,
 )
+from sim.errors import CellsimError, ScenarioError, UnknownNameError
+from sim.robots.registry import ROBOTS, Drive
 
 DRIVE = Drive(gear_ratio=100.0, efficiency=0.9, rotor_inertia=1e-4, rated_torque=1.0,
               peak_torque=3.0, max_speed_rpm=4000.0)

@@ -9,10 +9,18 @@ import numpy as np
 import pytest
 
 from sim.cells import build_cell
+from sim.cells.tools import (
+    CUP_BODY,
+    SUCTION_ACTUATOR,
+    TIP_SITE,
+    TOOLS,
+    build_tool,
+    get_tool,
+)
 from sim.errors import UnknownNameError
 from sim.robots.closed_form import fk_5r, fk_fanuc6
+from sim.robots.families import FiveR
 from sim.robots.registry import ROBOTS, get_robot
-from sim.cells.tools import (CUP_BODY, SUCTION_ACTUATOR, TIP_SITE, TOOLS, build_tool, get_tool)
 
 RNG = np.random.default_rng(7)
 
@@ -139,7 +147,7 @@ def test_tcp_on_tool_tip_matches_closed_form(robot, tool):
         np.testing.assert_allclose(ptip, pt, atol=1e-9)
         # closed form, in frame 0
         rel = R0.T @ (pt - p0)
-        if spec.family == "5r":
+        if isinstance(spec.family, FiveR):
             dims = {**spec.dims, "l3": spec.dims["l3"] - bare_offset + tl}
             Rcf, pcf = fk_5r(q, dims)
             axis = Rcf[:, 0]

@@ -36,13 +36,21 @@ from dm_control import mjcf
 from numpy.typing import NDArray
 
 from sim.cells import bare, pick, weld_cylinder, weld_table
-from sim.cells.compose import (ROBOT_PREFIX, Layout, RobotRig, add_home_keyframe, compile_model,
-                               prepare_robot, suction_actuator_name, tip_site_name)
+from sim.cells.compose import (
+    ROBOT_PREFIX,
+    Layout,
+    RobotRig,
+    add_home_keyframe,
+    compile_model,
+    prepare_robot,
+    suction_actuator_name,
+    tip_site_name,
+)
 from sim.cells.seam import Seam
+from sim.cells.tools import TOOLS, ToolSpec, get_tool
 from sim.errors import CellsimError, UnknownNameError
 from sim.robots.model import KinematicModel
 from sim.robots.registry import ROBOTS, RobotSpec, get_robot
-from sim.cells.tools import TOOLS, ToolSpec, get_tool
 
 #: ``tool="none"`` asks for no tool even where the cell has a default one.
 NO_TOOL = "none"

@@ -7,7 +7,14 @@ tcp), so the fully stretched arm clears the floor.
 
 from __future__ import annotations
 
-from sim.cells.compose import Layout, RobotRig, add_box, add_cameras, attach_robot, new_world
+from sim.cells.compose import (
+    Layout,
+    RobotRig,
+    add_box,
+    add_cameras,
+    attach_robot,
+    new_world,
+)
 
 
 def build(rig: RobotRig, mount: str) -> Layout:

@@ -37,11 +37,17 @@ import numpy as np
 from dm_control import mjcf
 from numpy.typing import NDArray
 
+from sim.cells.tools import (
+    CONTACT_FIXTURE,
+    CUP_BODY,
+    SUCTION_ACTUATOR,
+    TIP_SITE,
+    ToolSpec,
+    build_tool,
+)
 from sim.errors import CellsimError
-from sim.robots.closed_form import fk_5r, fk_fanuc6
 from sim.robots.model import KinematicModel, kinematic_model
 from sim.robots.registry import RobotSpec, get_robot
-from sim.cells.tools import CONTACT_FIXTURE, CUP_BODY, SUCTION_ACTUATOR, TIP_SITE, ToolSpec, build_tool
 
 ROBOT_PREFIX = "robot"
 TOOL_PREFIX = "tool"
@@ -151,7 +157,7 @@ def robot_statics(spec: RobotSpec) -> RobotStatics:
 
 @lru_cache(maxsize=None)
 def _robot_statics(name: str) -> RobotStatics:
-    spec = get_robot(name)
+    spec = get_robot(name)  # cache key: the registry name (RobotSpec holds arrays, not hashable)
     if not spec.robot_path.is_file():
         raise CellsimError(f"robot {spec.name!r}: model file {spec.robot_path} is missing")
     m = mujoco.MjModel.from_xml_path(str(spec.robot_path))
@@ -159,10 +165,7 @@ def _robot_statics(name: str) -> RobotStatics:
     mujoco.mj_forward(m, d)
     T0, Tf, Tt = (_site_pose(m, d, s) for s in ("frame0", "flange", "tcp"))
     zeros = np.zeros(spec.n_joints)
-    if spec.family == "5r":
-        a0 = fk_5r(zeros, spec.dims)[0][:, 0]
-    else:
-        a0 = fk_fanuc6(zeros, spec.dims)[0][:, 2]
+    a0 = spec.family.home_approach()
     a_world = T0[:3, :3] @ a0
     a_fl = _snap(Tf[:3, :3].T @ a_world)
     fid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "flange")
@@ -173,7 +176,7 @@ def _robot_statics(name: str) -> RobotStatics:
     along = float(off @ a_world)
     if np.linalg.norm(off - along * a_world) > 1e-9:
         raise CellsimError(f"robot {spec.name!r}: the bare tcp is not on the flange axis")
-    wrist_joint = "j4" if spec.family == "5r" else "j5"
+    wrist_joint = spec.joints[spec.family.wrist_joint]
     wid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, wrist_joint)
     if wid < 0:
         raise CellsimError(f"robot {spec.name!r}: model has no joint {wrist_joint!r}")
@@ -227,25 +230,20 @@ class RobotRig:
 
     def max_distance_from_frame0(self) -> float:
         """Upper bound of the tcp's distance from frame 0 (sum of link lengths), m."""
-        d = self.spec.dims
         reach = self.statics.flange_axial + self.tcp_from_flange
-        if self.spec.family == "5r":
-            return d["l1"] + d["d1"] + d["l2"] + reach
-        return d["d2"] + d["d3"] + float(np.hypot(d["R4"], d["d4"])) + reach
+        return self.spec.family.arm_length() + reach
 
     def kinematics(self) -> KinematicModel:
         """Closed-form kinematic model whose tool frame is this rig's tcp (the tool tip).
 
-        5r: ``l3 = flange_axial + tcp_from_flange``; fanuc6: tool length
-        ``r = flange_axial - R6 + tcp_from_flange`` (seed 004 eq. 6-7). The tcp's constant
-        rotation relative to the seed's tool frame is the bare robot's (read from the MJCF).
+        The family's wrist-to-tcp distance becomes ``flange_axial + tcp_from_flange``
+        (:meth:`KinematicFamily.with_tool`: 5R ``l3``, 200iC ``R6 + r``, seed 004 eq. 6-7). The
+        tcp's constant rotation relative to the seed's tool frame is the bare robot's (read
+        from the MJCF).
         """
-        km = kinematic_model(self.spec.name)
+        km = kinematic_model(self.spec)
         reach = self.statics.flange_axial + self.tcp_from_flange
-        if self.spec.family == "5r":
-            km.dims = {**km.dims, "l3": reach}
-        else:
-            km.tool_length = reach - km.dims["R6"]
+        km = km.with_family(km.family.with_tool(reach))
         km.tcp_offset = transform(km.tcp_offset[:3, :3])
         return km
 

@@ -21,7 +21,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.cells.compose import Layout, RobotRig, add_box, add_cameras, attach_robot, new_world
+from sim.cells.compose import (
+    Layout,
+    RobotRig,
+    add_box,
+    add_cameras,
+    attach_robot,
+    new_world,
+)
 from sim.cells.tools import CONTACT_PART_AFFINITY, CONTACT_PART_TYPE
 
 RISER = 0.6

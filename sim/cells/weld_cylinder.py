@@ -42,8 +42,15 @@ import warnings
 
 import numpy as np
 
-from sim.cells.compose import (Layout, RobotRig, add_box, add_cameras, add_ring, attach_robot,
-                               new_world)
+from sim.cells.compose import (
+    Layout,
+    RobotRig,
+    add_box,
+    add_cameras,
+    add_ring,
+    attach_robot,
+    new_world,
+)
 from sim.cells.seam import Seam
 from sim.errors import CellsimError
 from sim.robots.closed_form import fk_5r

@@ -34,8 +34,15 @@ import warnings
 
 import numpy as np
 
-from sim.cells.compose import (Layout, RobotRig, add_box, add_cameras, add_ring, attach_robot,
-                               new_world)
+from sim.cells.compose import (
+    Layout,
+    RobotRig,
+    add_box,
+    add_cameras,
+    add_ring,
+    attach_robot,
+    new_world,
+)
 from sim.cells.seam import Seam
 from sim.robots.ik import solve_ik
 
@@ -67,7 +74,7 @@ def build(rig: RobotRig, mount: str) -> Layout:
     T0 = attach_robot(world, rig, mount, RISER)
     wb = world.worldbody
     up = np.array([0.0, 0.0, 1.0])
-    tool_axis = 0 if rig.spec.family == "5r" else 2
+    tool_axis = rig.spec.family.approach_column
 
     def w(p) -> np.ndarray:  # frame 0 -> world
         return T0[:3, :3] @ np.asarray(p, float) + T0[:3, 3]

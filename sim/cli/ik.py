@@ -20,10 +20,10 @@ import warnings
 
 import numpy as np
 
+from sim.core.rotations import euler_zyx_to_matrix, make_transform
 from sim.errors import KinematicsError
 from sim.robots.ik import solve_ik
 from sim.robots.model import kinematic_model
-from sim.core.rotations import euler_zyx_to_matrix, make_transform, matrix_to_euler_zyx
 from sim.robots.registry import get_robot
 
 
@@ -58,27 +58,18 @@ def run(args: argparse.Namespace) -> int:
     _check_finite("X Y Z", position)
     if args.euler_zyx_deg is not None:
         _check_finite("A B G", args.euler_zyx_deg)
-    model = kinematic_model(spec.name)
+    model = kinematic_model(spec)
     p = np.asarray(position, dtype=float) / 1000.0
     if args.euler_zyx_deg is None:
-        R = model.fk(np.zeros(model.n_joints))[:3, :3]
-        if model.family == "5r" and np.hypot(p[0], p[1]) > 1e-12:
-            # home orientation turned into the arm plane of the target
-            alpha, beta, gamma = matrix_to_euler_zyx(R)
-            R = euler_zyx_to_matrix(np.arctan2(p[1], p[0]) + alpha, beta, gamma)
+        R = model.family.default_orientation(model.fk(np.zeros(model.n_joints))[:3, :3], p)
     else:
         a, b, g = np.deg2rad(args.euler_zyx_deg)
-        if model.family == "5r" and np.hypot(p[0], p[1]) > 1e-12:
-            implied = float(np.arctan2(p[1], p[0]))
-            off_plane = np.cos(b) * np.sin(a - implied)
-            if abs(off_plane) > 1e-9:
-                # nearest of the two consistent values: implied or implied + 180 deg
-                cands = [implied, implied + np.pi]
-                a_new = min(cands, key=lambda c: abs(np.angle(np.exp(1j * (a - c)))))
-                print(f"cellsim: note: {spec.name} has 5 axes: A is implied by the position "
-                      f"(A = {np.rad2deg(a_new):.3f} deg, not {args.euler_zyx_deg[0]:g})",
-                      file=sys.stderr)
-                a = a_new
+        a_new = model.family.reachable_alpha(p, float(a), float(b))
+        if a_new != a:
+            print(f"cellsim: note: {spec.name} has {spec.n_joints} axes: A is implied by the "
+                  f"position (A = {np.rad2deg(a_new):.3f} deg, not {args.euler_zyx_deg[0]:g})",
+                  file=sys.stderr)
+            a = a_new
         R = euler_zyx_to_matrix(a, b, g)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import importlib
 
-from sim.errors import CellsimError
 from sim.core.resources import shipped_scenarios
+from sim.errors import CellsimError
 from sim.robots.registry import ROBOTS
 
 

@@ -20,8 +20,14 @@ from typing import Any
 
 import numpy as np
 
-from sim.simulation.motion import HoldTrajectory, Motion, PhaseMotion, build_motion, limit_violations
 from sim.scenario import CartesianPhase, Scenario, load_scenario
+from sim.simulation.motion import (
+    HoldTrajectory,
+    Motion,
+    PhaseMotion,
+    build_motion,
+    limit_violations,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -11,8 +11,6 @@ no ``summary.json``; a run that fails mid-simulation keeps what it recorded in
 from __future__ import annotations
 
 import argparse
-import json
-import sys
 from pathlib import Path
 
 

@@ -50,8 +50,13 @@ def run_variant(variant: Variant) -> Path:
 
 def run(args: argparse.Namespace) -> int:
     from sim.errors import CellsimError
+    from sim.pipeline.sweep import (
+        parse_float_list,
+        run_sweep,
+        validate_payloads,
+        validate_speed_scales,
+    )
     from sim.scenario import load_scenario
-    from sim.pipeline.sweep import parse_float_list, run_sweep, validate_payloads, validate_speed_scales
 
     scenario = load_scenario(args.scenario)  # validates before any process starts
     payloads = validate_payloads(parse_float_list(args.payload, field="--payload")

@@ -15,8 +15,8 @@ import numpy as np
 
 from sim.errors import CellsimError
 from sim.robots.model import kinematic_model
-from sim.robots.workspace import plot_workspace
 from sim.robots.registry import get_robot
+from sim.robots.workspace import plot_workspace
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
         raise CellsimError(f"--out must name a .png file, got {str(out)!r}")
     if not out.parent.is_dir():
         raise CellsimError(f"--out: folder {str(out.parent)!r} does not exist")
-    model = kinematic_model(spec.name)
+    model = kinematic_model(spec)
     reach = plot_workspace(model, out, title=f"{spec.title} ({spec.name}) workspace")
     ranges = "joint ranges from the model" if model.lower is not None else \
         "no joint ranges known: +-180 deg assumed"

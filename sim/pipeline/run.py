@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim import __version__
-from sim.errors import CellsimError, InternalError
+from sim.errors import InternalError
 from sim.scenario import Scenario
 from sim.simulation.compile import BuiltCell, build
 from sim.simulation.metrics import make_summary
@@ -216,7 +216,12 @@ def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:
 def _write_sizing(tmp: Path, scenario: Scenario, built: BuiltCell, arrays: dict[str, Any],
                   summary: dict[str, Any]) -> None:
     from sim.analysis.report import write_sizing
-    from sim.analysis.sizing import apply_overrides, armature_from_model, forcerange_from_model, size_run
+    from sim.analysis.sizing import (
+        apply_overrides,
+        armature_from_model,
+        forcerange_from_model,
+        size_run,
+    )
 
     drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
     joints = built.cell.joint_names

@@ -40,10 +40,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sim.errors import CellsimError, SweepError
 from sim.analysis.report import csv_text, figure_png, write_atomic
 from sim.analysis.sizing import load_summary, load_trajectory, peak_abs, rms
-
+from sim.errors import CellsimError, SweepError
 
 #: Columns of sweep.csv, in order.
 SWEEP_COLUMNS = ("payload_kg", "speed_scale", "joint", "peak_torque_nm", "rms_torque_nm",

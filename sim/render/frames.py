@@ -25,7 +25,12 @@ from sim.errors import RenderError
 from sim.render.gl import configure_gl
 from sim.render.interp import QposInterpolator
 from sim.render.overlay import OverlayStyle, PathOverlay, caption_text, draw_caption
-from sim.simulation.runfolder import REQUIRED_FOR_VIDEO, RunFolderError, RunRecord, as_record
+from sim.simulation.runfolder import (
+    REQUIRED_FOR_VIDEO,
+    RunFolderError,
+    RunRecord,
+    as_record,
+)
 
 #: Largest tile side accepted, pixels (8K; larger sizes fail in most OpenGL drivers).
 MAX_SIDE = 8192

@@ -158,8 +158,8 @@ def write_video(
     import imageio.v2 as imageio
     from tqdm import tqdm
 
-    from sim.render.gl import active_backend
     from sim.render.frames import FrameRenderer
+    from sim.render.gl import active_backend
 
     out_path = Path(path)
     if out_path.suffix.lower() != ".mp4":

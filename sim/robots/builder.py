@@ -32,8 +32,8 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sim.errors import KinematicsError
 from sim.core.rotations import make_transform, rot_x, rot_z
+from sim.errors import KinematicsError
 
 _JOINT_TYPES = ("R", "P")
 

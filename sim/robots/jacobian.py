@@ -32,6 +32,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from sim.errors import KinematicsError
+from sim.robots.families import FiveR
 from sim.robots.model import KinematicModel
 
 
@@ -61,21 +63,14 @@ def task_jacobian_5r(model: KinematicModel, q: ArrayLike) -> NDArray[np.float64]
     Returns:
         Shape (5, 5) or (N, 5, 5).
     """
-    if model.family != "5r":
-        raise ValueError("task_jacobian_5r needs a 5r model")
-    J = geometric_jacobian(model, q)
-    out = np.zeros(J.shape[:-2] + (5, 5))
-    out[..., :3, :] = J[..., :3, :]
-    out[..., 3, 1:4] = 1.0  # beta = q2 + q3 + q4
-    out[..., 4, 4] = 1.0  # gamma = q5
-    return out
+    if not isinstance(model.family, FiveR):
+        raise KinematicsError(f"task_jacobian_5r needs a 5R model, got {model.family.name}")
+    return model.family.task_jacobian(geometric_jacobian(model, q))
 
 
 def task_jacobian(model: KinematicModel, q: ArrayLike) -> NDArray[np.float64]:
     """The square Jacobian used for manipulability: 6 x 6 geometric (200iC), 5 x 5 task (5R)."""
-    if model.family == "5r":
-        return task_jacobian_5r(model, q)
-    return geometric_jacobian(model, q)
+    return model.family.task_jacobian(geometric_jacobian(model, q))
 
 
 def manipulability(J: ArrayLike) -> NDArray[np.float64]:
@@ -130,17 +125,5 @@ def singularity_measures(model: KinematicModel, q: ArrayLike) -> dict[str, NDArr
         "manipulability": manipulability(J),
         "det": np.linalg.det(J),
     }
-    d = model.dims
-    q2, q3 = Q[..., 1], Q[..., 2]
-    if model.family == "fanuc6":
-        L = np.hypot(d["R4"], d["d4"])
-        out["wrist"] = np.sin(Q[..., 4])
-        out["elbow"] = (d["R4"] * np.cos(q3) - d["d4"] * np.sin(q3)) / L
-        out["shoulder"] = (d["d2"] - d["d3"] * np.sin(q2) + d["R4"] * np.cos(q2 + q3)
-                           - d["d4"] * np.sin(q2 + q3))
-    else:
-        q4 = Q[..., 3]
-        out["elbow"] = np.cos(q3)
-        out["shoulder"] = (d["l1"] + d["d1"] * np.sin(q2) + d["l2"] * np.cos(q2 + q3)
-                           + d["l3"] * np.cos(q2 + q3 + q4))
+    out.update(model.family.singular_factors(Q))
     return out

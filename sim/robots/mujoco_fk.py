@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sim.errors import KinematicsError
-from sim.robots.registry import get_robot
+from sim.robots.registry import RobotSpec
 
 
 class MujocoKinematics:
@@ -49,9 +49,8 @@ class MujocoKinematics:
         return int(sid)
 
     @classmethod
-    def for_robot(cls, name: str) -> MujocoKinematics:
-        """Load robot ``name``'s MJCF (``RobotSpec.robot_path``)."""
-        spec = get_robot(name)
+    def for_robot(cls, spec: RobotSpec) -> MujocoKinematics:
+        """Load a robot's MJCF (``RobotSpec.robot_path``)."""
         return cls.from_file(spec.robot_path, spec.joints)
 
     @classmethod

@@ -16,8 +16,10 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.errors import UnknownNameError
+from planners.registry import Registry
 from sim.core.resources import models_dir
+from sim.errors import KinematicsError
+from sim.robots.families import Fanuc6, FiveR, KinematicFamily
 
 
 @dataclass(frozen=True)
@@ -55,10 +57,10 @@ class RobotSpec:
         title: Human-readable name.
         folder: Model folder under ``models/``.
         robot_file: Robot MJCF file inside ``folder``.
-        family: Kinematic family: ``"5r"`` (seed 000 Table 1 screw axes, eq. 5) or
-            ``"fanuc6"`` (seed 004 modified DH, eq. 6-7).
-        dims: Kinematic dimensions in metres. ``"5r"``: l1, d1, l2, l3 (seed 000 Table 1,
-            l3 = J4 axis to the tool point); ``"fanuc6"``: d2, d3, d4, R4, R6 (seed 004 Table 1).
+        family: The kinematic family object with the robot's dimensions, m
+            (:class:`~sim.robots.families.FiveR`: seed 000 Table 1 screw axes, eq. 5, l1, d1,
+            l2, l3 with l3 = J4 axis to the tool point; :class:`~sim.robots.families.Fanuc6`:
+            seed 004 modified DH, eq. 6-7, d2, d3, d4, R4, R6).
         max_speed: Joint speed limits, rad/s, shape (n_joints,).
         description: One line for ``cellsim list``.
         drives: Default drive train per joint (documented in the model's README); the
@@ -69,8 +71,7 @@ class RobotSpec:
     title: str
     folder: str
     robot_file: str
-    family: str
-    dims: dict[str, float]
+    family: KinematicFamily
     max_speed: tuple[float, ...]
     description: str = ""
     drives: tuple[Drive, ...] = ()
@@ -79,6 +80,11 @@ class RobotSpec:
     @property
     def n_joints(self) -> int:
         return len(self.max_speed)
+
+    @property
+    def dims(self) -> dict[str, float]:
+        """The family's kinematic dimensions, m."""
+        return self.family.dims
 
     @property
     def joints(self) -> tuple[str, ...]:
@@ -97,18 +103,17 @@ def _deg(*values: float) -> tuple[float, ...]:
     return tuple(float(np.deg2rad(v)) for v in values)
 
 
-ROBOTS: dict[str, RobotSpec] = {
-    spec.name: spec
-    for spec in (
+#: The shipped robots by name.
+ROBOTS: Registry[RobotSpec] = Registry("robot")
+for _spec in (
         RobotSpec(
             name="lrmate100ib",
             title="FANUC LR Mate 100iB",
             folder="fanuc_lrmate100ib",
             robot_file="lrmate100ib.xml",
-            family="5r",
             # seed 000 Table 2 point 0 fixes d1 and l1+l2+l3; split after the RoboDK table
             # (../shared/reference/robots.md); l3 = 80 mm flange + 145 mm torch.
-            dims={"l1": 0.150, "d1": 0.250, "l2": 0.220, "l3": 0.225},
+            family=FiveR({"l1": 0.150, "d1": 0.250, "l2": 0.220, "l3": 0.225}),
             # as commonly quoted for the LR Mate 100iB/200iB family (estimate, see model README)
             max_speed=_deg(240, 270, 270, 330, 480),
             description="5-axis FANUC LR Mate 100iB (seed 000), 5 kg payload",
@@ -127,8 +132,7 @@ ROBOTS: dict[str, RobotSpec] = {
             title="FANUC LR Mate 200iC/5L",
             folder="fanuc_lrmate200ic",
             robot_file="lrmate200ic5l.xml",
-            family="fanuc6",
-            dims={"d2": 0.075, "d3": 0.400, "d4": 0.075, "R4": 0.410, "R6": 0.080},
+            family=Fanuc6({"d2": 0.075, "d3": 0.400, "d4": 0.075, "R4": 0.410, "R6": 0.080}),
             max_speed=_deg(270, 270, 270, 450, 450, 720),  # ROS-Industrial URDF
             description="6-axis FANUC LR Mate 200iC/5L (seed 004), 5 kg payload",
             # estimated beta-iS class motors (0.2-0.75 kW) + harmonic reducers (model README)
@@ -146,10 +150,9 @@ ROBOTS: dict[str, RobotSpec] = {
             title="5R welding robot",
             folder="robot_5r",
             robot_file="robot_5r.xml",
-            family="5r",
             # chosen for seed 001's cell (models/robot_5r/README.md): l3 = 100 mm flange +
             # 300 mm torch; long upper arm, short forearm for a large seam radius
-            dims={"l1": 0.250, "d1": 1.000, "l2": 0.600, "l3": 0.400},
+            family=FiveR({"l1": 0.250, "d1": 1.000, "l2": 0.600, "l3": 0.400}),
             max_speed=_deg(150, 150, 180, 300, 450),  # estimate for the 1.8-2 m reach class
             description="5-axis welding robot for large cylindrical parts (seed 001)",
             # estimated alpha-iS class motors (1-3 kW) + cycloidal/harmonic reducers
@@ -161,8 +164,8 @@ ROBOTS: dict[str, RobotSpec] = {
                 Drive(60, 0.75, 1.0e-4, 1.0, 4.0, 5000),
             ),
         ),
-    )
-}
+):
+    ROBOTS.add(_spec.name, _spec)
 
 
 @lru_cache(maxsize=None)
@@ -174,26 +177,22 @@ def _mjcf_ranges(path: str, joints: tuple[str, ...]) -> tuple[tuple[float, float
     for j in joints:
         jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j)
         if jid < 0:
-            raise UnknownNameError("joint", j, joints)
+            raise KinematicsError(f"{path}: no joint named {j!r}; joints: {', '.join(joints)}")
         lo, hi = model.jnt_range[jid]
         out.append((float(lo), float(hi)) if model.jnt_limited[jid] else (-np.inf, np.inf))
     return tuple(out)
 
 
-def joint_ranges(robot: str | RobotSpec) -> NDArray[np.float64]:
+def joint_ranges(spec: RobotSpec) -> NDArray[np.float64]:
     """Joint position ranges read from the robot's MJCF (the single source of truth).
 
     Args:
-        robot: Registry name or spec.
+        spec: The robot.
 
     Returns:
         Array of shape (n_joints, 2): lower and upper limit of joints ``j1..jN``, rad, in the
         seed's convention (MuJoCo qpos equals the seed's joint value).
-
-    Raises:
-        UnknownNameError: Unknown robot name.
     """
-    spec = robot if isinstance(robot, RobotSpec) else get_robot(robot)
     return np.array(_mjcf_ranges(str(spec.robot_path), spec.joints), dtype=float)
 
 
@@ -203,7 +202,4 @@ def get_robot(name: str) -> RobotSpec:
     Raises:
         UnknownNameError: The name is not registered; the message lists the known robots.
     """
-    try:
-        return ROBOTS[name]
-    except KeyError:
-        raise UnknownNameError("robot", name, ROBOTS) from None
+    return ROBOTS.get(name)

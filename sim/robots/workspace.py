@@ -56,7 +56,7 @@ def _bounds(model: KinematicModel) -> tuple[NDArray[np.float64], NDArray[np.floa
 def wrist_points(model: KinematicModel, q: NDArray[np.float64]) -> NDArray[np.float64]:
     """Wrist centre(s) in frame 0, m, for q of shape (n,) or (N, n): (3,) or (N, 3)."""
     axes, points, _ = model.joint_frames(q)
-    return points[..., 4, :] if model.family == "fanuc6" else points[..., 3, :]
+    return points[..., model.family.wrist_centre_index, :]
 
 
 def _maximize(f, lo: NDArray[np.float64], hi: NDArray[np.float64], n_grid: int
@@ -91,7 +91,7 @@ def compute_reach(model: KinematicModel) -> Reach:
 
     arm = [1, 2]
     wr, xw = _maximize(lambda x: radial(wrist_points(model, full(x, arm))), lo[arm], hi[arm], 61)
-    free = [1, 2, 3] if model.family == "5r" else [1, 2, 3, 4]
+    free = list(model.family.reach_free_joints)
     tc, xt = _maximize(lambda x: radial(model.fk(full(x, free))[:, :3, 3]), lo[free], hi[free],
                        21 if len(free) == 3 else 13)
     return Reach(wrist=wr, tcp=tc, q_wrist=full(xw[None], arm)[0], q_tcp=full(xt[None], free)[0])
@@ -112,7 +112,6 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
 
     reach = compute_reach(model)
     lo, hi = _bounds(model)
-    d = model.dims
     n = model.n_joints
     g2 = np.linspace(lo[1], hi[1], 241)
     g3 = np.linspace(lo[2], hi[2], 241)
@@ -120,18 +119,7 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
     Q = np.zeros((T2.size, n))
     Q[:, 1], Q[:, 2] = T2.ravel(), T3.ravel()
     W = wrist_points(model, Q)
-    if model.family == "fanuc6":
-        L = np.hypot(d["R4"], d["d4"])
-        elbow = (d["R4"] * np.cos(T3) - d["d4"] * np.sin(T3)) / L
-        shoulder = (d["d2"] - d["d3"] * np.sin(T2) + d["R4"] * np.cos(T2 + T3)
-                    - d["d4"] * np.sin(T2 + T3))
-        elbow_label = "eq. 24: R4 c3 - d4 s3 = 0 (elbow)"
-        shoulder_label = "eq. 25: wrist centre on J1 axis (shoulder)"
-    else:
-        elbow = np.cos(T3)
-        shoulder = d["l1"] + d["d1"] * np.sin(T2) + d["l2"] * np.cos(T2 + T3)
-        elbow_label = "cos q3 = 0 (elbow stretched)"
-        shoulder_label = "wrist point on J1 axis (shoulder)"
+    elbow, shoulder, elbow_label, shoulder_label = model.family.singular_curves(T2, T3)
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 6))
     im = ax1.pcolormesh(np.rad2deg(g2), np.rad2deg(g3), 1e3 * shoulder.T, shading="auto",
@@ -143,13 +131,13 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
                               colors="white", linewidths=2, linestyles="--")
     ax1.plot([], [], "r-", label=elbow_label)
     ax1.plot([], [], "w--", label=shoulder_label)
-    ax1.set_xlabel("theta2 (deg)" if model.family == "fanuc6" else "q2 (deg)")
-    ax1.set_ylabel("theta3 (deg)" if model.family == "fanuc6" else "q3 (deg)")
+    ax1.set_xlabel(f"{model.family.joint_symbol}2 (deg)")
+    ax1.set_ylabel(f"{model.family.joint_symbol}3 (deg)")
     ax1.set_title("joint ranges and singular curves")
     ax1.legend(loc="lower left", fontsize=8, facecolor="0.6")
 
     ax2.scatter(1e3 * W[:, 0], 1e3 * W[:, 2], s=1, c="0.6", label="wrist centre (J1 = 0)")
-    if model.family == "5r":
+    if model.family.section_shows_tcp:
         rng = np.random.default_rng(0)
         Qt = rng.uniform(lo, hi, size=(60000, n))
         Qt[:, 0] = 0.0

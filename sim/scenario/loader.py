@@ -26,8 +26,8 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError
 
 from planners.errors import PlannerError
-from sim.errors import ScenarioError, UnknownNameError
 from sim.core.resources import shipped_scenarios
+from sim.errors import ScenarioError, UnknownNameError
 from sim.robots.registry import RobotSpec, get_robot
 
 # --------------------------------------------------------------------------------------------

@@ -17,8 +17,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import InternalError
-from sim.simulation.motion import CartesianContext
 from sim.scenario import Scenario
+from sim.simulation.motion import CartesianContext
 
 
 @dataclass
@@ -85,7 +85,7 @@ def build(scenario: Scenario) -> BuiltCell:
     part_qpos = [np.arange(model.jnt_qposadr[model.body(p).jntadr[0]],
                            model.jnt_qposadr[model.body(p).jntadr[0]] + 7)
                  for p in getattr(cell, "parts", [])]
-    kin = _tool_kinematics(closed_form_model(scenario.robot.name), model, cell, robot_qpos)
+    kin = _tool_kinematics(closed_form_model(scenario.robot), model, cell, robot_qpos)
     ctx = CartesianContext(kinematics=kin, seams=dict(getattr(cell, "seams", {})),
                            world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float))
     return BuiltCell(cell, model, saved_xml, robot_qpos, robot_dof, robot_act, suction, slices,
@@ -101,7 +101,6 @@ def _tool_kinematics(kin: Any, model: Any, cell: Any, robot_qpos: NDArray[np.int
     in ``frame0`` at q = 0, where the seeds put the tool point at ``(l1 + l2 + l3, 0, d1)`` and
     ``(d2 + R4 + R6 + r, 0, d3 + d4)``; :func:`_check_tcp_consistency` then checks the whole pose.
     """
-    import dataclasses
 
     import mujoco
 
@@ -111,9 +110,5 @@ def _tool_kinematics(kin: Any, model: Any, cell: Any, robot_qpos: NDArray[np.int
     f0 = model.site(cell.frame0_site).id
     tcp = model.site(cell.tcp_site).id
     p = data.site_xmat[f0].reshape(3, 3).T @ (data.site_xpos[tcp] - data.site_xpos[f0])
-    dims = dict(kin.dims)
-    if kin.family == "5r":
-        dims["l3"] = float(p[0] - dims["l1"] - dims["l2"])
-        return dataclasses.replace(kin, dims=dims)
-    return dataclasses.replace(kin, tool_length=float(p[0] - dims["d2"] - dims["R4"] - dims["R6"]))
+    return kin.with_family(kin.family.tool_from_home_tcp(p))
 

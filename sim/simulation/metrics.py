@@ -98,7 +98,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
     dev = np.linalg.norm(a["tcp_pos"] - a["tcp_pos_ref"], axis=1)
     peak_id = np.max(np.abs(a["tau_id"]), axis=0)
     rms_diff = np.sqrt(np.mean((a["tau"] - a["tau_id"]) ** 2, axis=0))
-    torch_axis = 0 if scenario.robot.family == "5r" else 2
+    torch_axis = scenario.robot.family.approach_column
     summary: dict[str, Any] = {
         "scenario": scenario.name,
         "robot": scenario.robot.name,

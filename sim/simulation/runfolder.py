@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from sim.errors import CellsimError, RunFolderError
+from sim.errors import RunFolderError
 
 #: Arrays every run must have to be rendered.
 REQUIRED_FOR_VIDEO: tuple[str, ...] = ("t", "qpos")

@@ -25,7 +25,6 @@ from sim.errors import SimulationError
 from sim.simulation.compile import BuiltCell
 from sim.simulation.motion import Motion
 
-
 #: Steps per rollout chunk (checked for instability after each).
 CHUNK_STEPS = 2000
 

@@ -37,8 +37,13 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sim.core.rotations import euler_zyx_to_matrix, make_transform, matrix_to_euler_zyx, rot_z, \
-    wrap_to_pi
+from sim.core.rotations import (
+    euler_zyx_to_matrix,
+    make_transform,
+    matrix_to_euler_zyx,
+    rot_z,
+    wrap_to_pi,
+)
 from sim.errors import KinematicsError, SingularityWarning, UnreachableError
 from sim.robots.closed_form import fk_5r
 from sim.robots.families.base import KinematicFamily
