@@ -5,7 +5,7 @@ reference motion, then times, over the same model and number of steps:
 
 * ``bare``: a plain Python loop ``for k in range(n): mj_step(model, data)`` (ctrl held);
 * ``sim``: the runner's simulation proper (``summary.wall_s``: the chunked mujoco.rollout);
-* ``total``: :func:`sim.pipeline.run.simulate` as a whole (inverse dynamics of the reference,
+* ``total``: :func:`sim.simulation.simulate.simulate` as a whole (inverse dynamics of the reference,
   controls, rollout, recording).
 
 and prints ``sim/bare`` (target <= 1.5) and ``total/bare`` with the real-time factor.

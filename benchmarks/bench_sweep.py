@@ -12,7 +12,7 @@ Usage::
     .venv/bin/python benchmarks/bench_sweep.py                       # stand-in runner
     .venv/bin/python benchmarks/bench_sweep.py --payloads 0,2.5,5 --speeds 0.5,1,1.5 \\
         --workers 2 --json bench_sweep.json
-    .venv/bin/python benchmarks/bench_sweep.py --runner sim.pipeline.run:run_variant --scenario weld_5r
+    .venv/bin/python benchmarks/bench_sweep.py --runner sim.cli.size:run_variant --scenario bugnar_5r_weld_cycle
 """
 
 from __future__ import annotations

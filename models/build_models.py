@@ -1,7 +1,7 @@
 """Generator of the three cellsim robot models (MJCF), their scenes and README figures.
 
 Run ``python models/build_models.py`` from the repository root after changing anything here
-or in ``sim/robots.py`` (dims, drives, speed limits). It writes, for each robot:
+or in ``sim/robots/registry.py`` (dims, drives, speed limits). It writes, for each robot:
 
 * ``models/<folder>/<robot>.xml``: the robot, one top-level body ``base`` (no free joint),
   joints ``j1..jN`` with the seeds' zero and sign, sites ``frame0``, ``wrist``, ``flange``,
@@ -12,7 +12,7 @@ or in ``sim/robots.py`` (dims, drives, speed limits). It writes, for each robot:
   per-link inertials.
 
 ``tests/test_models.py`` checks that the committed files equal what this script writes, so the
-XML, the README figures and ``sim/robots.py`` cannot drift apart.
+XML, the README figures and ``sim/robots/registry.py`` cannot drift apart.
 
 Mass model (documented in each README): every visual primitive is a solid of uniform density;
 motors (black cylinders) carry a fixed mass estimated for their servo class, metal flanges the

@@ -13,6 +13,8 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planners.errors import UsageError
+
 
 @dataclass(frozen=True)
 class JointState:
@@ -53,7 +55,7 @@ def sample_times(t0: float, t1: float, dt: float) -> NDArray[np.float64]:
         ValueError: ``dt`` is not a positive finite number.
     """
     if not np.isfinite(dt) or dt <= 0:
-        raise ValueError(f"sample period dt must be a positive number of seconds, got {dt!r}")
+        raise UsageError(f"sample period dt must be a positive number of seconds, got {dt!r}")
     n = int(np.floor((t1 - t0) / dt + 1e-9))
     t = t0 + dt * np.arange(n + 1)
     if t1 - t[-1] > 1e-12 * max(1.0, abs(t1)):

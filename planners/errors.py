@@ -30,6 +30,11 @@ class InternalError(CellsimError, RuntimeError):
     """A fault inside cellsim, not a user mistake: please report it with its traceback."""
 
 
+class UsageError(CellsimError, ValueError):
+    """A function called with arguments that cannot work together (a caller's mistake in code
+    that uses cellsim as a library: wrong shape, a missing argument, a value out of domain)."""
+
+
 class CellsimWarning(CellsimError, UserWarning):
     """Root of cellsim's warnings (issued with :func:`warnings.warn`, never raised)."""
 

@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import solve_banded
 
-from planners.errors import InvalidBoundaryError, InvalidKnotsError
+from planners.errors import InternalError, InvalidBoundaryError, InvalidKnotsError
 
 
 def validate_knots(times: ArrayLike, q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -188,7 +188,7 @@ def solve_piecewise(times: NDArray[np.float64], q: NDArray[np.float64], degrees:
     n_unknown = int(np.sum(degrees + 1))
     n_rows = 2 * (K + 1) + (K + 2) * (m - 1)
     if n_unknown != n_rows:  # a programming error, not a user error
-        raise AssertionError(f"non-square system: {n_unknown} unknowns, {n_rows} conditions")
+        raise InternalError(f"non-square system: {n_unknown} unknowns, {n_rows} conditions")
     col0 = np.concatenate(([0], np.cumsum(degrees + 1)[:-1]))
     s_lo = np.zeros(m)
     s_hi = np.ones(m)

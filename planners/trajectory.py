@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from planners.base import JointState, sample_times
-from planners.errors import PlannerError
+from planners.errors import PlannerError, UsageError
 
 #: Slack on the time range accepted by :meth:`PiecewisePolynomialTrajectory.at`, s.
 TIME_TOLERANCE = 1e-9
@@ -128,7 +128,7 @@ class PiecewisePolynomialTrajectory:
         self._degrees = tuple(int(d) for d in degrees)
         m = self._knots.size - 1
         if self._coef.ndim != 3 or self._coef.shape[0] != m or len(self._degrees) != m:
-            raise ValueError("coefficients must have shape (n_segments, n_joints, D+1) with one "
+            raise UsageError("coefficients must have shape (n_segments, n_joints, D+1) with one "
                              "degree per segment")
         self._planner = str(planner)
         self._h = np.diff(self._knots)

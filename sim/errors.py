@@ -14,6 +14,7 @@ from planners.errors import (
     InternalError,
     PlannerError,
     UnknownNameError,
+    UsageError,
 )
 
 
@@ -49,10 +50,6 @@ class RunFolderError(CellsimError):
     """A run folder is missing, incomplete or inconsistent; names the folder and the file/field."""
 
 
-class SizingError(CellsimError):
-    """Bad sizing input (drive overrides, joints that do not match the robot)."""
-
-
 class SweepError(CellsimError):
     """Bad sweep input (payloads, speed scales, workers) or failed variants; one line."""
 
@@ -64,5 +61,6 @@ class RenderError(CellsimError):
 __all__ = [
     "CellError", "CellsimError", "CellsimWarning", "InternalError", "KinematicsError",
     "PlannerError", "RenderError", "RunFolderError", "ScenarioError", "SimulationError",
-    "SingularityWarning", "SizingError", "SweepError", "UnknownNameError", "UnreachableError",
+    "SingularityWarning", "SweepError", "UnknownNameError", "UnreachableError",
+    "UsageError",
 ]

@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from sim.cells import BARE, CELLS, MOUNTS, Seam, build_cell
+from sim.cells import BARE, CELLS, MOUNTS, Seam, build_cell, resolve_tool
 from sim.cells.tools import TOOLS
 from sim.errors import CellsimError, UnknownNameError
 from sim.robots.closed_form import fk_5r
@@ -26,7 +26,7 @@ PHASE1_END = np.deg2rad([-15.2, 116.82, -1.3, 1.4, -0.206])  # seed 001 eq. (4),
 
 @lru_cache(maxsize=None)
 def cell_and_model(cell, robot, mount="floor"):
-    c = build_cell(cell, robot, mount=mount)
+    c = build_cell(None if cell is None else CELLS[cell], ROBOTS[robot], mount=mount)
     return c, c.compile()
 
 
@@ -330,7 +330,7 @@ def _pick_run(suction: float, mass: float = 0.25, swing: bool = False):
     """Touch part0 from above, set suction, lift 0.1 m (optionally swing J1 by 90 deg in 0.5 s).
 
     Returns (lift of the part, m; largest slip of the part relative to the tcp, m)."""
-    c = build_cell("pick", "lrmate200ic5l")
+    c = build_cell(CELLS["pick"], ROBOTS["lrmate200ic5l"])
     m = c.compile()
     part = c.parts[0]
     b = m.body(part).id
@@ -422,7 +422,11 @@ def test_bad_input_one_line(kwargs, exc, needles):
     kw = dict(kwargs)
     cell, robot = kw.pop("cell"), kw.pop("robot")
     with pytest.raises(exc) as info:
-        build_cell(cell, robot, **kw)
+        # names resolve through the registries (the scenario loader's way), then compose
+        cspec = BARE if cell is None else CELLS.get(cell)
+        if "tool" in kw:
+            kw["tool"] = resolve_tool(cspec, kw["tool"])
+        build_cell(cspec, ROBOTS.get(robot), **kw)
     msg = str(info.value)
     assert "\n" not in msg
     for n in needles:
@@ -430,9 +434,10 @@ def test_bad_input_one_line(kwargs, exc, needles):
 
 
 def test_tool_choice_and_no_tool():
-    c = build_cell(None, "lrmate200ic5l")
+    c = build_cell(None, ROBOTS["lrmate200ic5l"])
     assert c.tool is None and c.tip_site is None and c.adhesion_actuator is None
-    c = build_cell("weld_table", "lrmate100ib", tool="mig_torch_long")
+    table = CELLS["weld_table"]
+    c = build_cell(table, ROBOTS["lrmate100ib"], tool=resolve_tool(table, "mig_torch_long"))
     assert c.tool.name == "mig_torch_long"
-    c = build_cell(None, "lrmate200ic5l", tool="none")
+    c = build_cell(None, ROBOTS["lrmate200ic5l"], tool=resolve_tool(BARE, "none"))
     assert c.tool is None

@@ -1,5 +1,5 @@
 """Acceptance tests of the three MJCF robot models (models/*/), against the seeds' closed forms,
-the reference data (shared/reference/robots.md), the READMEs and the drive data in sim/robots.py.
+the reference data (shared/reference/robots.md), the READMEs and the drive data in sim/robots/registry.py.
 """
 
 from __future__ import annotations

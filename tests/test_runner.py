@@ -224,12 +224,15 @@ def test_path_deviation_metric_against_the_line(tmp_path):
     """Via points 40 mm apart: the joint polynomial leaves the straight seam between them. The
     summary's max_path_deviation_mm equals the largest distance of the recorded tool point
     from the seam's line (computed here from the cell's seam end points)."""
-    from sim.cells import build_cell
+    from sim.cells import CELLS, build_cell
+    from sim.cells.tools import TOOLS
+    from sim.robots.registry import ROBOTS
 
     s = _run(parse_scenario(COARSE_LINE, source="coarse.toml"), tmp_path / "c")
     (weld,) = s["weld"]
     a = np.load(tmp_path / "c" / "trajectory.npz")
-    seam = build_cell("weld_table", "lrmate200ic5l", tool="mig_torch").seams["line"]
+    seam = build_cell(CELLS["weld_table"], ROBOTS["lrmate200ic5l"],
+                      tool=TOOLS["mig_torch"]).seams["line"]
     p0, p1 = seam.points
     u = (p1 - p0) / np.linalg.norm(p1 - p0)
     p = a["tcp_pos"][a["arc_on"]] - p0

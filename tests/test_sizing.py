@@ -495,7 +495,7 @@ def test_tiny_negative_margin_never_reads_as_zero() -> None:
 @pytest.mark.parametrize("robot", sorted(ROBOTS))
 def test_model_limits_and_armature_convention(robot: str) -> None:
     # The shipped models: every joint has a finite force range around zero, and the MJCF
-    # armature is the drive's reflected inertia J_r N^2 (sim/robots.py), which size_run
+    # armature is the drive's reflected inertia J_r N^2 (sim/robots/registry.py), which size_run
     # subtracts by default so that the rotor inertia is counted once.
     import mujoco
 

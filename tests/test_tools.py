@@ -32,7 +32,7 @@ def _compile(model) -> mujoco.MjModel:
 @pytest.mark.parametrize("name", sorted(TOOLS))
 def test_tool_mass_and_straight_geometry(name):
     spec = TOOLS[name]
-    m = _compile(build_tool(name))
+    m = _compile(build_tool(TOOLS[name]))
     d = mujoco.MjData(m)
     mujoco.mj_forward(m, d)
     # the geoms' masses (from densities x volumes) add up to the stated tool mass (1 %)
@@ -56,13 +56,13 @@ def test_tool_mass_and_straight_geometry(name):
 
 def test_torch_geoms_touch_nothing():
     for name in ("mig_torch", "mig_torch_long"):
-        m = _compile(build_tool(name))
+        m = _compile(build_tool(TOOLS[name]))
         assert np.all(m.geom_contype == 0) and np.all(m.geom_conaffinity == 0)
 
 
 def test_vacuum_gripper_adhesion_actuator():
     spec = get_tool("vacuum_gripper")
-    m = _compile(build_tool("vacuum_gripper"))
+    m = _compile(build_tool(TOOLS["vacuum_gripper"]))
     a = m.actuator(SUCTION_ACTUATOR)
     assert m.actuator_trntype[a.id] == mujoco.mjtTrn.mjTRN_BODY
     assert m.actuator_trnid[a.id, 0] == m.body(CUP_BODY).id
@@ -100,7 +100,7 @@ def test_mujoco_margin_gap_semantics(dist, active):
 
 def test_unknown_tool_lists_choices():
     with pytest.raises(UnknownNameError) as exc:
-        build_tool("mig_torhc")
+        build_tool(TOOLS.get("mig_torhc"))
     msg = str(exc.value)
     assert "\n" not in msg and "did you mean 'mig_torch'" in msg
     for name in TOOLS:
@@ -124,7 +124,7 @@ def test_tcp_on_tool_tip_matches_closed_form(robot, tool):
     l3 = l3 - (bare tcp - flange) + length) or seed 004 eq. 6-7 (r = length)."""
     spec = get_robot(robot)
     tl = TOOLS[tool].length_m
-    cell = build_cell(None, robot, tool=tool)
+    cell = build_cell(None, ROBOTS[robot], tool=TOOLS[tool])
     m = cell.compile()
     d = mujoco.MjData(m)
     mb, db = _bare_robot(spec)
@@ -168,8 +168,8 @@ def test_tcp_on_tool_tip_matches_closed_form(robot, tool):
 @pytest.mark.parametrize("robot", ["lrmate200ic5l", "robot_5r"])
 def test_payload_lumped_sphere_at_tcp(robot):
     payload = 2.5
-    plain = build_cell(None, robot, tool="mig_torch").compile()
-    cell = build_cell(None, robot, tool="mig_torch", payload_kg=payload)
+    plain = build_cell(None, ROBOTS[robot], tool=TOOLS["mig_torch"]).compile()
+    cell = build_cell(None, ROBOTS[robot], tool=TOOLS["mig_torch"], payload_kg=payload)
     m = cell.compile()
     assert m.body_subtreemass[0] - plain.body_subtreemass[0] == pytest.approx(payload)
     d = mujoco.MjData(m)

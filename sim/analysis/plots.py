@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from sim.simulation.runfolder import REQUIRED_FOR_PLOTS, RunRecord, as_record
+from sim.errors import UsageError
+from sim.simulation.runfolder import PLOTS_DIR, REQUIRED_FOR_PLOTS, RunRecord, as_record
 
 #: Resolution of the PNG files, dots per inch.
 DPI = 100
@@ -244,8 +245,8 @@ def write_plots(run: str | Path | RunRecord, out_dir: str | Path | None = None) 
     record.require(REQUIRED_FOR_PLOTS)
     if out_dir is None:
         if record.source is None:
-            raise ValueError("out_dir is required for a run that was not read from a folder")
-        out_dir = record.source / "plots"
+            raise UsageError("out_dir is required for a run that was not read from a folder")
+        out_dir = record.source / PLOTS_DIR
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     jobs: list[tuple[str, Any]] = [

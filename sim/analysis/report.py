@@ -37,9 +37,17 @@ from sim.analysis.sizing import (
     load_summary,
     peak_envelope,
 )
+from sim.simulation.runfolder import (
+    REPORT_HTML,
+    SIZING_CHARTS_DIR,
+    SIZING_CSV,
+    SIZING_JSON,
+    SIZING_MD,
+    VIDEO_MP4,
+)
 
 #: Sub-folder of the run folder holding the charts.
-PLOTS_DIR = "sizing"
+PLOTS_DIR = SIZING_CHARTS_DIR
 
 #: Required leading columns of sizing.csv.
 REQUIRED_COLUMNS = ("joint", "peak_torque_nm", "rms_torque_nm", "peak_speed_rad_s", "peak_power_w",
@@ -427,8 +435,12 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
 # Entry point
 # --------------------------------------------------------------------------------------------
 
-def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = True) -> dict[str, Path]:
+def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = True,
+                 summary: Mapping[str, Any] | None = None) -> dict[str, Path]:
     """Write the sizing files of a run into ``run_dir``.
+
+    ``summary`` is the run's summary in memory (the runner's); without it the folder's
+    ``summary.json`` is read and the video linked when ``video.mp4`` is there.
 
     Args:
         run_dir: The run folder (``summary.json`` and ``video.mp4`` are read from it when
@@ -443,15 +455,18 @@ def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = Tr
     run_dir.mkdir(parents=True, exist_ok=True)
     written: dict[str, Path] = {}
     columns, rows = sizing_rows(result)
-    written["csv"] = write_atomic(run_dir / "sizing.csv", csv_text(columns, rows))
-    written["json"] = write_atomic(run_dir / "sizing.json",
+    written["csv"] = write_atomic(run_dir / SIZING_CSV, csv_text(columns, rows))
+    written["json"] = write_atomic(run_dir / SIZING_JSON,
                                    json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n")
     pngs = sizing_charts(result) if charts else {}
     for name, png in pngs.items():
         written[name] = write_atomic(run_dir / PLOTS_DIR / name, png)
-    written["md"] = write_atomic(run_dir / "sizing.md", sizing_markdown(result, list(pngs)))
-    summary = load_summary(run_dir)
-    video = "video.mp4" if (run_dir / "video.mp4").is_file() else None
-    written["html"] = write_atomic(run_dir / "report.html",
+    written["md"] = write_atomic(run_dir / SIZING_MD, sizing_markdown(result, list(pngs)))
+    if summary is None:  # a finished folder: read what it holds
+        summary = load_summary(run_dir)
+        video = VIDEO_MP4 if (run_dir / VIDEO_MP4).is_file() else None
+    else:  # the runner's summary in memory names the video when it wrote one
+        video = summary.get("video")
+    written["html"] = write_atomic(run_dir / REPORT_HTML,
                                    sizing_html(result, pngs, summary, video))
     return written

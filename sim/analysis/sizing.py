@@ -67,6 +67,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.robots.registry import Drive, RobotSpec
+from sim.simulation.runfolder import SUMMARY_JSON, TRAJECTORY_NPZ, RunRecord
 
 #: Fraction of the motor's maximum speed up to which the peak torque is available (the
 #: voltage-limit knee of the peak envelope). Generic servo-motor shape, not catalogue data.
@@ -525,9 +526,8 @@ def motor_speed_rpm(qd: ArrayLike, drive: Drive) -> NDArray[np.float64]:
 
 
 def _rated_speed_rpm(drive: Drive) -> float:
-    # Drive has no rated speed today; honour one if the registry grows it.
-    rated = getattr(drive, "rated_speed_rpm", None)
-    return float(rated) if rated else float(drive.max_speed_rpm)
+    # Drive has no rated speed: the generic S1 shape is flat up to the maximum speed.
+    return float(drive.max_speed_rpm)
 
 
 def continuous_envelope(drive: Drive, speed_rpm: ArrayLike) -> NDArray[np.float64]:
@@ -702,14 +702,28 @@ def forcerange_from_model(model: Any, joint_names: Sequence[str]) -> NDArray[np.
     Raises:
         UnknownNameError: A joint name is not in the model.
     """
+    return joint_forcerange(model, _joint_ids(model, joint_names))
+
+
+def _joint_ids(model: Any, joint_names: Sequence[str]) -> list[int]:
     import mujoco
 
-    out = np.empty((len(joint_names), 2))
     valid = [model.joint(i).name for i in range(model.njnt)]
-    for k, name in enumerate(joint_names):
+    ids = []
+    for name in joint_names:
         jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
         if jid < 0:
             raise UnknownNameError("joint", name, valid)
+        ids.append(int(jid))
+    return ids
+
+
+def joint_forcerange(model: Any, joint_ids: Sequence[int]) -> NDArray[np.float64]:
+    """:func:`forcerange_from_model` for joints given by id (resolved once by the caller)."""
+    import mujoco
+
+    out = np.empty((len(joint_ids), 2))
+    for k, jid in enumerate(joint_ids):
         lo, hi, driven = 0.0, 0.0, False
         for a in range(model.nu):
             if model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT or model.actuator_trnid[a, 0] != jid:
@@ -732,16 +746,12 @@ def forcerange_from_model(model: Any, joint_names: Sequence[str]) -> NDArray[np.
 
 def armature_from_model(model: Any, joint_names: Sequence[str]) -> NDArray[np.float64]:
     """``dof_armature`` of each (hinge/slide) joint, kg m^2, shape (n_joints,)."""
-    import mujoco
+    return joint_armature(model, _joint_ids(model, joint_names))
 
-    valid = [model.joint(i).name for i in range(model.njnt)]
-    out = np.empty(len(joint_names))
-    for k, name in enumerate(joint_names):
-        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
-        if jid < 0:
-            raise UnknownNameError("joint", name, valid)
-        out[k] = float(model.dof_armature[model.jnt_dofadr[jid]])
-    return out
+
+def joint_armature(model: Any, joint_ids: Sequence[int]) -> NDArray[np.float64]:
+    """:func:`armature_from_model` for joints given by id (resolved once by the caller)."""
+    return np.array([float(model.dof_armature[model.jnt_dofadr[j]]) for j in joint_ids])
 
 
 # --------------------------------------------------------------------------------------------
@@ -758,7 +768,7 @@ def load_trajectory(run_dir: str | Path) -> dict[str, NDArray[np.float64]]:
     Raises:
         CellsimError: Missing file or key, or inconsistent shapes (names the file and key).
     """
-    path = Path(run_dir) / "trajectory.npz"
+    path = Path(run_dir) / TRAJECTORY_NPZ
     if not path.is_file():
         raise CellsimError(f"{path}: no such file (is {run_dir} a run folder from 'cellsim run'?)")
     try:
@@ -766,6 +776,18 @@ def load_trajectory(run_dir: str | Path) -> dict[str, NDArray[np.float64]]:
             data = {k: np.asarray(z[k]) for k in z.files}
     except Exception as exc:  # zipfile / format errors
         raise CellsimError(f"{path}: cannot be read ({exc})") from None
+    return check_trajectory(data, path)
+
+
+def check_trajectory(data: Mapping[str, NDArray[Any]], path: str | Path
+                     ) -> dict[str, NDArray[np.float64]]:
+    """Validate recorded arrays for sizing (keys, shapes, finite values); ``path`` names them
+    in messages. Returns them as a dict.
+
+    Raises:
+        CellsimError: Missing key, inconsistent shapes, NaN (names ``path`` and the key).
+    """
+    data = dict(data)
     missing = [k for k in TRAJECTORY_KEYS if k not in data]
     if missing:
         raise CellsimError(f"{path}: missing array(s) {', '.join(missing)}")
@@ -787,7 +809,7 @@ def load_trajectory(run_dir: str | Path) -> dict[str, NDArray[np.float64]]:
 
 def load_summary(run_dir: str | Path) -> dict[str, Any]:
     """``run_dir/summary.json`` as a dict ({} when absent)."""
-    path = Path(run_dir) / "summary.json"
+    path = Path(run_dir) / SUMMARY_JSON
     if not path.is_file():
         return {}
     try:
@@ -955,11 +977,27 @@ def size_run(run_dir: str | Path, spec: RobotSpec, drives: Sequence[Drive] | Non
     Raises:
         CellsimError: Missing or malformed run files, or joints that do not match ``spec``.
     """
-    traj = load_trajectory(run_dir)
-    summary = load_summary(run_dir)
+    return _size(load_trajectory(run_dir), load_summary(run_dir), Path(run_dir) / SUMMARY_JSON,
+                 spec, drives, forcerange, armature=armature, basis=basis,
+                 knee_fraction=knee_fraction)
+
+
+def size_record(record: RunRecord, spec: RobotSpec, drives: Sequence[Drive] | None = None,
+                forcerange: ArrayLike | None = None, *, armature: ArrayLike | None = None,
+                basis: str = "worst", knee_fraction: float = PEAK_KNEE_FRACTION) -> SizingResult:
+    """Size a run held in memory (the runner's :class:`RunRecord`); arguments as
+    :func:`size_run`."""
+    traj = check_trajectory(record.arrays, f"{record.where}: trajectory")
+    return _size(traj, record.summary, f"{record.where}: summary", spec, drives, forcerange,
+                 armature=armature, basis=basis, knee_fraction=knee_fraction)
+
+
+def _size(traj: dict[str, NDArray[np.float64]], summary: Mapping[str, Any], where: str | Path,
+          spec: RobotSpec, drives: Sequence[Drive] | None, forcerange: ArrayLike | None, *,
+          armature: ArrayLike | None, basis: str, knee_fraction: float) -> SizingResult:
     names = tuple(summary.get("joints") or spec.joints)
     if names != tuple(spec.joints):
-        raise CellsimError(f"{Path(run_dir) / 'summary.json'}: joints {', '.join(names)} do not "
+        raise CellsimError(f"{where}: joints {', '.join(names)} do not "
                            f"match robot {spec.name} ({', '.join(spec.joints)})")
     if drives is None:
         drives = spec.drives

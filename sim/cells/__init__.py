@@ -1,9 +1,11 @@
-"""Welding and pick cells composed with ``dm_control.mjcf`` (robot + tool + fixtures + parts).
+"""Cells layer: tools, seams and the welding and pick cells composed with ``dm_control.mjcf``
+(robot + tool + fixtures + parts). May import: planners, :mod:`sim.errors`, :mod:`sim.core`,
+:mod:`sim.robots`.
 
 Public API::
 
     from sim.cells import CELLS, Cell, Seam, build_cell
-    cell = build_cell("weld_cylinder", "robot_5r", mount="floor")
+    cell = build_cell(CELLS["weld_cylinder"], ROBOTS["robot_5r"], mount="floor")
     model = cell.compile()                      # mujoco.MjModel, keyframe "home"
 
 Cells (:data:`CELLS`; each module's docstring gives its dimensions and the reasons for them):
@@ -35,6 +37,7 @@ import numpy as np
 from dm_control import mjcf
 from numpy.typing import NDArray
 
+from planners.registry import Registry
 from sim.cells import bare, pick, weld_cylinder, weld_table
 from sim.cells.compose import (
     ROBOT_PREFIX,
@@ -47,10 +50,10 @@ from sim.cells.compose import (
     tip_site_name,
 )
 from sim.cells.seam import Seam
-from sim.cells.tools import TOOLS, ToolSpec, get_tool
-from sim.errors import CellsimError, UnknownNameError
+from sim.cells.tools import TOOLS, ToolSpec
+from sim.errors import CellError, UnknownNameError
 from sim.robots.model import KinematicModel
-from sim.robots.registry import ROBOTS, RobotSpec, get_robot
+from sim.robots.registry import ROBOTS, RobotSpec
 
 #: ``tool="none"`` asks for no tool even where the cell has a default one.
 NO_TOOL = "none"
@@ -64,41 +67,45 @@ class CellSpec:
     Attributes:
         name: Registry name.
         description: One line for ``cellsim list``.
-        robots: Robots the cell is built for.
+        robots: Names of the robots the cell is built for.
         default_tool: Tool used when none is asked for (None: no tool).
         tools: Tools the cell accepts (besides the default).
         mounts: Robot mounts the cell supports.
         build: Builder ``(RobotRig, mount) -> Layout``.
+        needs_tool: The cell's work needs a tool (welding, picking): "no tool" is refused.
     """
 
     name: str
     description: str
     robots: tuple[str, ...]
-    default_tool: str | None
-    tools: tuple[str, ...]
+    default_tool: ToolSpec | None
+    tools: tuple[ToolSpec, ...]
     mounts: tuple[str, ...]
     build: Callable[[RobotRig, str], Layout] = field(repr=False, compare=False)
+    needs_tool: bool = True
 
 
-CELLS: dict[str, CellSpec] = {
-    spec.name: spec
-    for spec in (
-        CellSpec("weld_cylinder",
-                 "5R welding of a large cylinder coaxial with J1 (seed 001); floor or ceiling",
-                 ("robot_5r",), "mig_torch_long", ("mig_torch", "mig_torch_long"),
-                 ("floor", "ceiling"), weld_cylinder.build),
-        CellSpec("weld_table", "welding table: a 1F fillet line and a 2F fillet arc",
-                 ("lrmate100ib", "lrmate200ic5l"), "mig_torch", ("mig_torch", "mig_torch_long"),
-                 ("floor",), weld_table.build),
-        CellSpec("pick", "vacuum pick-and-place of 4 boxes from an infeed table to a tray",
-                 ("lrmate200ic5l",), "vacuum_gripper", ("vacuum_gripper",), ("floor",),
-                 pick.build),
-    )
-}
+_TORCHES = (TOOLS["mig_torch"], TOOLS["mig_torch_long"])
+
+#: The shipped cells by name.
+CELLS: Registry[CellSpec] = Registry("cell")
+for _spec in (
+    CellSpec("weld_cylinder",
+             "5R welding of a large cylinder coaxial with J1 (seed 001); floor or ceiling",
+             ("robot_5r",), TOOLS["mig_torch_long"], _TORCHES, ("floor", "ceiling"),
+             weld_cylinder.build),
+    CellSpec("weld_table", "welding table: a 1F fillet line and a 2F fillet arc",
+             ("lrmate100ib", "lrmate200ic5l"), TOOLS["mig_torch"], _TORCHES, ("floor",),
+             weld_table.build),
+    CellSpec("pick", "vacuum pick-and-place of 4 boxes from an infeed table to a tray",
+             ("lrmate200ic5l",), TOOLS["vacuum_gripper"], (TOOLS["vacuum_gripper"],), ("floor",),
+             pick.build),
+):
+    CELLS.add(_spec.name, _spec)
 
 #: The bare scene's entry (``cell=None``): every robot, any tool or none, both mounts.
 BARE = CellSpec("bare", "the robot alone: floor, lights, cameras", tuple(ROBOTS), None,
-                tuple(TOOLS), MOUNTS, bare.build)
+                tuple(TOOLS.values()), MOUNTS, bare.build, needs_tool=False)
 
 
 @dataclass
@@ -170,21 +177,57 @@ def _check_payload(payload_kg: float) -> float:
     try:
         p = float(payload_kg)
     except (TypeError, ValueError):
-        raise CellsimError(f"payload_kg must be a number >= 0 (kg), got {payload_kg!r}") from None
+        raise CellError(f"payload_kg must be a number >= 0 (kg), got {payload_kg!r}") from None
     if not math.isfinite(p) or p < 0.0:
-        raise CellsimError(f"payload_kg must be a finite number >= 0 (kg), got {payload_kg!r}")
+        raise CellError(f"payload_kg must be a finite number >= 0 (kg), got {payload_kg!r}")
     return p
 
 
-def build_cell(cell: str | None, robot: str, *, tool: str | None = None, mount: str = "floor",
+#: ``build_cell(..., tool=CELL_DEFAULT)``: the cell's default tool.
+CELL_DEFAULT = object()
+
+
+def resolve_tool(cell: CellSpec, name: str | None) -> ToolSpec | None:
+    """The tool a cell gets for a requested tool name.
+
+    Args:
+        cell: The cell (:data:`BARE` for the robot alone).
+        name: A tool name, ``None`` for the cell's default tool, or ``"none"`` for no tool.
+
+    Raises:
+        UnknownNameError: Unknown tool (the message lists the tools).
+        CellError: The cell does not take that tool (the message lists the ones it takes).
+    """
+    if name is None:
+        return cell.default_tool
+    if name == NO_TOOL:
+        return None
+    tool = TOOLS.get(name)
+    _check_tool(cell, tool)
+    return tool
+
+
+def _check_tool(cell: CellSpec, tool: ToolSpec | None) -> None:
+    if tool is None:
+        if cell.needs_tool:
+            raise CellError(f"cell {cell.name!r} needs a tool; tools: "
+                            f"{', '.join(t.name for t in cell.tools)}")
+        return
+    if tool not in cell.tools and tool != cell.default_tool:
+        raise CellError(f"cell {cell.name!r} does not take tool {tool.name!r}; tools: "
+                        f"{', '.join(sorted({*(t.name for t in cell.tools), NO_TOOL}))}")
+
+
+def build_cell(cell: CellSpec | None, robot: RobotSpec, *,
+               tool: ToolSpec | None | object = CELL_DEFAULT, mount: str = "floor",
                payload_kg: float = 0.0) -> Cell:
     """Compose a cell for a robot.
 
     Args:
-        cell: A key of :data:`CELLS`, or None for the robot's bare scene.
-        robot: Robot registry name (``sim.robots.ROBOTS``).
-        tool: Tool name (``sim.cells.tools.TOOLS``); None = the cell's default tool (bare scene: no
-            tool); ``"none"`` = no tool.
+        cell: The cell (an entry of :data:`CELLS`), or None for the robot's bare scene.
+        robot: The robot.
+        tool: The tool, None for no tool, or :data:`CELL_DEFAULT` for the cell's default tool
+            (bare scene: no tool); :func:`resolve_tool` turns a scenario's tool name into one.
         mount: ``"floor"`` or ``"ceiling"`` (each cell lists the ones it supports).
         payload_kg: Lumped payload at the tcp, kg (>= 0).
 
@@ -192,38 +235,23 @@ def build_cell(cell: str | None, robot: str, *, tool: str | None = None, mount: 
         The composed :class:`Cell` (its ``mjcf`` compiles; keyframe ``home`` added).
 
     Raises:
-        UnknownNameError: Unknown cell, robot, tool or mount (the message lists valid ones).
-        CellsimError: Robot or tool or mount not supported by the cell, negative payload.
+        UnknownNameError: Unknown mount (the message lists the valid ones).
+        CellError: Robot, tool or mount not supported by the cell, negative payload.
     """
-    spec_r = get_robot(robot)
-    if cell is None:
-        cspec = BARE
-    else:
-        if cell not in CELLS:
-            raise UnknownNameError("cell", str(cell), CELLS)
-        cspec = CELLS[cell]
+    cspec = BARE if cell is None else cell
+    spec_r = robot
     if spec_r.name not in cspec.robots:
-        raise CellsimError(f"cell {cspec.name!r} is not built for robot {spec_r.name!r}; "
-                           f"robots: {', '.join(cspec.robots)}")
+        raise CellError(f"cell {cspec.name!r} is not built for robot {spec_r.name!r}; "
+                        f"robots: {', '.join(cspec.robots)}")
     if mount not in MOUNTS:
         raise UnknownNameError("mount", str(mount), MOUNTS)
     if mount not in cspec.mounts:
-        raise CellsimError(f"cell {cspec.name!r} does not support mount {mount!r}; "
-                           f"mounts: {', '.join(cspec.mounts)}")
-    if tool is None:
-        tool_name = cspec.default_tool
-    elif tool == NO_TOOL:
-        tool_name = None
-    else:
-        get_tool(tool)  # unknown tool -> UnknownNameError listing the tools
-        if tool not in cspec.tools and tool != cspec.default_tool:
-            raise CellsimError(f"cell {cspec.name!r} does not take tool {tool!r}; tools: "
-                               f"{', '.join(sorted({*cspec.tools, NO_TOOL}))}")
-        tool_name = tool
-    if cspec.name in ("weld_cylinder", "weld_table", "pick") and tool_name is None:
-        raise CellsimError(f"cell {cspec.name!r} needs a tool; tools: {', '.join(cspec.tools)}")
+        raise CellError(f"cell {cspec.name!r} does not support mount {mount!r}; "
+                        f"mounts: {', '.join(cspec.mounts)}")
+    tool_spec = cspec.default_tool if tool is CELL_DEFAULT else tool
+    assert tool_spec is None or isinstance(tool_spec, ToolSpec)
+    _check_tool(cspec, tool_spec)
     payload = _check_payload(payload_kg)
-    tool_spec = None if tool_name is None else get_tool(tool_name)
 
     rig = prepare_robot(spec_r, tool_spec, payload)
     layout = cspec.build(rig, mount)
@@ -243,4 +271,5 @@ def build_cell(cell: str | None, robot: str, *, tool: str | None = None, mount: 
         _rig=rig)
 
 
-__all__ = ["BARE", "CELLS", "MOUNTS", "NO_TOOL", "Cell", "CellSpec", "Seam", "build_cell"]
+__all__ = ["BARE", "CELLS", "CELL_DEFAULT", "MOUNTS", "NO_TOOL", "Cell", "CellSpec", "Seam",
+           "build_cell", "resolve_tool"]

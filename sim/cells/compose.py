@@ -276,7 +276,7 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
         R_mount = Rf @ rotation_between(np.array([0.0, 0.0, 1.0]), st.approach_flange)
         mount = flange_body.add("site", name="tool_mount", pos=pf, quat=quat_from_matrix(R_mount),
                                 size=[0.004], group=4)
-        tool_model = build_tool(tool.name)
+        tool_model = build_tool(tool)
         tool_model.model = TOOL_PREFIX
         mount.attach(tool_model)
         tool_body = tool_model.worldbody.body[0]

@@ -14,7 +14,7 @@ materials below, set explicitly on every geom so the numbers are visible and tes
 
 ``mig_torch`` - a straight (0 deg neck) robotic MIG/MAG torch, 145 mm from the flange face to the
 wire tip (the split of the LR Mate 100iB's l3 = 225 mm into an 80 mm flange and a 145 mm torch,
-``sim/robots.py``), 1.0 kg in total:
+``sim/robots/registry.py``), 1.0 kg in total:
 
 ====================  ============  ====================  ===================================
 part                  z range (mm)  primitive             mass (material)
@@ -38,7 +38,7 @@ aluminium), collision sensor r 34 mm 15-65 mm (0.939 kg, effective 5170 kg/m^3),
 / ID 19), contact tip r 4.5 mm 273-285 mm (0.007 kg), wire 285-300 mm.
 
 With its default torch each robot's tcp is where the seed dimensions put it (100iB: l3 = 80 + 145 =
-225 mm; 5R: l3 = 100 + 300 = 400 mm), so ``sim/robots.py``'s dims hold as they are in the welding
+225 mm; 5R: l3 = 100 + 300 = 400 mm), so ``sim/robots/registry.py``'s dims hold as they are in the welding
 cells. The 15 mm wire stick-out is the contact-tip-to-work distance usual for 1.0-1.2 mm wire in
 short-arc MAG welding. The hose package is not modelled (it hangs from the robot's arm). Torch
 geoms do not collide with anything (``contype = conaffinity = 0``): a welding torch never touches
@@ -77,7 +77,7 @@ from dataclasses import dataclass
 import numpy as np
 from dm_control import mjcf
 
-from sim.errors import UnknownNameError
+from planners.registry import Registry
 
 #: Contact bit masks used across cellsim's cells (MuJoCo ``contype``/``conaffinity``): a contact
 #: is generated when ``(contype1 & conaffinity2) | (contype2 & conaffinity1)`` is non-zero.
@@ -122,9 +122,9 @@ class ToolSpec:
     suction_gain_n: float = 0.0
 
 
-TOOLS: dict[str, ToolSpec] = {
-    spec.name: spec
-    for spec in (
+#: The shipped tools by name.
+TOOLS: Registry[ToolSpec] = Registry("tool")
+for _spec in (
         ToolSpec(
             name="mig_torch",
             description="straight robotic MIG/MAG torch, 145 mm to the wire tip, 1.0 kg",
@@ -147,8 +147,8 @@ TOOLS: dict[str, ToolSpec] = {
             kind="gripper",
             suction_gain_n=SUCTION_GAIN_N,
         ),
-    )
-}
+):
+    TOOLS.add(_spec.name, _spec)
 
 
 def get_tool(name: str) -> ToolSpec:
@@ -157,10 +157,7 @@ def get_tool(name: str) -> ToolSpec:
     Raises:
         UnknownNameError: Not a registered tool; the message lists the known ones.
     """
-    try:
-        return TOOLS[name]
-    except KeyError:
-        raise UnknownNameError("tool", name, TOOLS) from None
+    return TOOLS.get(name)
 
 
 def _cyl_mass(radius: float, length: float, density: float) -> float:
@@ -252,19 +249,15 @@ _BUILDERS = {"mig_torch": _build_torch, "mig_torch_long": _build_torch,
              "vacuum_gripper": _build_vacuum_gripper}
 
 
-def build_tool(name: str) -> mjcf.RootElement:
+def build_tool(spec: ToolSpec) -> mjcf.RootElement:
     """Build a tool's MJCF model in its tool frame (origin on the flange face, +z out).
 
     Args:
-        name: A key of :data:`TOOLS`.
+        spec: The tool.
 
     Returns:
         A ``dm_control.mjcf`` model named ``name`` with one top-level body, a site ``tip`` at
         ``(0, 0, length_m)`` (the tool centre point, oriented as the tool frame) and, for the
         vacuum gripper, a body ``cup`` and an adhesion actuator ``suction``.
-
-    Raises:
-        UnknownNameError: Unknown tool name (the message lists the known ones).
     """
-    spec = get_tool(name)
     return _BUILDERS[spec.name](spec)

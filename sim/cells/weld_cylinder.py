@@ -75,10 +75,9 @@ def phase1_end_q() -> np.ndarray:
 def seam_start_frame0(rig: RobotRig) -> tuple[np.ndarray, np.ndarray]:
     """Closed-form tcp position (3,) and torch axis (3,) at the phase-I end, in frame 0.
 
-    Seed 000 eq. (5) with ``l3 = J4 -> flange + tool length`` (the rig's tool).
+    Seed 000 eq. (5) with the rig's kinematics (``l3 = J4 -> flange + tool length``).
     """
-    dims = {**rig.spec.dims, "l3": rig.statics.flange_axial + rig.tcp_from_flange}
-    R, p = fk_5r(phase1_end_q(), dims)
+    R, p = fk_5r(phase1_end_q(), rig.kinematics().family.dims)
     return p, R[:, 0]
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import importlib
 
 from sim.core.resources import shipped_scenarios
 from sim.errors import CellsimError
@@ -27,24 +26,17 @@ def _scenario_line(name: str, path) -> str:
         return f"  {name:32s} (invalid: {exc})"
 
 
-def _registry_lines(module: str, attr: str) -> list[str] | None:
-    try:
-        mod = importlib.import_module(module)
-    except ModuleNotFoundError:
-        return None
-    return [f"  {name:32s} {getattr(item, 'description', '')}"
-            for name, item in sorted(getattr(mod, attr).items())]
-
-
 def run(args: argparse.Namespace) -> int:
     print("robots:")
     for spec in ROBOTS.values():
         print(f"  {spec.name:32s} {spec.n_joints} axes  {spec.description}")
-    for title, module, attr in (("cells", "sim.cells", "CELLS"), ("tools", "sim.cells.tools", "TOOLS")):
-        lines = _registry_lines(module, attr)
-        if lines is not None:
-            print(f"{title}:")
-            print("\n".join(lines))
+    from sim.cells import CELLS
+    from sim.cells.tools import TOOLS
+
+    for title, registry in (("cells", CELLS), ("tools", TOOLS)):
+        print(f"{title}:")
+        for name, item in sorted(registry.items()):
+            print(f"  {name:32s} {item.description}")
     print("scenarios:")
     for name, path in shipped_scenarios().items():
         print(_scenario_line(name, path))

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from sim.scenario import CartesianPhase, Scenario, load_scenario
+from sim.scenario import CartesianPhase, JointPhase, Scenario, load_scenario
 from sim.simulation.motion import (
     HoldTrajectory,
     Motion,
@@ -48,9 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 def planned_phases(scenario: Scenario) -> list[PhaseMotion]:
     """The scenario's polynomial phases on one clock (Cartesian ones through the cell's IK)."""
     context = None
-    if any(isinstance(p, CartesianPhase) or getattr(p, "target", None) is not None
+    if any(isinstance(p, CartesianPhase) or (isinstance(p, JointPhase) and p.target is not None)
            for p in scenario.phases):
-        from sim.pipeline.run import build
+        from sim.simulation.compile import build
 
         context = build(scenario).context
     motion: Motion = build_motion(scenario, context)

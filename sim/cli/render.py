@@ -14,6 +14,7 @@ import argparse
 from pathlib import Path
 
 from sim.errors import RenderError
+from sim.simulation.runfolder import VIDEO_MP4
 
 
 def _positive_int(text: str) -> int:
@@ -74,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     backend = configure_gl(args.gl)  # before anything imports mujoco
     from sim.render.video import write_video
 
-    out = Path(args.out) if args.out else Path(args.run_dir) / "video.mp4"
+    out = Path(args.out) if args.out else Path(args.run_dir) / VIDEO_MP4
     if out.suffix.lower() != ".mp4":
         raise RenderError(f"--out {str(out)!r} must end in .mp4")
     result = write_video(

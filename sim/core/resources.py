@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from planners.registry import Registry
+
 #: The ``sim`` package folder (this module lives in ``sim/core``).
 _PKG = Path(__file__).resolve().parents[1]
 
@@ -33,6 +35,9 @@ def scenarios_dir() -> Path:
     return _data_dir("scenarios")
 
 
-def shipped_scenarios() -> dict[str, Path]:
-    """Shipped scenarios by name (file stem), sorted."""
-    return {p.stem: p for p in sorted(scenarios_dir().glob("*.toml"))}
+def shipped_scenarios() -> Registry[Path]:
+    """Shipped scenario files by name (file stem), sorted (read from the folder each call)."""
+    registry: Registry[Path] = Registry("scenario")
+    for path in sorted(scenarios_dir().glob("*.toml")):
+        registry.add(path.stem, path)
+    return registry

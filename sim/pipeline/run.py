@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 from sim import __version__
 from sim.errors import InternalError
 from sim.scenario import Scenario
+from sim.simulation import runfolder
 from sim.simulation.compile import BuiltCell, build
 from sim.simulation.metrics import make_summary
 from sim.simulation.motion import build_motion, check_motion_limits
@@ -96,21 +97,6 @@ def manifest(scenario: Scenario) -> dict[str, Any]:
     }
 
 
-def write_csv(path: Path, arrays: dict[str, NDArray[Any]], joints: tuple[str, ...]) -> None:
-    cols: list[tuple[str, NDArray[Any]]] = [("t", arrays["t"]), ("phase", arrays["phase"])]
-    for key in ("q_ref", "qd_ref", "qdd_ref", "q", "qd", "tau", "tau_id"):
-        for j, name in enumerate(joints):
-            cols.append((f"{key}_{name}", arrays[key][:, j]))
-    for key in ("tcp_pos", "tcp_pos_ref"):
-        for a, axis in enumerate("xyz"):
-            cols.append((f"{key}_{axis}", arrays[key][:, a]))
-    for key in ("arc_on", "suction"):
-        cols.append((key, arrays[key].astype(int)))
-    header = ",".join(c for c, _ in cols)
-    data = np.column_stack([np.asarray(v, dtype=float) for _, v in cols])
-    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.9g")
-
-
 def default_out_dir(scenario: Scenario) -> Path:
     return Path("runs") / scenario.name
 
@@ -150,14 +136,15 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
     try:
-        (tmp / "model.xml").write_text(built.xml)
-        (tmp / "scenario.toml").write_text(scenario.text)
-        (tmp / "manifest.json").write_text(json.dumps(manifest(scenario), indent=1) + "\n")
+        runfolder.write_text(tmp, runfolder.MODEL_XML, built.xml)
+        runfolder.write_text(tmp, runfolder.SCENARIO_TOML, scenario.text)
+        runfolder.write_text(tmp, runfolder.MANIFEST_JSON,
+                             json.dumps(manifest(scenario), indent=1) + "\n")
 
         def keep_failed(partial: dict[str, NDArray[Any]], message: str) -> None:
-            np.savez_compressed(tmp / "trajectory.npz", **partial)
-            (tmp / "error.txt").write_text(message + "\n")
-            failed = out_dir.with_name(out_dir.name + ".failed")
+            runfolder.write_trajectory(tmp, partial)
+            runfolder.write_text(tmp, runfolder.ERROR_TXT, message + "\n")
+            failed = runfolder.failed_folder(out_dir)
             if failed.exists():
                 shutil.rmtree(failed)
             os.replace(tmp, failed)
@@ -166,26 +153,28 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
                        settle_s=scenario.simulation.settle_s, progress=options.progress,
                        on_failure=keep_failed)
         arrays = rec.arrays
-        np.savez_compressed(tmp / "trajectory.npz", **arrays)
-        write_csv(tmp / "trajectory.csv", arrays, scenario.robot.joints)
+        runfolder.write_trajectory(tmp, arrays)
+        runfolder.write_csv(tmp, arrays, scenario.robot.joints)
 
         summary = make_summary(scenario, built, motion, rec, feedforward)
-        # written now for the report writers, rewritten complete at the end; the folder only
-        # becomes visible (moved into place) once everything succeeded
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+        # post-processing reads the record in memory, never the files just written; the
+        # folder only becomes visible (moved into place) once everything succeeded
+        record = runfolder.RunRecord.from_arrays(
+            arrays, joints=list(summary["joints"]), phases=summary["phases"],
+            model_path=tmp / runfolder.MODEL_XML, summary=summary)
         if options.plots:
             from sim.analysis.plots import write_plots
 
-            write_plots(tmp)
+            write_plots(record, tmp / runfolder.PLOTS_DIR)
         if options.video:
             from sim.render.video import write_video
 
-            write_video(tmp, tmp / "video.mp4", progress=options.progress, **video_args)
-            summary["video"] = "video.mp4"
-            (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+            write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
+                        **video_args)
+            summary["video"] = runfolder.VIDEO_MP4
         if options.sizing:  # last: report.html links the video when there is one
-            _write_sizing(tmp, scenario, built, arrays, summary)
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+            _write_sizing(tmp, scenario, built, record, summary)
+        runfolder.write_summary(tmp, summary)
     except BaseException:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
@@ -195,7 +184,7 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         os.replace(out_dir, trash / "old")
         shutil.rmtree(trash, ignore_errors=True)
     os.replace(tmp, out_dir)
-    stale = out_dir.with_name(out_dir.name + ".failed")
+    stale = runfolder.failed_folder(out_dir)
     if stale.exists():
         shutil.rmtree(stale, ignore_errors=True)
     return summary
@@ -213,21 +202,21 @@ def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:
     return args
 
 
-def _write_sizing(tmp: Path, scenario: Scenario, built: BuiltCell, arrays: dict[str, Any],
+def _write_sizing(tmp: Path, scenario: Scenario, built: BuiltCell, record: runfolder.RunRecord,
                   summary: dict[str, Any]) -> None:
     from sim.analysis.report import write_sizing
     from sim.analysis.sizing import (
         apply_overrides,
-        armature_from_model,
-        forcerange_from_model,
-        size_run,
+        joint_armature,
+        joint_forcerange,
+        size_record,
     )
 
     drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
-    joints = built.cell.joint_names
-    result = size_run(tmp, scenario.robot, drives, forcerange_from_model(built.model, joints),
-                      armature=armature_from_model(built.model, joints))
-    write_sizing(tmp, result)
+    result = size_record(record, scenario.robot, drives,
+                         joint_forcerange(built.model, built.joint_ids),
+                         armature=joint_armature(built.model, built.joint_ids))
+    write_sizing(tmp, result, summary=summary)
     summary["sizing"] = {"hardest_joint": result.hardest_joint,
                          "hardest_margin_pct": result.hardest_margin_pct,
                          "pass": bool(result.all_pass),
@@ -241,12 +230,12 @@ def _check_tcp_consistency(built: BuiltCell, scenario: Scenario) -> None:
     model = built.model
     data = mujoco.MjData(model)
     rng = np.random.default_rng(0)
-    lo = model.jnt_range[[model.joint(n).id for n in built.cell.joint_names], 0]
-    hi = model.jnt_range[[model.joint(n).id for n in built.cell.joint_names], 1]
+    lo = model.jnt_range[built.joint_ids, 0]
+    hi = model.jnt_range[built.joint_ids, 1]
     q = lo + (hi - lo) * rng.uniform(0.3, 0.7, size=lo.size)
     data.qpos[built.robot_qpos] = q
     mujoco.mj_kinematics(model, data)
-    site = model.site(built.cell.tcp_site).id
+    site = built.tcp_site
     T0 = built.context.world_from_frame0
     T = np.asarray(built.context.kinematics.fk(q), dtype=float)
     p_cf = T0[:3, :3] @ T[:3, 3] + T0[:3, 3]
@@ -256,5 +245,5 @@ def _check_tcp_consistency(built: BuiltCell, scenario: Scenario) -> None:
     if err > 1e-6 or rerr > 1e-6:
         raise InternalError(f"closed-form tcp and MuJoCo tcp differ by "
                            f"{err * 1e3:.3f} mm / {rerr:.2e} in rotation for robot "
-                           f"{scenario.robot.name} with tool {scenario.tool!r}")
+                           f"{scenario.robot.name} with tool {None if scenario.tool is None else scenario.tool.name!r}")
 

@@ -43,6 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 from sim.analysis.report import csv_text, figure_png, write_atomic
 from sim.analysis.sizing import load_summary, load_trajectory, peak_abs, rms
 from sim.errors import CellsimError, SweepError
+from sim.simulation.runfolder import SIZING_JSON
 
 #: Columns of sweep.csv, in order.
 SWEEP_COLUMNS = ("payload_kg", "speed_scale", "joint", "peak_torque_nm", "rms_torque_nm",
@@ -218,7 +219,7 @@ def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
     summary = load_summary(run_dir)
     n = traj["tau"].shape[1]
     names = list(summary.get("joints") or [f"j{k + 1}" for k in range(n)])
-    sizing_path = Path(run_dir) / "sizing.json"
+    sizing_path = Path(run_dir) / SIZING_JSON
     sized: dict[str, dict[str, Any]] = {}
     if sizing_path.is_file():
         try:

@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from sim.errors import UsageError
+
 
 def slerp(q0: np.ndarray, q1: np.ndarray, u: float) -> np.ndarray:
     """Spherical linear interpolation of unit quaternions (w, x, y, z).
@@ -61,7 +63,7 @@ class QposInterpolator:
         t = np.asarray(t, dtype=float)
         qpos = np.asarray(qpos, dtype=float)
         if qpos.ndim != 2 or qpos.shape != (t.size, model.nq):
-            raise ValueError(
+            raise UsageError(
                 f"qpos has shape {qpos.shape}, expected ({t.size}, {model.nq}) (nq of the model)"
             )
         self.t = t

@@ -1,33 +1,40 @@
-"""Scenario layer: the scenario file's declared schema, its units, and loading.
+"""Scenario layer: the scenario file's schema (keys, types, units), the validated scenario,
+and loading.
 
-Owns: :mod:`~sim.scenario.loader` (TOML -> validated :class:`Scenario` whose robot, tool and
-cell are resolved into spec objects once). May import: planners, :mod:`sim.errors`,
-:mod:`sim.core`, :mod:`sim.robots`, :mod:`sim.cells`.
+Owns: :mod:`~sim.scenario.schema` (the declared keys, pydantic), :mod:`~sim.scenario.model`
+(:class:`Scenario` in SI units, with its robot, cell and tool resolved into spec objects
+once), :mod:`~sim.scenario.loader` (TOML -> :class:`Scenario`, one-line errors naming the file
+and key; planning of joint phases). May import: planners, :mod:`sim.errors`, :mod:`sim.core`,
+:mod:`sim.robots`, :mod:`sim.cells`.
 """
 
 from sim.scenario.loader import (
-    Action,
-    ActionSpec,
-    CartesianPhase,
-    CircularPhaseSpec,
-    DriveOverrideSpec,
-    HoldPhase,
-    HoldPhaseSpec,
-    JointPhase,
-    JointPhaseSpec,
-    LinearPhaseSpec,
-    Phase,
     PlannedPhase,
-    PoseTarget,
-    Scenario,
-    ScenarioSpec,
-    SimulationSpec,
-    VideoSpec,
     load_scenario,
     parse_scenario,
     plan_phase,
     plan_scenario,
     resolve_scenario,
+)
+from sim.scenario.model import (
+    Action,
+    CartesianPhase,
+    HoldPhase,
+    JointPhase,
+    Phase,
+    PoseTarget,
+    Scenario,
+)
+from sim.scenario.schema import (
+    ActionSpec,
+    CircularPhaseSpec,
+    DriveOverrideSpec,
+    HoldPhaseSpec,
+    JointPhaseSpec,
+    LinearPhaseSpec,
+    ScenarioSpec,
+    SimulationSpec,
+    VideoSpec,
 )
 
 __all__ = [

@@ -1,4 +1,4 @@
-"""Scenario files: loading, validation and planning.
+"""Scenario files: loading, validation and planning (TOML -> :class:`Scenario`).
 
 A scenario is a TOML file (stdlib :mod:`tomllib`) that names a robot and a list of phases.
 The structure is declared once, with pydantic models below, so that unknown keys, wrong types
@@ -14,421 +14,42 @@ starts with the file name and the dotted path of the offending key, e.g.
 from __future__ import annotations
 
 import difflib
-import hashlib
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError
+from pydantic import BaseModel, ValidationError
 
 from planners.errors import PlannerError
+from planners.registry import get_planner
 from sim.core.resources import shipped_scenarios
-from sim.errors import ScenarioError, UnknownNameError
+from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.robots.registry import RobotSpec, get_robot
-
-# --------------------------------------------------------------------------------------------
-# Declared structure (what the file may contain)
-# --------------------------------------------------------------------------------------------
-
-_NAME_PATTERN = r"^[A-Za-z0-9_.-]+$"
-
-#: Boundary-condition keys of a joint phase: (quantity, end, unit suffix) -> planner keyword.
-_BOUNDARY_KEYS: dict[str, tuple[str, float]] = {}
-for _end, _kw in (("start", "0"), ("end", "f")):
-    for _qty, _sym, _order in (("velocity", "v", 1), ("acceleration", "a", 2), ("jerk", "j", 3)):
-        _unit = "_s" if _order == 1 else f"_s{_order}"
-        _BOUNDARY_KEYS[f"{_end}_{_qty}_deg{_unit}"] = (f"{_sym}{_kw}", math.pi / 180.0)
-        _BOUNDARY_KEYS[f"{_end}_{_qty}_rad{_unit}"] = (f"{_sym}{_kw}", 1.0)
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
-
-
-Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
-PlannerName = Literal["434", "546"]
-
-
-class JointPhaseSpec(_Strict):
-    """A joint-space phase: via points, joined by a piecewise polynomial."""
-
-    name: str = Field(pattern=_NAME_PATTERN, description="phase name, unique in the scenario")
-    kind: Literal["joint"] = Field("joint", description='phase kind: "joint"')
-    planner: PlannerName = Field(description='"434" (seed 001) or "546" (seed 000)')
-    time_s: list[float] | None = Field(None, description="absolute knot times, s")
-    durations_s: list[float] | None = Field(None, description="segment durations, s")
-    joints_deg: list[list[float]] | None = Field(None, description="one row per knot, deg")
-    joints_rad: list[list[float]] | None = Field(None, description="one row per knot, rad")
-    start_velocity_deg_s: list[float] | None = None
-    start_velocity_rad_s: list[float] | None = None
-    end_velocity_deg_s: list[float] | None = None
-    end_velocity_rad_s: list[float] | None = None
-    start_acceleration_deg_s2: list[float] | None = None
-    start_acceleration_rad_s2: list[float] | None = None
-    end_acceleration_deg_s2: list[float] | None = None
-    end_acceleration_rad_s2: list[float] | None = None
-    start_jerk_deg_s3: list[float] | None = None
-    start_jerk_rad_s3: list[float] | None = None
-    end_jerk_deg_s3: list[float] | None = None
-    end_jerk_rad_s3: list[float] | None = None
-    to_mm: Vec3 | None = None
-    to_seam: str | None = None
-    euler_zyx_deg: Vec3 | None = None
-    note: str | None = Field(None, description="free text (e.g. which seed value was chosen)")
-
-
-class _CartesianSpec(_Strict):
-    name: str = Field(pattern=_NAME_PATTERN)
-    planner: PlannerName = "434"
-    seam: str | None = None
-    to_mm: Vec3 | None = None
-    speed_mm_s: float = Field(gt=0)
-    sample_period_s: float = Field(0.1, gt=0)
-    ramp_s: float | None = Field(None, gt=0)
-    euler_zyx_deg: Vec3 | None = None
-    note: str | None = None
-
-
-class LinearPhaseSpec(_CartesianSpec):
-    """A straight move of the tool point at constant speed (ADNIA, seed 003 eq. 1-7)."""
-
-    kind: Literal["linear"]
-    orientation: Literal["keep", "seam", "euler"] = "keep"
-
-
-class CircularPhaseSpec(_CartesianSpec):
-    """A circular arc of the tool point at constant tangential speed (ADNIA, seed 003)."""
-
-    kind: Literal["circular"]
-    via_mm: Vec3 | None = None
-    center_mm: Vec3 | None = None
-    axis: Vec3 | None = None
-    sweep_deg: float | None = None
-    orientation: Literal["keep", "follow", "seam", "euler"] = "follow"
-
-
-class HoldPhaseSpec(_Strict):
-    """The robot holds its pose (e.g. while suction builds up, or to measure static torques)."""
-
-    name: str = Field(pattern=_NAME_PATTERN)
-    kind: Literal["hold"]
-    duration_s: float = Field(gt=0)
-    note: str | None = None
-
-
-def _phase_kind(value: Any) -> str | None:
-    if isinstance(value, dict):
-        kind = value.get("kind", "joint")
-        return kind if isinstance(kind, str) else None
-    return getattr(value, "kind", None)
-
-
-PhaseSpec = Annotated[
-    Union[
-        Annotated[JointPhaseSpec, Tag("joint")],
-        Annotated[LinearPhaseSpec, Tag("linear")],
-        Annotated[CircularPhaseSpec, Tag("circular")],
-        Annotated[HoldPhaseSpec, Tag("hold")],
-    ],
-    Discriminator(_phase_kind),
-]
-PHASE_KINDS: dict[str, type[BaseModel]] = {
-    "joint": JointPhaseSpec, "linear": LinearPhaseSpec, "circular": CircularPhaseSpec,
-    "hold": HoldPhaseSpec,
-}
-
-
-class ActionSpec(_Strict):
-    """A tool action at a time: absolute ``time_s``, or at the start/end of a named phase."""
-
-    action: Literal["arc_on", "arc_off", "suction_on", "suction_off"]
-    time_s: float | None = None
-    phase: str | None = None
-    at: Literal["start", "end"] = "start"
-
-
-class SimulationSpec(_Strict):
-    """Simulation settings."""
-
-    timestep_s: float | None = Field(None, gt=0, le=0.01)
-    feedforward: bool = True
-    settle_s: float = Field(0.0, ge=0)
-    enforce_speed_limits: bool = True
-
-
-class VideoSpec(_Strict):
-    """Default video settings (command-line flags override them)."""
-
-    cameras: list[str] | None = None
-    width: int | None = Field(None, gt=0)
-    height: int | None = Field(None, gt=0)
-    fps: float | None = Field(None, gt=0)
-
-
-class DriveOverrideSpec(_Strict):
-    """Drive-train values of one joint that replace the robot's defaults."""
-
-    gear_ratio: float | None = Field(None, gt=0)
-    efficiency: float | None = Field(None, gt=0, le=1)
-    rotor_inertia_kg_m2: float | None = Field(None, ge=0)
-    rated_torque_nm: float | None = Field(None, gt=0)
-    peak_torque_nm: float | None = Field(None, gt=0)
-    max_speed_rpm: float | None = Field(None, gt=0)
-
-
-class ScenarioSpec(_Strict):
-    """Top level of a scenario file."""
-
-    name: str = Field(pattern=_NAME_PATTERN, description="scenario name")
-    description: str = Field(description="one paragraph shown by `cellsim list`")
-    robot: str = Field(description="robot name (`cellsim list` shows them)")
-    note: str | None = Field(None, description="free text: sources, choices made")
-    cell: str | None = None
-    tool: str | None = None
-    mount: Literal["floor", "ceiling"] = "floor"
-    payload_kg: float = Field(0.0, ge=0)
-    simulation: SimulationSpec = SimulationSpec()
-    video: VideoSpec = VideoSpec()
-    drives: dict[str, DriveOverrideSpec] = {}
-    actions: list[ActionSpec] = []
-    phases: list[PhaseSpec] = Field(min_length=1, description="the work cycle, in order")
-
-
-# --------------------------------------------------------------------------------------------
-# Validated, SI-unit result
-# --------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class JointPhase:
-    """A validated joint-space phase in SI units.
-
-    Attributes:
-        index: Position of the phase in the scenario (0-based).
-        name: Phase name.
-        planner: ``"434"`` or ``"546"``.
-        times: Absolute knot times, s, shape (m+1,); ``None`` when the phase was given by
-            segment durations (it then starts whenever the previous phase ends).
-        durations: Segment durations, s, shape (m,).
-        q: Knot values, rad, shape (m+1, n_joints); with ``durations_s`` the first row is
-            ``NaN`` until the previous phase's end fills it in (see :meth:`with_start`).
-        boundary: Planner keywords (``v0``, ``vf``, ``a0``, ``af``, ``j0``, ``jf``) with arrays
-            of shape (n_joints,) in rad/s^k; absent keys default to 0 in the planner.
-    """
-
-    index: int
-    name: str
-    planner: str
-    times: NDArray[np.float64] | None
-    durations: NDArray[np.float64]
-    q: NDArray[np.float64]
-    boundary: dict[str, NDArray[np.float64]] = field(default_factory=dict)
-    kind: str = "joint"
-    target: "PoseTarget | None" = None
-
-    @property
-    def t0(self) -> float:
-        if self.times is None:
-            raise ValueError(f"phase {self.name} has relative times")
-        return float(self.times[0])
-
-    @property
-    def t1(self) -> float:
-        if self.times is None:
-            raise ValueError(f"phase {self.name} has relative times")
-        return float(self.times[-1])
-
-    @property
-    def starts_from_previous(self) -> bool:
-        return self.times is None
-
-    def with_start(self, t0: float, q0: NDArray[np.float64]) -> "JointPhase":
-        """This phase placed at ``t0`` and, if it starts from the previous phase, from ``q0``."""
-        import dataclasses
-
-        q = self.q.copy()
-        if self.starts_from_previous:
-            q[0] = q0
-        times = (self.times if self.times is not None
-                 else t0 + np.concatenate([[0.0], np.cumsum(self.durations)]))
-        placed = dataclasses.replace(self, times=times, q=q)
-        return placed if self.target is not None else placed.with_end(q[-1])
-
-    def with_end(self, q_end: NDArray[np.float64]) -> "JointPhase":
-        """This phase ending at ``q_end`` (its pose target solved); an automatic via point
-        (NaN row) becomes the joint-space midpoint of start and end."""
-        import dataclasses
-
-        q = self.q.copy()
-        q[-1] = q_end
-        for r in range(1, q.shape[0] - 1):
-            if np.isnan(q[r]).all():
-                q[r] = 0.5 * (q[0] + q_end)
-        return dataclasses.replace(self, q=q)
-
-
-@dataclass(frozen=True)
-class PoseTarget:
-    """Where a joint phase ends, in Cartesian terms (solved by inverse kinematics).
-
-    Attributes:
-        position: tcp position in frame 0, m, (3,), or ``None`` with ``seam``.
-        rotation: tcp orientation in frame 0, (3, 3); ``None`` keeps the previous one.
-        seam: A cell seam whose start (and torch posture) is the target.
-    """
-
-    position: NDArray[np.float64] | None = None
-    rotation: NDArray[np.float64] | None = None
-    seam: str | None = None
-
-
-@dataclass(frozen=True)
-class CartesianPhase:
-    """A validated Cartesian phase (``linear`` or ``circular``), lengths in metres, frame0.
-
-    Attributes:
-        kind: ``"linear"`` or ``"circular"``.
-        seam: Name of a cell seam to follow, or ``None``.
-        to: End point in frame0, m, shape (3,), or ``None`` when ``seam`` gives it.
-        via: Circular only: a point on the arc, frame0, m.
-        center, axis, sweep: Circular only: centre (m), axis (unit), sweep (rad).
-        speed: Travel speed, m/s. sample_period: ADNIA sampling period, s. ramp: ramp time, s.
-        orientation: ``keep``, ``follow``, ``seam`` or ``euler``; ``euler``: R = Rz Ry Rx (rad).
-    """
-
-    index: int
-    name: str
-    kind: str
-    planner: str
-    speed: float
-    sample_period: float
-    ramp: float | None
-    orientation: str
-    seam: str | None = None
-    to: NDArray[np.float64] | None = None
-    via: NDArray[np.float64] | None = None
-    center: NDArray[np.float64] | None = None
-    axis: NDArray[np.float64] | None = None
-    sweep: float | None = None
-    euler_zyx: NDArray[np.float64] | None = None
-
-
-@dataclass(frozen=True)
-class HoldPhase:
-    """The robot holds the pose where the previous phase ended, for ``duration`` s."""
-
-    index: int
-    name: str
-    duration: float
-    kind: str = "hold"
-
-
-@dataclass(frozen=True)
-class Action:
-    """A tool action; ``time`` absolute (s) or ``phase``/``at`` resolved when the run is timed."""
-
-    action: str
-    time: float | None
-    phase: str | None
-    at: str
-
-
-Phase = JointPhase | CartesianPhase | HoldPhase
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """A validated scenario (SI units).
-
-    Attributes:
-        name: Scenario name.
-        description: Free text.
-        robot: The robot's registry entry.
-        phases: Phases in order.
-        source: File the scenario came from.
-        text: The file's text (copied into run folders, hashed into manifests).
-        cell, tool, mount, payload_kg: The cell the robot works in (``None``: bare scene).
-        simulation, video: Settings tables (pydantic models, defaults filled in).
-        drives: Drive-train overrides by joint name: {field: value}, SI units.
-        actions: Tool actions in file order.
-    """
-
-    name: str
-    description: str
-    robot: RobotSpec
-    phases: tuple[Phase, ...]
-    source: Path
-    text: str
-    cell: str | None = None
-    tool: str | None = None
-    mount: str = "floor"
-    payload_kg: float = 0.0
-    simulation: SimulationSpec = SimulationSpec()
-    video: VideoSpec = VideoSpec()
-    drives: dict[str, dict[str, float]] = field(default_factory=dict)
-    actions: tuple[Action, ...] = ()
-
-    @property
-    def sha256(self) -> str:
-        return hashlib.sha256(self.text.encode()).hexdigest()
-
-    def scaled(self, speed_scale: float = 1.0, payload_kg: float | None = None) -> "Scenario":
-        """This scenario run ``speed_scale`` times faster, optionally with another payload.
-
-        Knot times, segment durations, hold durations and action times are divided by
-        ``speed_scale``; Cartesian speeds are multiplied by it (sampling periods and ramps
-        divided), and boundary velocities, accelerations and jerks scale by its 1st, 2nd and 3rd
-        power, so the joint paths are the same, traversed faster. Without gravity, friction and
-        damping, joint torques then scale exactly as ``speed_scale**2``.
-
-        Raises:
-            ScenarioError: ``speed_scale`` not positive, or negative ``payload_kg``.
-        """
-        import dataclasses
-
-        if not (np.isfinite(speed_scale) and speed_scale > 0):
-            raise ScenarioError(f"speed scale must be a positive number, got {speed_scale!r}")
-        if payload_kg is not None and not (np.isfinite(payload_kg) and payload_kg >= 0):
-            raise ScenarioError(f"payload_kg must be >= 0, got {payload_kg!r}")
-        s = float(speed_scale)
-        order = {"v": 1, "a": 2, "j": 3}
-        phases: list[Phase] = []
-        for p in self.phases:
-            if isinstance(p, JointPhase):
-                phases.append(dataclasses.replace(
-                    p, times=None if p.times is None else p.times / s,
-                    durations=p.durations / s,
-                    boundary={k: v * s ** order[k[0]] for k, v in p.boundary.items()}))
-            elif isinstance(p, CartesianPhase):
-                phases.append(dataclasses.replace(
-                    p, speed=p.speed * s, sample_period=p.sample_period / s,
-                    ramp=None if p.ramp is None else p.ramp / s))
-            else:
-                phases.append(dataclasses.replace(p, duration=p.duration / s))
-        actions = tuple(dataclasses.replace(a, time=None if a.time is None else a.time / s)
-                        for a in self.actions)
-        return dataclasses.replace(
-            self, phases=tuple(phases), actions=actions,
-            payload_kg=self.payload_kg if payload_kg is None else float(payload_kg))
-
-    @property
-    def fixed_timing(self) -> bool:
-        """True when every phase is a joint phase with absolute times (no timing to resolve)."""
-        return all(isinstance(p, JointPhase) and p.times is not None for p in self.phases)
-
-    @property
-    def duration(self) -> float:
-        """Total duration, s (joint phases with absolute times only; see ``sim.simulation.motion``)."""
-        first, last = self.phases[0], self.phases[-1]
-        if not (isinstance(first, JointPhase) and isinstance(last, JointPhase)
-                and first.times is not None and last.times is not None):
-            raise ValueError("duration depends on Cartesian planning; plan the motion first")
-        return last.t1 - first.t0
-
+from sim.scenario.model import (
+    Action,
+    CartesianPhase,
+    HoldPhase,
+    JointPhase,
+    Phase,
+    PoseTarget,
+    Scenario,
+)
+from sim.scenario.schema import (
+    _BOUNDARY_KEYS,
+    PHASE_KINDS,
+    ActionSpec,
+    CircularPhaseSpec,
+    DriveOverrideSpec,
+    JointPhaseSpec,
+    LinearPhaseSpec,
+    ScenarioSpec,
+    SimulationSpec,
+    VideoSpec,
+)
 
 # --------------------------------------------------------------------------------------------
 # Loading
@@ -445,11 +66,9 @@ def resolve_scenario(ref: str | Path) -> Path:
     if path.is_file():
         return path
     shipped = shipped_scenarios()
-    if str(ref) in shipped:
-        return shipped[str(ref)]
-    if path.suffix == ".toml" or path.parent != Path("."):
+    if str(ref) not in shipped and (path.suffix == ".toml" or path.parent != Path(".")):
         raise ScenarioError(f"{ref}: no such scenario file")
-    raise UnknownNameError("scenario", str(ref), shipped)
+    return shipped.get(str(ref))
 
 
 def load_scenario(ref: str | Path) -> Scenario:
@@ -517,9 +136,19 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
             phase = HoldPhase(index=i, name=pspec.name, duration=pspec.duration_s)
         phases.append(phase)
 
-    _check_registry_name(where, "cell", spec.cell, "sim.cells", "CELLS")
-    _check_registry_name(where, "tool", spec.tool, "sim.cells.tools", "TOOLS")
-    effective_tool, tool_kind = _effective_tool(spec)
+    # imported here: sim.cells imports mujoco, and the command line must be able to choose the
+    # OpenGL backend (MUJOCO_GL) after loading a scenario
+    from sim.cells import BARE, CELLS, resolve_tool
+
+    try:
+        cell = None if spec.cell is None else CELLS.get(spec.cell)
+    except UnknownNameError as exc:
+        raise ScenarioError(f"{where}: cell: {exc}") from None
+    try:
+        tool = resolve_tool(BARE if cell is None else cell, spec.tool)
+    except CellsimError as exc:
+        raise ScenarioError(f"{where}: tool: {exc}") from None
+    tool_kind = None if tool is None else tool.kind
     drives: dict[str, dict[str, float]] = {}
     for joint, override in spec.drives.items():
         if joint not in robot.joints:
@@ -540,7 +169,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         need = "gripper" if a.action.startswith("suction") else "torch"
         if tool_kind != need:
             raise ScenarioError(f"{where}: actions[{i}].action: {a.action} needs a {need} tool "
-                                f"(the tool is {effective_tool or 'none'})")
+                                f"(the tool is {'none' if tool is None else tool.name})")
         actions.append(Action(a.action, a.time_s, a.phase, a.at))
     return Scenario(
         name=spec.name,
@@ -549,8 +178,8 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         phases=tuple(phases),
         source=Path(source),
         text=text,
-        cell=spec.cell,
-        tool=spec.tool,
+        cell=cell,
+        tool=tool,
         mount=spec.mount,
         payload_kg=spec.payload_kg,
         simulation=spec.simulation,
@@ -558,33 +187,6 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         drives=drives,
         actions=tuple(actions),
     )
-
-
-def _effective_tool(spec: ScenarioSpec) -> tuple[str | None, str | None]:
-    """The tool a scenario ends up with (its own, or its cell's default) and that tool's kind."""
-    from sim.cells import CELLS
-    from sim.cells.tools import TOOLS
-
-    tool = spec.tool
-    if tool is None and spec.cell is not None:
-        tool = CELLS[spec.cell].default_tool
-    if tool in (None, "none"):
-        return None, None
-    return tool, TOOLS[tool].kind
-
-
-def _check_registry_name(where: str, kind: str, name: str | None, module: str, attr: str) -> None:
-    """Unknown cell/tool names are user mistakes; the message lists the known ones."""
-    if name is None:
-        return
-    import importlib
-
-    try:
-        registry = getattr(importlib.import_module(module), attr)
-    except ModuleNotFoundError:
-        registry = {}
-    if name not in registry:
-        raise ScenarioError(f"{where}: {kind}: {UnknownNameError(kind, name, registry)}")
 
 
 def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where: str) -> JointPhase:
@@ -874,8 +476,6 @@ def plan_phase(phase: JointPhase, where: str = "") -> Any:
     Raises:
         ScenarioError: The planner rejected the phase (message prefixed with ``where``).
     """
-    from planners.registry import get_planner
-
     try:
         return get_planner(phase.planner)(phase.times, phase.q, **phase.boundary)
     except PlannerError as exc:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,12 +20,31 @@ from sim.errors import InternalError
 from sim.scenario import Scenario
 from sim.simulation.motion import CartesianContext
 
+if TYPE_CHECKING:  # sim.cells imports mujoco: the command line picks MUJOCO_GL first
+    from sim.cells import Cell
+    from sim.robots.model import KinematicModel
+
 
 @dataclass
 class BuiltCell:
-    """A compiled cell and the handles the runner needs."""
+    """A compiled cell and every id the simulation needs, resolved once.
 
-    cell: Any
+    Attributes:
+        cell: The composed cell.
+        model: The compiled ``mujoco.MjModel`` (with the runner's sensors).
+        xml: The compiled model as MJCF (``model.xml`` of the run folder).
+        robot_qpos, robot_dof: qpos and dof addresses of the robot joints, in order, (n,).
+        robot_act: Ids of the robot's position actuators, in joint order, (n,).
+        suction_act: Id of the suction actuator, or None.
+        sensor_slices: Slices of ``sensordata`` by recorded quantity (``tau0..``, ``tcp_pos``,
+            ``tcp_quat``).
+        part_qpos: qpos addresses (7 each: position, quaternion) of the parts' free joints.
+        context: Kinematics, seams and frame 0 for the Cartesian phases.
+        joint_ids: Ids of the robot joints, in order, (n,).
+        tcp_site, frame0_site: Ids of the sites ``tcp`` and ``frame0``.
+    """
+
+    cell: Cell
     model: Any
     xml: str
     robot_qpos: NDArray[np.int64]
@@ -35,6 +54,9 @@ class BuiltCell:
     sensor_slices: dict[str, slice]
     part_qpos: list[NDArray[np.int64]]
     context: CartesianContext
+    joint_ids: NDArray[np.int64]
+    tcp_site: int
+    frame0_site: int
 
 
 # --------------------------------------------------------------------------------------------
@@ -49,7 +71,7 @@ def build(scenario: Scenario) -> BuiltCell:
     from sim.cells import build_cell
     from sim.robots.model import closed_form_model
 
-    cell = build_cell(scenario.cell, scenario.robot.name, tool=scenario.tool,
+    cell = build_cell(scenario.cell, scenario.robot, tool=scenario.tool,
                       mount=scenario.mount, payload_kg=scenario.payload_kg)
     root = cell.mjcf
     if scenario.simulation.timestep_s is not None:
@@ -66,7 +88,7 @@ def build(scenario: Scenario) -> BuiltCell:
     try:
         model = mujoco.MjModel.from_xml_string(xml, root.get_assets())
     except ValueError as exc:  # a bug in a cell builder, not a user mistake
-        raise InternalError(f"cell {scenario.cell!r} does not compile: {exc}") from exc
+        raise InternalError(f"cell {cell.name!r} does not compile: {exc}") from exc
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "model.xml"
         mujoco.mj_saveLastXML(str(path), model)
@@ -76,23 +98,26 @@ def build(scenario: Scenario) -> BuiltCell:
     for name, size in sensors:
         slices[name] = slice(start, start + size)
         start += size
-    jids = [model.joint(n).id for n in cell.joint_names]
+    jids = np.array([model.joint(n).id for n in cell.joint_names])
     robot_qpos = np.array([model.jnt_qposadr[j] for j in jids])
     robot_dof = np.array([model.jnt_dofadr[j] for j in jids])
     robot_act = np.array([model.actuator(n).id for n in cell.actuator_names])
-    suction = (model.actuator(cell.adhesion_actuator).id
-               if getattr(cell, "adhesion_actuator", None) else None)
+    suction = (None if cell.adhesion_actuator is None
+               else model.actuator(cell.adhesion_actuator).id)
     part_qpos = [np.arange(model.jnt_qposadr[model.body(p).jntadr[0]],
                            model.jnt_qposadr[model.body(p).jntadr[0]] + 7)
-                 for p in getattr(cell, "parts", [])]
-    kin = _tool_kinematics(closed_form_model(scenario.robot), model, cell, robot_qpos)
-    ctx = CartesianContext(kinematics=kin, seams=dict(getattr(cell, "seams", {})),
+                 for p in cell.parts]
+    tcp_site, frame0_site = model.site(cell.tcp_site).id, model.site(cell.frame0_site).id
+    kin = _tool_kinematics(closed_form_model(scenario.robot), model, frame0_site, tcp_site,
+                           robot_qpos)
+    ctx = CartesianContext(kinematics=kin, seams=dict(cell.seams),
                            world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float))
     return BuiltCell(cell, model, saved_xml, robot_qpos, robot_dof, robot_act, suction, slices,
-                     part_qpos, ctx)
+                     part_qpos, ctx, jids, tcp_site, frame0_site)
 
 
-def _tool_kinematics(kin: Any, model: Any, cell: Any, robot_qpos: NDArray[np.int64]) -> Any:
+def _tool_kinematics(kin: KinematicModel, model: Any, f0: int, tcp: int,
+                     robot_qpos: NDArray[np.int64]) -> KinematicModel:
     """The closed-form kinematics with the attached tool, measured from the compiled cell.
 
     Tools are straight (their tip lies on the seeds' tool axis), so the tool changes one
@@ -101,14 +126,11 @@ def _tool_kinematics(kin: Any, model: Any, cell: Any, robot_qpos: NDArray[np.int
     in ``frame0`` at q = 0, where the seeds put the tool point at ``(l1 + l2 + l3, 0, d1)`` and
     ``(d2 + R4 + R6 + r, 0, d3 + d4)``; :func:`_check_tcp_consistency` then checks the whole pose.
     """
-
     import mujoco
 
     data = mujoco.MjData(model)
     data.qpos[robot_qpos] = 0.0
     mujoco.mj_kinematics(model, data)
-    f0 = model.site(cell.frame0_site).id
-    tcp = model.site(cell.tcp_site).id
     p = data.site_xmat[f0].reshape(3, 3).T @ (data.site_xpos[tcp] - data.site_xpos[f0])
     return kin.with_family(kin.family.tool_from_home_tcp(p))
 

@@ -82,7 +82,7 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
 def pick_metrics(arrays: dict[str, NDArray[Any]], built: BuiltCell, tol_mm: float = 5.0
                  ) -> dict[str, Any] | None:
     """For pick cells: final part positions against their slots."""
-    slots = np.asarray(getattr(built.cell, "slots", np.zeros((0, 3))), dtype=float)
+    slots = np.asarray(built.cell.slots, dtype=float)
     if "part_pos" not in arrays or slots.size == 0:
         return None
     final = arrays["part_pos"][-1]
@@ -102,8 +102,8 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
     summary: dict[str, Any] = {
         "scenario": scenario.name,
         "robot": scenario.robot.name,
-        "cell": scenario.cell,
-        "tool": scenario.tool,
+        "cell": None if scenario.cell is None else scenario.cell.name,
+        "tool": None if scenario.tool is None else scenario.tool.name,
         "mount": scenario.mount,
         "payload_kg": scenario.payload_kg,
         "joints": list(scenario.robot.joints),

@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from planners.base import JointState, sample_times
 from planners.errors import PlannerError
 from sim.errors import CellsimError, ScenarioError
-from sim.scenario.loader import (
+from sim.scenario import (
     CartesianPhase,
     HoldPhase,
     JointPhase,

@@ -1,24 +1,29 @@
-"""Reading a finished run folder (what ``cellsim run`` writes) for rendering and plots.
+"""The run folder: its schema (file names, array names, units), writing and reading it.
 
-A run folder DIR holds:
+This module is the one place that knows what a run folder holds. The runner writes through it
+(:func:`write_trajectory`, :func:`write_summary`, :func:`write_csv`, :func:`write_text`),
+and sizing, plots, video and ``cellsim render`` read through it: in the runner from the
+in-memory :class:`RunRecord`, afterwards with :func:`load_run`.
+
+A run folder DIR holds (``FILES`` lists them):
 
 * ``model.xml``: the compiled cell (``mujoco.MjModel.from_xml_path``);
+* ``scenario.toml``: the scenario as given; ``manifest.json``: versions and hashes;
 * ``summary.json``: ``scenario``, ``robot``, ``joints`` (names), ``phases``
-  (``[{"name", "kind", "t0", "t1"}]``), ``duration_s``, ...;
-* ``trajectory.npz``: ``t`` (N,) s, ``phase`` (N,) phase index, ``qpos`` (N, nq) full MuJoCo
-  qpos, ``q_ref``/``qd_ref``/``qdd_ref``/``qddd_ref``/``q``/``qd``/``tau``/``tau_id``
-  (N, n_joints) in rad, rad/s, rad/s^2, rad/s^3, N m, ``tcp_pos``/``tcp_pos_ref`` (N, 3) m in the
-  world frame, ``tcp_quat`` (N, 4), ``arc_on``/``suction`` (N,) bool, ``knot_t`` (K,) s.
+  (``[{"name", "kind", "t0", "t1"}]``), ``duration_s``, metrics, ``sizing`` verdict, ...;
+* ``trajectory.npz``: the recorded arrays (``ARRAYS`` gives each one's shape and unit);
+  ``trajectory.csv``: the main ones as columns;
+* ``video.mp4``, ``plots/*.png``, the sizing report (``sizing.md``, ``sizing.csv``,
+  ``sizing.json``, ``report.html``, ``sizing/*.png``).
 
-:class:`RunRecord` can also be built from arrays in memory (:meth:`RunRecord.from_arrays`),
-so the runner can render without writing and reading the folder back.
+A run that fails mid-simulation keeps what it recorded in ``DIR.failed/`` with ``error.txt``.
 """
 
 from __future__ import annotations
 
 import json
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,6 +31,65 @@ from typing import Any
 import numpy as np
 
 from sim.errors import RunFolderError
+
+# ------------------------------------------------------------------------------------ schema
+MODEL_XML = "model.xml"
+SCENARIO_TOML = "scenario.toml"
+MANIFEST_JSON = "manifest.json"
+SUMMARY_JSON = "summary.json"
+TRAJECTORY_NPZ = "trajectory.npz"
+TRAJECTORY_CSV = "trajectory.csv"
+VIDEO_MP4 = "video.mp4"
+PLOTS_DIR = "plots"
+ERROR_TXT = "error.txt"
+SIZING_MD = "sizing.md"
+SIZING_CSV = "sizing.csv"
+SIZING_JSON = "sizing.json"
+REPORT_HTML = "report.html"
+SIZING_CHARTS_DIR = "sizing"
+#: Suffix of the folder a failed run leaves next to the one it would have written.
+FAILED_SUFFIX = ".failed"
+
+#: Every file (or folder) a complete run folder may hold, in the order a person reads them.
+FILES: tuple[str, ...] = (SUMMARY_JSON, REPORT_HTML, SIZING_MD, SIZING_CSV, SIZING_JSON,
+                          SIZING_CHARTS_DIR, VIDEO_MP4, PLOTS_DIR, TRAJECTORY_NPZ,
+                          TRAJECTORY_CSV, MODEL_XML, SCENARIO_TOML, MANIFEST_JSON)
+
+
+@dataclass(frozen=True)
+class ArraySpec:
+    """One recorded array: its shape (N samples, n joints, P parts, K knots) and unit."""
+
+    shape: str
+    unit: str
+    description: str
+
+
+#: The arrays of ``trajectory.npz`` (SI units; positions in the world frame).
+ARRAYS: dict[str, ArraySpec] = {
+    "t": ArraySpec("(N,)", "s", "sample time"),
+    "phase": ArraySpec("(N,)", "-", "index of the phase (summary.json 'phases')"),
+    "q_ref": ArraySpec("(N, n)", "rad", "reference joint position"),
+    "qd_ref": ArraySpec("(N, n)", "rad/s", "reference joint speed"),
+    "qdd_ref": ArraySpec("(N, n)", "rad/s^2", "reference joint acceleration"),
+    "qddd_ref": ArraySpec("(N, n)", "rad/s^3", "reference joint jerk"),
+    "q": ArraySpec("(N, n)", "rad", "simulated joint position"),
+    "qd": ArraySpec("(N, n)", "rad/s", "simulated joint speed"),
+    "qdd": ArraySpec("(N, n)", "rad/s^2", "simulated joint acceleration (velocity increments)"),
+    "tau": ArraySpec("(N, n)", "N m", "joint torque the drive delivers (servo + feed-forward)"),
+    "tau_actuator": ArraySpec("(N, n)", "N m", "position servo's part of tau"),
+    "tau_ff": ArraySpec("(N, n)", "N m", "feed-forward part of tau"),
+    "tau_id": ArraySpec("(N, n)", "N m", "inverse dynamics of the reference"),
+    "tcp_pos": ArraySpec("(N, 3)", "m", "simulated tool point, world"),
+    "tcp_pos_ref": ArraySpec("(N, 3)", "m", "reference tool point, world"),
+    "tcp_quat": ArraySpec("(N, 4)", "-", "simulated tcp orientation (w, x, y, z), world"),
+    "qpos": ArraySpec("(N, nq)", "m, rad, -", "full MuJoCo qpos (robot, parts)"),
+    "arc_on": ArraySpec("(N,)", "bool", "welding arc on"),
+    "suction": ArraySpec("(N,)", "bool", "suction on"),
+    "knot_t": ArraySpec("(K,)", "s", "knot times of the joint polynomials"),
+    "part_pos": ArraySpec("(N, P, 3)", "m", "part positions, world"),
+    "part_quat": ArraySpec("(N, P, 4)", "-", "part orientations (w, x, y, z), world"),
+}
 
 #: Arrays every run must have to be rendered.
 REQUIRED_FOR_VIDEO: tuple[str, ...] = ("t", "qpos")
@@ -278,21 +342,21 @@ def load_run(run_dir: str | Path) -> RunRecord:
         raise RunFolderError(
             f"{where} does not exist or is not a folder (give the folder `cellsim run` wrote)"
         )
-    missing = [n for n in ("model.xml", "trajectory.npz") if not (folder / n).is_file()]
+    missing = [n for n in (MODEL_XML, TRAJECTORY_NPZ) if not (folder / n).is_file()]
     if missing:
         raise RunFolderError(
             f"{where} lacks {', '.join(missing)} (a run folder holds model.xml, summary.json and "
             "trajectory.npz)"
         )
     try:
-        with np.load(folder / "trajectory.npz", allow_pickle=False) as npz:
+        with np.load(folder / TRAJECTORY_NPZ, allow_pickle=False) as npz:
             arrays = {name: npz[name] for name in npz.files}
     except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
         raise RunFolderError(f"{where}: trajectory.npz does not load ({exc})") from exc
     summary: Any = {}
-    if (folder / "summary.json").is_file():
+    if (folder / SUMMARY_JSON).is_file():
         try:
-            summary = json.loads((folder / "summary.json").read_text())
+            summary = json.loads((folder / SUMMARY_JSON).read_text())
         except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
             raise RunFolderError(f"{where}: summary.json is not valid JSON ({exc})") from exc
         if not isinstance(summary, dict):
@@ -311,7 +375,7 @@ def load_run(run_dir: str | Path) -> RunRecord:
         arrays=arrays,
         joints=list(joints),
         phases=[_phase(p, f"{where}: summary.json") for p in phases_raw],
-        model_path=folder / "model.xml",
+        model_path=folder / MODEL_XML,
         summary=summary,
         source=folder,
     )
@@ -322,3 +386,51 @@ def load_run(run_dir: str | Path) -> RunRecord:
 def as_record(run: str | Path | RunRecord) -> RunRecord:
     """A :class:`RunRecord` from a run folder path or a record (returned as is)."""
     return run if isinstance(run, RunRecord) else load_run(run)
+
+
+# ------------------------------------------------------------------------------------ writing
+def write_text(folder: str | Path, name: str, text: str) -> Path:
+    """Write one of the folder's text files (``MODEL_XML``, ``SCENARIO_TOML``, ...)."""
+    path = Path(folder) / name
+    path.write_text(text)
+    return path
+
+
+def write_summary(folder: str | Path, summary: Mapping[str, Any]) -> Path:
+    """Write ``summary.json`` (one-space indent, trailing newline)."""
+    return write_text(folder, SUMMARY_JSON, json.dumps(summary, indent=1) + "\n")
+
+
+def write_trajectory(folder: str | Path, arrays: Mapping[str, np.ndarray]) -> Path:
+    """Write ``trajectory.npz`` (compressed) from the recorded arrays (see ``ARRAYS``)."""
+    path = Path(folder) / TRAJECTORY_NPZ
+    np.savez_compressed(path, **arrays)
+    return path
+
+
+#: Joint arrays written to ``trajectory.csv`` (one column per joint: ``q_ref_j1``, ...).
+CSV_JOINT_ARRAYS: tuple[str, ...] = ("q_ref", "qd_ref", "qdd_ref", "q", "qd", "tau", "tau_id")
+
+
+def write_csv(folder: str | Path, arrays: Mapping[str, np.ndarray], joints: Sequence[str]
+              ) -> Path:
+    """Write ``trajectory.csv``: t, phase, the joint arrays per joint, tool points, tool state."""
+    cols: list[tuple[str, np.ndarray]] = [("t", arrays["t"]), ("phase", arrays["phase"])]
+    for key in CSV_JOINT_ARRAYS:
+        for j, name in enumerate(joints):
+            cols.append((f"{key}_{name}", arrays[key][:, j]))
+    for key in ("tcp_pos", "tcp_pos_ref"):
+        for a, axis in enumerate("xyz"):
+            cols.append((f"{key}_{axis}", arrays[key][:, a]))
+    for key in ("arc_on", "suction"):
+        cols.append((key, arrays[key].astype(int)))
+    header = ",".join(c for c, _ in cols)
+    data = np.column_stack([np.asarray(v, dtype=float) for _, v in cols])
+    path = Path(folder) / TRAJECTORY_CSV
+    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.9g")
+    return path
+
+
+def failed_folder(out_dir: Path) -> Path:
+    """Where a run that failed mid-simulation keeps what it recorded."""
+    return out_dir.with_name(out_dir.name + FAILED_SUFFIX)

@@ -93,7 +93,6 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
     n_steps = int(round((motion.duration + settle_s) / dt))
     t = motion.t0 + dt * np.arange(n_steps + 1)
     ref = motion.at(t)
-    nj = motion.n_joints
     kp = model.actuator_gainprm[built.robot_act, 0]
     kv = -model.actuator_biasprm[built.robot_act, 2]
 

@@ -1,0 +1,248 @@
+"""A validated scenario in SI units: its phases, tool actions, robot, cell and tool objects."""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.errors import ScenarioError, UsageError
+from sim.robots.registry import RobotSpec
+from sim.scenario.schema import SimulationSpec, VideoSpec
+
+if TYPE_CHECKING:
+    from sim.cells import CellSpec
+    from sim.cells.tools import ToolSpec
+
+
+@dataclass(frozen=True)
+class JointPhase:
+    """A validated joint-space phase in SI units.
+
+    Attributes:
+        index: Position of the phase in the scenario (0-based).
+        name: Phase name.
+        planner: ``"434"`` or ``"546"``.
+        times: Absolute knot times, s, shape (m+1,); ``None`` when the phase was given by
+            segment durations (it then starts whenever the previous phase ends).
+        durations: Segment durations, s, shape (m,).
+        q: Knot values, rad, shape (m+1, n_joints); with ``durations_s`` the first row is
+            ``NaN`` until the previous phase's end fills it in (see :meth:`with_start`).
+        boundary: Planner keywords (``v0``, ``vf``, ``a0``, ``af``, ``j0``, ``jf``) with arrays
+            of shape (n_joints,) in rad/s^k; absent keys default to 0 in the planner.
+    """
+
+    index: int
+    name: str
+    planner: str
+    times: NDArray[np.float64] | None
+    durations: NDArray[np.float64]
+    q: NDArray[np.float64]
+    boundary: dict[str, NDArray[np.float64]] = field(default_factory=dict)
+    kind: str = "joint"
+    target: "PoseTarget | None" = None
+
+    @property
+    def t0(self) -> float:
+        if self.times is None:
+            raise UsageError(f"phase {self.name} has relative times")
+        return float(self.times[0])
+
+    @property
+    def t1(self) -> float:
+        if self.times is None:
+            raise UsageError(f"phase {self.name} has relative times")
+        return float(self.times[-1])
+
+    @property
+    def starts_from_previous(self) -> bool:
+        return self.times is None
+
+    def with_start(self, t0: float, q0: NDArray[np.float64]) -> "JointPhase":
+        """This phase placed at ``t0`` and, if it starts from the previous phase, from ``q0``."""
+        import dataclasses
+
+        q = self.q.copy()
+        if self.starts_from_previous:
+            q[0] = q0
+        times = (self.times if self.times is not None
+                 else t0 + np.concatenate([[0.0], np.cumsum(self.durations)]))
+        placed = dataclasses.replace(self, times=times, q=q)
+        return placed if self.target is not None else placed.with_end(q[-1])
+
+    def with_end(self, q_end: NDArray[np.float64]) -> "JointPhase":
+        """This phase ending at ``q_end`` (its pose target solved); an automatic via point
+        (NaN row) becomes the joint-space midpoint of start and end."""
+        import dataclasses
+
+        q = self.q.copy()
+        q[-1] = q_end
+        for r in range(1, q.shape[0] - 1):
+            if np.isnan(q[r]).all():
+                q[r] = 0.5 * (q[0] + q_end)
+        return dataclasses.replace(self, q=q)
+
+
+@dataclass(frozen=True)
+class PoseTarget:
+    """Where a joint phase ends, in Cartesian terms (solved by inverse kinematics).
+
+    Attributes:
+        position: tcp position in frame 0, m, (3,), or ``None`` with ``seam``.
+        rotation: tcp orientation in frame 0, (3, 3); ``None`` keeps the previous one.
+        seam: A cell seam whose start (and torch posture) is the target.
+    """
+
+    position: NDArray[np.float64] | None = None
+    rotation: NDArray[np.float64] | None = None
+    seam: str | None = None
+
+
+@dataclass(frozen=True)
+class CartesianPhase:
+    """A validated Cartesian phase (``linear`` or ``circular``), lengths in metres, frame0.
+
+    Attributes:
+        kind: ``"linear"`` or ``"circular"``.
+        seam: Name of a cell seam to follow, or ``None``.
+        to: End point in frame0, m, shape (3,), or ``None`` when ``seam`` gives it.
+        via: Circular only: a point on the arc, frame0, m.
+        center, axis, sweep: Circular only: centre (m), axis (unit), sweep (rad).
+        speed: Travel speed, m/s. sample_period: ADNIA sampling period, s. ramp: ramp time, s.
+        orientation: ``keep``, ``follow``, ``seam`` or ``euler``; ``euler``: R = Rz Ry Rx (rad).
+    """
+
+    index: int
+    name: str
+    kind: str
+    planner: str
+    speed: float
+    sample_period: float
+    ramp: float | None
+    orientation: str
+    seam: str | None = None
+    to: NDArray[np.float64] | None = None
+    via: NDArray[np.float64] | None = None
+    center: NDArray[np.float64] | None = None
+    axis: NDArray[np.float64] | None = None
+    sweep: float | None = None
+    euler_zyx: NDArray[np.float64] | None = None
+
+
+@dataclass(frozen=True)
+class HoldPhase:
+    """The robot holds the pose where the previous phase ended, for ``duration`` s."""
+
+    index: int
+    name: str
+    duration: float
+    kind: str = "hold"
+
+
+@dataclass(frozen=True)
+class Action:
+    """A tool action; ``time`` absolute (s) or ``phase``/``at`` resolved when the run is timed."""
+
+    action: str
+    time: float | None
+    phase: str | None
+    at: str
+
+
+Phase = JointPhase | CartesianPhase | HoldPhase
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario (SI units).
+
+    Attributes:
+        name: Scenario name.
+        description: Free text.
+        robot: The robot's registry entry.
+        phases: Phases in order.
+        source: File the scenario came from.
+        text: The file's text (copied into run folders, hashed into manifests).
+        cell: The cell the robot works in (``None``: the robot's bare scene).
+        tool: The tool it carries, resolved (the scenario's, else the cell's default), or None.
+        mount, payload_kg: Robot mount (``"floor"``/``"ceiling"``) and lumped payload, kg.
+        simulation, video: Settings tables (pydantic models, defaults filled in).
+        drives: Drive-train overrides by joint name: {field: value}, SI units.
+        actions: Tool actions in file order.
+    """
+
+    name: str
+    description: str
+    robot: RobotSpec
+    phases: tuple[Phase, ...]
+    source: Path
+    text: str
+    cell: CellSpec | None = None
+    tool: ToolSpec | None = None
+    mount: str = "floor"
+    payload_kg: float = 0.0
+    simulation: SimulationSpec = SimulationSpec()
+    video: VideoSpec = VideoSpec()
+    drives: dict[str, dict[str, float]] = field(default_factory=dict)
+    actions: tuple[Action, ...] = ()
+
+    @property
+    def sha256(self) -> str:
+        return hashlib.sha256(self.text.encode()).hexdigest()
+
+    def scaled(self, speed_scale: float = 1.0, payload_kg: float | None = None) -> "Scenario":
+        """This scenario run ``speed_scale`` times faster, optionally with another payload.
+
+        Knot times, segment durations, hold durations and action times are divided by
+        ``speed_scale``; Cartesian speeds are multiplied by it (sampling periods and ramps
+        divided), and boundary velocities, accelerations and jerks scale by its 1st, 2nd and 3rd
+        power, so the joint paths are the same, traversed faster. Without gravity, friction and
+        damping, joint torques then scale exactly as ``speed_scale**2``.
+
+        Raises:
+            ScenarioError: ``speed_scale`` not positive, or negative ``payload_kg``.
+        """
+        import dataclasses
+
+        if not (np.isfinite(speed_scale) and speed_scale > 0):
+            raise ScenarioError(f"speed scale must be a positive number, got {speed_scale!r}")
+        if payload_kg is not None and not (np.isfinite(payload_kg) and payload_kg >= 0):
+            raise ScenarioError(f"payload_kg must be >= 0, got {payload_kg!r}")
+        s = float(speed_scale)
+        order = {"v": 1, "a": 2, "j": 3}
+        phases: list[Phase] = []
+        for p in self.phases:
+            if isinstance(p, JointPhase):
+                phases.append(dataclasses.replace(
+                    p, times=None if p.times is None else p.times / s,
+                    durations=p.durations / s,
+                    boundary={k: v * s ** order[k[0]] for k, v in p.boundary.items()}))
+            elif isinstance(p, CartesianPhase):
+                phases.append(dataclasses.replace(
+                    p, speed=p.speed * s, sample_period=p.sample_period / s,
+                    ramp=None if p.ramp is None else p.ramp / s))
+            else:
+                phases.append(dataclasses.replace(p, duration=p.duration / s))
+        actions = tuple(dataclasses.replace(a, time=None if a.time is None else a.time / s)
+                        for a in self.actions)
+        return dataclasses.replace(
+            self, phases=tuple(phases), actions=actions,
+            payload_kg=self.payload_kg if payload_kg is None else float(payload_kg))
+
+    @property
+    def fixed_timing(self) -> bool:
+        """True when every phase is a joint phase with absolute times (no timing to resolve)."""
+        return all(isinstance(p, JointPhase) and p.times is not None for p in self.phases)
+
+    @property
+    def duration(self) -> float:
+        """Total duration, s (joint phases with absolute times only; see ``sim.simulation.motion``)."""
+        first, last = self.phases[0], self.phases[-1]
+        if not (isinstance(first, JointPhase) and isinstance(last, JointPhase)
+                and first.times is not None and last.times is not None):
+            raise UsageError("duration depends on Cartesian planning; plan the motion first")
+        return last.t1 - first.t0

@@ -1,0 +1,181 @@
+"""The scenario file's declared schema: every key, its type and its unit.
+
+The structure is declared once, with pydantic models, so that unknown keys, wrong types and NaN
+are rejected with one line naming the key; the format reference (``docs/scenario-format.md``)
+documents the same keys and a test keeps the two in step. Keys carry their units in their names
+(``joints_deg``, ``points_mm``, ``speed_mm_s``); :mod:`sim.scenario.loader` converts them to SI.
+Planner names come from the planner registry (``planners.registry.PLANNERS``).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal, Union
+
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag
+
+from planners.registry import PLANNERS
+
+_NAME_PATTERN = r"^[A-Za-z0-9_.-]+$"
+
+#: Boundary-condition keys of a joint phase: (quantity, end, unit suffix) -> planner keyword.
+_BOUNDARY_KEYS: dict[str, tuple[str, float]] = {}
+for _end, _kw in (("start", "0"), ("end", "f")):
+    for _qty, _sym, _order in (("velocity", "v", 1), ("acceleration", "a", 2), ("jerk", "j", 3)):
+        _unit = "_s" if _order == 1 else f"_s{_order}"
+        _BOUNDARY_KEYS[f"{_end}_{_qty}_deg{_unit}"] = (f"{_sym}{_kw}", math.pi / 180.0)
+        _BOUNDARY_KEYS[f"{_end}_{_qty}_rad{_unit}"] = (f"{_sym}{_kw}", 1.0)
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
+
+
+Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+#: Planner names the schema accepts: the planner registry's (``planners.registry.PLANNERS``).
+PlannerName = Literal[PLANNERS.names()]  # type: ignore[valid-type]
+
+
+class JointPhaseSpec(_Strict):
+    """A joint-space phase: via points, joined by a piecewise polynomial."""
+
+    name: str = Field(pattern=_NAME_PATTERN, description="phase name, unique in the scenario")
+    kind: Literal["joint"] = Field("joint", description='phase kind: "joint"')
+    planner: PlannerName = Field(description='"434" (seed 001) or "546" (seed 000)')
+    time_s: list[float] | None = Field(None, description="absolute knot times, s")
+    durations_s: list[float] | None = Field(None, description="segment durations, s")
+    joints_deg: list[list[float]] | None = Field(None, description="one row per knot, deg")
+    joints_rad: list[list[float]] | None = Field(None, description="one row per knot, rad")
+    start_velocity_deg_s: list[float] | None = None
+    start_velocity_rad_s: list[float] | None = None
+    end_velocity_deg_s: list[float] | None = None
+    end_velocity_rad_s: list[float] | None = None
+    start_acceleration_deg_s2: list[float] | None = None
+    start_acceleration_rad_s2: list[float] | None = None
+    end_acceleration_deg_s2: list[float] | None = None
+    end_acceleration_rad_s2: list[float] | None = None
+    start_jerk_deg_s3: list[float] | None = None
+    start_jerk_rad_s3: list[float] | None = None
+    end_jerk_deg_s3: list[float] | None = None
+    end_jerk_rad_s3: list[float] | None = None
+    to_mm: Vec3 | None = None
+    to_seam: str | None = None
+    euler_zyx_deg: Vec3 | None = None
+    note: str | None = Field(None, description="free text (e.g. which seed value was chosen)")
+
+
+class _CartesianSpec(_Strict):
+    name: str = Field(pattern=_NAME_PATTERN)
+    planner: PlannerName = "434"
+    seam: str | None = None
+    to_mm: Vec3 | None = None
+    speed_mm_s: float = Field(gt=0)
+    sample_period_s: float = Field(0.1, gt=0)
+    ramp_s: float | None = Field(None, gt=0)
+    euler_zyx_deg: Vec3 | None = None
+    note: str | None = None
+
+
+class LinearPhaseSpec(_CartesianSpec):
+    """A straight move of the tool point at constant speed (ADNIA, seed 003 eq. 1-7)."""
+
+    kind: Literal["linear"]
+    orientation: Literal["keep", "seam", "euler"] = "keep"
+
+
+class CircularPhaseSpec(_CartesianSpec):
+    """A circular arc of the tool point at constant tangential speed (ADNIA, seed 003)."""
+
+    kind: Literal["circular"]
+    via_mm: Vec3 | None = None
+    center_mm: Vec3 | None = None
+    axis: Vec3 | None = None
+    sweep_deg: float | None = None
+    orientation: Literal["keep", "follow", "seam", "euler"] = "follow"
+
+
+class HoldPhaseSpec(_Strict):
+    """The robot holds its pose (e.g. while suction builds up, or to measure static torques)."""
+
+    name: str = Field(pattern=_NAME_PATTERN)
+    kind: Literal["hold"]
+    duration_s: float = Field(gt=0)
+    note: str | None = None
+
+
+def _phase_kind(value: Any) -> str | None:
+    if isinstance(value, dict):
+        kind = value.get("kind", "joint")
+        return kind if isinstance(kind, str) else None
+    return getattr(value, "kind", None)
+
+
+PhaseSpec = Annotated[
+    Union[
+        Annotated[JointPhaseSpec, Tag("joint")],
+        Annotated[LinearPhaseSpec, Tag("linear")],
+        Annotated[CircularPhaseSpec, Tag("circular")],
+        Annotated[HoldPhaseSpec, Tag("hold")],
+    ],
+    Discriminator(_phase_kind),
+]
+PHASE_KINDS: dict[str, type[BaseModel]] = {
+    "joint": JointPhaseSpec, "linear": LinearPhaseSpec, "circular": CircularPhaseSpec,
+    "hold": HoldPhaseSpec,
+}
+
+
+class ActionSpec(_Strict):
+    """A tool action at a time: absolute ``time_s``, or at the start/end of a named phase."""
+
+    action: Literal["arc_on", "arc_off", "suction_on", "suction_off"]
+    time_s: float | None = None
+    phase: str | None = None
+    at: Literal["start", "end"] = "start"
+
+
+class SimulationSpec(_Strict):
+    """Simulation settings."""
+
+    timestep_s: float | None = Field(None, gt=0, le=0.01)
+    feedforward: bool = True
+    settle_s: float = Field(0.0, ge=0)
+    enforce_speed_limits: bool = True
+
+
+class VideoSpec(_Strict):
+    """Default video settings (command-line flags override them)."""
+
+    cameras: list[str] | None = None
+    width: int | None = Field(None, gt=0)
+    height: int | None = Field(None, gt=0)
+    fps: float | None = Field(None, gt=0)
+
+
+class DriveOverrideSpec(_Strict):
+    """Drive-train values of one joint that replace the robot's defaults."""
+
+    gear_ratio: float | None = Field(None, gt=0)
+    efficiency: float | None = Field(None, gt=0, le=1)
+    rotor_inertia_kg_m2: float | None = Field(None, ge=0)
+    rated_torque_nm: float | None = Field(None, gt=0)
+    peak_torque_nm: float | None = Field(None, gt=0)
+    max_speed_rpm: float | None = Field(None, gt=0)
+
+
+class ScenarioSpec(_Strict):
+    """Top level of a scenario file."""
+
+    name: str = Field(pattern=_NAME_PATTERN, description="scenario name")
+    description: str = Field(description="one paragraph shown by `cellsim list`")
+    robot: str = Field(description="robot name (`cellsim list` shows them)")
+    note: str | None = Field(None, description="free text: sources, choices made")
+    cell: str | None = None
+    tool: str | None = None
+    mount: Literal["floor", "ceiling"] = "floor"
+    payload_kg: float = Field(0.0, ge=0)
+    simulation: SimulationSpec = SimulationSpec()
+    video: VideoSpec = VideoSpec()
+    drives: dict[str, DriveOverrideSpec] = {}
+    actions: list[ActionSpec] = []
+    phases: list[PhaseSpec] = Field(min_length=1, description="the work cycle, in order")

@@ -1,0 +1,173 @@
+"""The house rules: layers import downwards only, one exception root, one registry type."""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import inspect
+import pkgutil
+import warnings
+from pathlib import Path
+
+import pytest
+
+import planners
+import sim
+from planners.errors import CellsimError
+from planners.registry import PLANNERS, Registry
+from sim.cells import CELLS
+from sim.cells.tools import TOOLS
+from sim.core.resources import shipped_scenarios
+from sim.layers import LAYERS, layer_of
+from sim.robots.registry import ROBOTS
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _modules() -> list[tuple[str, Path]]:
+    out = []
+    for package in ("planners", "sim"):
+        for path in sorted((ROOT / package).rglob("*.py")):
+            rel = path.relative_to(ROOT).with_suffix("")
+            parts = list(rel.parts)
+            if parts[-1] == "__init__":
+                parts.pop()
+            out.append((".".join(parts), path))
+    return out
+
+
+MODULES = _modules()
+MODULE_NAMES = {m for m, _ in MODULES}
+
+
+def _imports(module: str, path: Path) -> list[tuple[int, str]]:
+    """Every cellsim module ``module`` imports (also inside functions and TYPE_CHECKING)."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    found = []
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, a.name) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - (node.level - 1)]
+                name = ".".join(base + ([node.module] if node.module else []))
+            else:
+                name = node.module or ""
+            found.append((node.lineno, name))
+            # "from sim.render import gl" imports the module sim.render.gl
+            found += [(node.lineno, f"{name}.{a.name}") for a in node.names
+                      if f"{name}.{a.name}" in MODULE_NAMES]
+    return [(ln, n) for ln, n in found if n.split(".")[0] in ("sim", "planners")]
+
+
+def test_every_module_has_a_layer():
+    for module, _ in MODULES:
+        layer_of(module)  # raises for a module no layer claims
+
+
+@pytest.mark.parametrize("module,path", MODULES, ids=[m for m, _ in MODULES])
+def test_no_module_imports_a_higher_layer(module, path):
+    own = layer_of(module)
+    for line, name in _imports(module, path):
+        other = layer_of(name)
+        assert other <= own, (
+            f"{path.relative_to(ROOT)}:{line}: {module} (layer {LAYERS[own][0]}) imports "
+            f"{name} (layer {LAYERS[other][0]}, higher)")
+
+
+def test_the_layer_check_catches_an_upward_import(tmp_path):
+    """The checker itself: a robots module importing the pipeline is reported."""
+    bad = tmp_path / "bad.py"
+    bad.write_text("def f():\n    from sim.pipeline.run import run_scenario\n")
+    names = [n for _, n in _imports("sim.robots.bad", bad)]
+    assert "sim.pipeline.run" in names
+    assert layer_of("sim.pipeline.run") > layer_of("sim.robots.bad")
+
+
+def test_sim_top_level_keeps_at_most_four_modules():
+    top = [p.name for p in (ROOT / "sim").glob("*.py")]
+    assert len(top) <= 4, top
+
+
+def test_every_sim_package_says_what_it_owns():
+    for init in (ROOT / "sim").glob("*/__init__.py"):
+        doc = ast.get_docstring(ast.parse(init.read_text()))
+        assert doc and "import" in doc.lower(), f"{init.relative_to(ROOT)} lacks a layer docstring"
+
+
+def _all_classes() -> list[type]:
+    classes = []
+    for package in (planners, sim):
+        names = [package.__name__] + [m.name for m in pkgutil.walk_packages(
+            package.__path__, package.__name__ + ".")]
+        for name in names:
+            if name == "sim.__main__":
+                continue  # running it would start the command line
+            mod = importlib.import_module(name)  # a broken module fails here, loudly
+            classes += [obj for _, obj in inspect.getmembers(mod, inspect.isclass)
+                        if obj.__module__ == name]
+    return classes
+
+
+def test_every_exception_derives_from_the_root():
+    classes = _all_classes()
+    exceptions = [c for c in classes if issubclass(c, BaseException)]
+    assert len(exceptions) >= 20  # the walk found the tree, not an empty list
+    stray = [f"{c.__module__}.{c.__qualname__}" for c in exceptions
+             if not issubclass(c, CellsimError)]
+    assert not stray, f"exceptions outside the CellsimError tree: {stray}"
+
+
+def test_warnings_are_cellsim_errors_too():
+    from sim.errors import CellsimWarning, SingularityWarning
+
+    assert issubclass(SingularityWarning, CellsimWarning)
+    assert issubclass(SingularityWarning, UserWarning)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(CellsimError):
+            warnings.warn("x", SingularityWarning, stacklevel=1)
+
+
+@pytest.mark.parametrize("registry", [ROBOTS, TOOLS, CELLS, PLANNERS, shipped_scenarios()],
+                         ids=["robots", "tools", "cells", "planners", "scenarios"])
+def test_every_registry_is_the_one_type_and_suggests_names(registry):
+    from sim.errors import UnknownNameError
+
+    assert isinstance(registry, Registry)
+    name = registry.names()[0]
+    assert registry.get(name) is registry[name]
+    with pytest.raises(UnknownNameError) as info:
+        registry.get(name + "x")
+    msg = str(info.value)
+    assert f"did you mean {name!r}" in msg and "\n" not in msg
+    for n in registry.names():
+        assert n in msg
+
+
+def test_registry_refuses_a_name_twice():
+    from sim.errors import InternalError
+
+    r: Registry[int] = Registry("thing")
+    r.add("a", 1)
+    with pytest.raises(InternalError):
+        r.add("a", 2)
+
+
+def test_scenario_schema_takes_planner_names_from_the_registry():
+    from typing import get_args
+
+    from sim.scenario.schema import PlannerName
+
+    assert set(get_args(PlannerName)) == set(PLANNERS.names())
+
+
+def test_no_string_tests_on_the_kinematic_family():
+    """A family is an object: nothing compares it (or its name) with a string."""
+    for module, path in MODULES:
+        text = path.read_text()
+        for needle in ('family == "', 'family != "', "family == '", 'family.name == "',
+                       'family.name != "', 'family in ("'):
+            assert needle not in text, f"{path.relative_to(ROOT)}: {needle}"
