@@ -47,7 +47,7 @@ from sim.cells.tools import (
 )
 from sim.errors import CellsimError
 from sim.robots.model import KinematicModel, kinematic_model
-from sim.robots.registry import RobotSpec, get_robot
+from sim.robots.registry import RobotSpec
 
 ROBOT_PREFIX = "robot"
 TOOL_PREFIX = "tool"
@@ -152,12 +152,11 @@ def robot_statics(spec: RobotSpec) -> RobotStatics:
     Raises:
         CellsimError: The model file is missing or lacks the sites the cells rely on.
     """
-    return _robot_statics(spec.name)
+    return _robot_statics(spec)
 
 
 @lru_cache(maxsize=None)
-def _robot_statics(name: str) -> RobotStatics:
-    spec = get_robot(name)  # cache key: the registry name (RobotSpec holds arrays, not hashable)
+def _robot_statics(spec: RobotSpec) -> RobotStatics:
     if not spec.robot_path.is_file():
         raise CellsimError(f"robot {spec.name!r}: model file {spec.robot_path} is missing")
     m = mujoco.MjModel.from_xml_path(str(spec.robot_path))
@@ -231,7 +230,7 @@ class RobotRig:
     def max_distance_from_frame0(self) -> float:
         """Upper bound of the tcp's distance from frame 0 (sum of link lengths), m."""
         reach = self.statics.flange_axial + self.tcp_from_flange
-        return self.spec.family.arm_length() + reach
+        return self.spec.family.reach() + reach
 
     def kinematics(self) -> KinematicModel:
         """Closed-form kinematic model whose tool frame is this rig's tcp (the tool tip).

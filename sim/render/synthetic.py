@@ -18,11 +18,12 @@ models or on the simulator. The folder has the layout ``cellsim run`` writes
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
+
+from sim.simulation import runfolder
 
 #: Joint names of the demo arm.
 JOINTS: tuple[str, ...] = ("j1", "j2", "j3", "j4")
@@ -169,7 +170,7 @@ def write_synthetic_run(
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     xml = demo_model_xml(offwidth, offheight)
-    (folder / "model.xml").write_text(xml)
+    runfolder.write_text(folder, runfolder.MODEL_XML, xml)
     model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
 
@@ -226,8 +227,7 @@ def write_synthetic_run(
     arc_on = (t >= weld[2] * duration) & (t <= weld[3] * duration)
     suction = np.zeros(n, dtype=bool)
 
-    np.savez_compressed(
-        folder / "trajectory.npz",
+    runfolder.write_trajectory(folder, dict(
         t=t,
         phase=phase,
         qpos=qpos,
@@ -245,7 +245,7 @@ def write_synthetic_run(
         arc_on=arc_on,
         suction=suction,
         knot_t=knot_t,
-    )
+    ))
     summary = {
         "scenario": "synthetic_demo",
         "robot": "demo_arm",
@@ -253,5 +253,5 @@ def write_synthetic_run(
         "phases": phases,
         "duration_s": duration,
     }
-    (folder / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    runfolder.write_summary(folder, summary)
     return folder

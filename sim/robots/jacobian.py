@@ -34,6 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sim.errors import KinematicsError
 from sim.robots.families import FiveR
+from sim.robots.families.base import geometric_from_frames
 from sim.robots.model import KinematicModel
 
 
@@ -47,10 +48,7 @@ def geometric_jacobian(model: KinematicModel, q: ArrayLike) -> NDArray[np.float6
     Returns:
         J, shape (6, n) or (N, 6, n): rows v (m/s per rad/s) then omega (rad/s per rad/s).
     """
-    axes, points, T = model.joint_frames(q)
-    p = T[..., :3, 3]
-    lin = np.cross(axes, p[..., None, :] - points)
-    return np.concatenate([np.swapaxes(lin, -1, -2), np.swapaxes(axes, -1, -2)], axis=-2)
+    return geometric_from_frames(*model.joint_frames(q))
 
 
 def task_jacobian_5r(model: KinematicModel, q: ArrayLike) -> NDArray[np.float64]:

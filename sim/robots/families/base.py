@@ -23,6 +23,15 @@ from numpy.typing import ArrayLike, NDArray
 from sim.errors import KinematicsError
 
 
+def geometric_from_frames(axes: NDArray[np.float64], points: NDArray[np.float64],
+                          T: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Geometric Jacobian from joint axes (..., n, 3), points on them (..., n, 3) and the tool
+    frame (..., 4, 4): column ``i = [z_i x (p - o_i); z_i]``, shape (..., 6, n)."""
+    p = T[..., :3, 3]
+    lin = np.cross(axes, p[..., None, :] - points)
+    return np.concatenate([np.swapaxes(lin, -1, -2), np.swapaxes(axes, -1, -2)], axis=-2)
+
+
 class KinematicFamily(ABC):
     """One arm structure and its dimensions (metres).
 
@@ -97,6 +106,13 @@ class KinematicFamily(ABC):
         T = self.joint_frames(np.atleast_2d(Q))[2]
         return T[0] if Q.ndim == 1 else T
 
+    def jacobian(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Geometric Jacobian of the seed tool frame in frame 0, rows ``[v; omega]``:
+        (6, n) or (N, 6, n) for q of shape (n,) or (N, n)."""
+        Q = np.asarray(q, dtype=float)
+        J = geometric_from_frames(*self.joint_frames(np.atleast_2d(Q)))
+        return J[0] if Q.ndim == 1 else J
+
     @abstractmethod
     def home_approach(self) -> NDArray[np.float64]:
         """Approach axis of the seed tool frame at q = 0, in frame 0, shape (3,)."""
@@ -159,8 +175,11 @@ class KinematicFamily(ABC):
         """
 
     @abstractmethod
-    def arm_length(self) -> float:
-        """Sum of the link lengths from frame 0 to the wrist, m (an upper bound of its reach)."""
+    def reach(self) -> float:
+        """Upper bound of the wrist's distance from frame 0: the sum of the link lengths, m.
+
+        (:func:`sim.robots.workspace.compute_reach` finds the reach inside the joint ranges.)
+        """
 
     # ------------------------------------------------------------------ tcp frame
     def check_tcp_offset(self, robot: str, offset: NDArray[np.float64]) -> None:

@@ -213,6 +213,6 @@ class Fanuc6(KinematicFamily):
         d = self._dims
         return Fanuc6(d, tool_length=float(p[0] - d["d2"] - d["R4"] - d["R6"]))
 
-    def arm_length(self) -> float:
+    def reach(self) -> float:
         d = self._dims
         return d["d2"] + d["d3"] + float(np.hypot(d["R4"], d["d4"]))

@@ -217,7 +217,7 @@ class FiveR(KinematicFamily):
         d = self._dims
         return FiveR({**d, "l3": float(p[0] - d["l1"] - d["l2"])})
 
-    def arm_length(self) -> float:
+    def reach(self) -> float:
         d = self._dims
         return d["l1"] + d["d1"] + d["l2"]
 
