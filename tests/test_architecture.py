@@ -171,3 +171,25 @@ def test_no_string_tests_on_the_kinematic_family():
         for needle in ('family == "', 'family != "', "family == '", 'family.name == "',
                        'family.name != "', 'family in ("'):
             assert needle not in text, f"{path.relative_to(ROOT)}: {needle}"
+
+
+def test_cli_exit_codes_separate_user_mistakes_from_internal_faults(monkeypatch, capsys):
+    """A user mistake is one line and exit 2; an internal fault prints its traceback, exit 3."""
+    import sim.cli.list as list_command
+    from sim.cli import main
+    from sim.errors import InternalError, ScenarioError
+
+    def mistake(args):
+        raise ScenarioError("x.toml: phases[0].time_s: knot times must increase")
+
+    def fault(args):
+        raise InternalError("closed-form tcp and MuJoCo tcp differ")
+
+    monkeypatch.setattr(list_command, "run", mistake)
+    assert main(["list"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == "cellsim: error: x.toml: phases[0].time_s: knot times must increase"
+    monkeypatch.setattr(list_command, "run", fault)
+    assert main(["list"]) == 3
+    err = capsys.readouterr().err
+    assert "Traceback" in err and "internal error" in err and "report" in err
