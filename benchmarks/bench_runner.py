@@ -8,7 +8,7 @@ reference motion, then times, over the same model and number of steps:
 * ``total``: :func:`sim.simulation.simulate.simulate` as a whole (inverse dynamics of the reference,
   controls, rollout, recording).
 
-and prints ``sim/bare`` (target <= 1.5) and ``total/bare`` with the real-time factor.
+and prints ``sim/bare`` (target <= 1.2) and ``total/bare`` with the real-time factor.
 
 Usage: python benchmarks/bench_runner.py [SCENARIO ...] [--repeat N]
 """
@@ -22,9 +22,10 @@ import mujoco
 import numpy as np
 
 from sim.core.resources import shipped_scenarios
-from sim.pipeline.run import build, simulate
 from sim.scenario import load_scenario
+from sim.simulation.compile import build
 from sim.simulation.motion import build_motion
+from sim.simulation.simulate import simulate
 
 
 def bare_loop(model: mujoco.MjModel, n: int, q0: np.ndarray, built) -> float:

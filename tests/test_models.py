@@ -446,3 +446,24 @@ def test_robot_5r_phase1_end_pose_in_readme():
     radial = np.array([np.cos(q[0]), np.sin(q[0]), 0])
     assert p[2] < 0 and np.hypot(p[0], p[1]) > 0.5
     assert Rm[2, 0] < -0.8 and Rm[:, 0] @ radial < 0
+
+
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_acceleration_limits_are_derived_from_the_drive_train(name):
+    """The registry's acceleration limits are the drive-train derivation with the rated payload
+    (sim/robots/accel_limits.py), rounded down to two significant digits, and the model's README
+    lists them."""
+    from sim.robots.accel_limits import derive_accel_limits
+
+    spec = ROBOTS[name]
+    derived = np.degrees(derive_accel_limits(spec, spec.payload_kg))
+    stored = np.degrees(np.asarray(spec.max_accel))
+    assert stored.shape == (spec.n_joints,)
+    assert np.all(stored <= derived)
+    assert np.all(stored >= 0.9 * derived)
+    readme = (spec.robot_path.parent / "README.md").read_text()
+    section = readme.split("## Acceleration limits", 1)[1].split("\n## ", 1)[0]
+    for joint, value in zip(spec.joints, stored):
+        assert re.search(rf"^\| {joint} \| [^|]+ \| [^|]+ \| {value:,.0f} \|$", section, re.M), joint
+    # a heavier payload can only lower them (the derivation is monotone in the load)
+    assert np.all(np.degrees(derive_accel_limits(spec, 2 * spec.payload_kg + 1)) <= derived + 1e-9)

@@ -134,6 +134,8 @@ class Cell:
         tip_site: The tool's own ``tip`` site (coincides with ``tcp_site``), or None.
         dims: Key dimensions for reports (m, deg where the name says so).
         description: The cell's one-line description.
+        frictionloss: Coulomb friction of each robot joint, N m, (n,), applied by the friction
+            actuators ``robot/friction_jN`` (:mod:`sim.cells.compose`).
     """
 
     name: str
@@ -158,6 +160,7 @@ class Cell:
     tip_site: str | None = None
     dims: dict[str, float] = field(default_factory=dict)
     description: str = ""
+    frictionloss: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     _rig: RobotRig | None = field(default=None, repr=False)
 
     def compile(self) -> mujoco.MjModel:
@@ -268,6 +271,7 @@ def build_cell(cell: CellSpec | None, robot: RobotSpec, *,
         adhesion_actuator=suction_actuator_name(rig), home_q=np.asarray(home_q, float),
         start_q=layout.start_q, payload_kg=payload, tip_site=tip_site_name(rig),
         dims={k: float(v) for k, v in layout.dims.items()}, description=cspec.description,
+        frictionloss=rig.statics.frictionloss.copy(),
         _rig=rig)
 
 

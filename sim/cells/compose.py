@@ -47,9 +47,11 @@ from sim.cells.tools import (
 )
 from sim.errors import CellsimError
 from sim.robots.model import KinematicModel, kinematic_model
-from sim.robots.registry import RobotSpec
+from sim.robots.registry import COULOMB_SPEED, RobotSpec
 
 ROBOT_PREFIX = "robot"
+#: Name prefix of the robot's friction actuators (``robot/friction_j1``, ...).
+FRICTION_PREFIX = "friction_"
 TOOL_PREFIX = "tool"
 STEEL_DENSITY = 7850.0
 #: Offscreen framebuffer (pixels): large enough for 1280x720 and 1920x1080 renders.
@@ -126,6 +128,8 @@ class RobotStatics:
         flange_axial: Distance along the approach axis from the J4 axis (5r) or the wrist centre
             (fanuc6, J5 anchor) to the flange, m, measured in the MJCF.
         home_q: Joint values of the robot's ``home`` keyframe (zeros without one), rad, (n,).
+        frictionloss: Coulomb friction of each robot joint, N m, (n,) (the MJCF's
+            ``frictionloss``; the composed robot applies it with friction actuators).
     """
 
     base_from_frame0: NDArray[np.float64]
@@ -137,6 +141,7 @@ class RobotStatics:
     tcp_minus_flange: float
     flange_axial: float
     home_q: NDArray[np.float64]
+    frictionloss: NDArray[np.float64]
 
 
 def _site_pose(m: mujoco.MjModel, d: mujoco.MjData, name: str) -> NDArray[np.float64]:
@@ -195,6 +200,8 @@ def _robot_statics(spec: RobotSpec) -> RobotStatics:
         tcp_minus_flange=along,
         flange_axial=flange_axial,
         home_q=home,
+        frictionloss=np.array([m.dof_frictionloss[m.jnt_dofadr[mujoco.mj_name2id(
+            m, mujoco.mjtObj.mjOBJ_JOINT, j)]] for j in spec.joints]),
     )
 
 
@@ -263,6 +270,19 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
         # implicitfast diverged with an adhesion-held 0.5 kg part (the part tumbles); the full
         # implicit integrator (also supported by mj_inverse's invdiscrete) holds it: see sim.cells.tools
         robot.option.integrator = "implicit"
+    # Coulomb friction as the drives see it (sim.robots.registry.coulomb): MuJoCo's frictionloss
+    # is a soft constraint whose force depends on the timestep; a friction actuator per joint
+    # applies F * clip(qd / COULOMB_SPEED, -1, 1) exactly (affine velocity bias, clamped to +-F,
+    # integrated implicitly like damping)
+    for j, F in zip(spec.joints, st.frictionloss, strict=True):
+        if F <= 0.0:
+            continue
+        joint = robot.find("joint", j)
+        joint.frictionloss = 0.0
+        robot.actuator.add("general", name=f"{FRICTION_PREFIX}{j}", joint=joint, gaintype="fixed",
+                           gainprm=[0.0], biastype="affine",
+                           biasprm=[0.0, 0.0, -float(F) / COULOMB_SPEED], ctrllimited=False,
+                           forcelimited=True, forcerange=[-float(F), float(F)])
     flange = robot.find("site", "flange")
     tcp = robot.find("site", "tcp")
     if flange is None or tcp is None:

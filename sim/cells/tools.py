@@ -92,6 +92,11 @@ TIP_SITE = "tip"
 CUP_BODY = "cup"
 SUCTION_ACTUATOR = "suction"
 
+#: Time constant of the vacuum in the cup, s: suction builds and decays as a first-order lag
+#: of the valve command (about 50 ms for a small cup on an ejector); the scenario's 0.3 s dwells
+#: leave it at 99.8 %. A step in the adhesion force instead struck the held part against the lip
+#: and made the torque peak depend on the timestep.
+VACUUM_TIME_CONSTANT_S = 0.05
 #: Vacuum-gripper suction parameters (see the module docstring for where they come from).
 SUCTION_GAIN_N = 40.0
 SUCTION_GAP_M = 0.003

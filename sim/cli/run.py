@@ -6,6 +6,12 @@ The folder (default ``runs/<scenario name>/``) holds ``summary.json``, ``traject
 ``report.html``), ``plots/`` and ``video.mp4``. It is written atomically: a failed run leaves
 no ``summary.json``; a run that fails mid-simulation keeps what it recorded in
 ``<folder>.failed/``.
+
+The run's verdict (``summary.json`` ``"verdict"``, :mod:`sim.analysis.verdict`) fails when the
+run tracks worse than its tolerance, saturates a drive, exceeds a speed or acceleration limit
+or a sizing limit; the failed checks are printed. Exit codes: 0 when the run was simulated
+(whatever its verdict), 1 with ``--strict`` when the verdict is fail, 2 for a mistake in the
+input.
 """
 
 from __future__ import annotations
@@ -36,6 +42,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--camera", action="append", metavar="NAME",
                    help="cell camera to film (repeat to tile several side by side)")
     p.add_argument("--quiet", action="store_true", help="no progress bars, only the result line")
+    p.add_argument("--strict", action="store_true",
+                   help="exit with 1 when the run's verdict is fail (a saturated drive, a joint "
+                        "over its speed or acceleration limit, tracking worse than the "
+                        "tolerance, a sizing limit exceeded)")
     p.set_defaults(func=run)
 
 
@@ -82,5 +92,16 @@ def run(args: argparse.Namespace) -> int:
         s = summary["sizing"]
         print(f"  sizing: hardest joint {s['hardest_joint']} (margin {s['hardest_margin_pct']:.1f} %),"
               f" {'all pass' if s['pass'] else 'FAIL'}")
+    failed = [c for c in summary.get("checks", []) if not c["pass"]]
+    for s in summary.get("saturation", [])[:10]:
+        print(f"  saturation {s['joint']}: {s['t0']:.3f}-{s['t1']:.3f} s ({s['phase']}), "
+              f"demand over the drive's limit by up to {s['worst_excess_nm']:.4g} N m")
+    if failed:
+        print(f"  verdict: FAIL ({len(failed)} check(s) failed)")
+        for c in failed:
+            print(f"    {c['name']} {c['joint']}: {c['value']:.4g} {c['unit']} against the "
+                  f"limit {c['limit']:.4g} {c['unit']}")
+    else:
+        print(f"  verdict: pass ({len(summary.get('checks', []))} checks)")
     print(f"  results in {out}/")
-    return 0
+    return 1 if args.strict and summary.get("verdict") == "fail" else 0

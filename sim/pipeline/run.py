@@ -1,24 +1,19 @@
-"""The scenario runner: build the cell, plan, simulate with position actuators, record.
+"""The scenario runner: build the cell, plan, simulate with the drives, record, judge.
 
 ``run_scenario`` is what ``cellsim run`` does:
 
-1. compose the cell (robot, tool, fixtures, cameras) with ``dm_control.mjcf`` and compile it;
-2. plan every phase into one reference motion (:mod:`sim.simulation.motion`);
-3. simulate: the robot's position actuators track the reference (``ctrl = q_ref(t)``). With
-   feed-forward on (the default) the drives also apply ``tau_id``, the inverse dynamics of the
-   reference (``mj_inverse``), and the set-point carries the velocity feed-forward
-   ``ctrl = q_ref + (kv/kp) qd_ref``, so the servo force ``kp (q_ref - q) + kv (qd_ref - qd)``
-   only corrects errors. Without feed-forward the arm lags by about ``(kv/kp) qd`` plus
-   ``tau/kp`` (the position servo alone; see the README's tracking figures). Steps run
-   in C through ``mujoco.rollout`` in chunks, with the controls precomputed (they do not depend
-   on the state), and every chunk is checked for NaN and MuJoCo warnings;
-4. record the tool-point path and the joint torques, compute the summary metrics, and write
-   the run folder atomically.
-
-Recorded torque ``tau`` is what the joint's drive delivers: the position actuator's force plus
-the feed-forward torque. ``tau_id`` is the inverse dynamics of the reference motion.
+1. compose the cell (robot, tool, fixtures, cameras) with ``dm_control.mjcf`` and compile it
+   (:mod:`sim.simulation.compile`);
+2. plan every phase into one reference motion (:mod:`sim.simulation.motion`) and check it
+   against the joint ranges, speed and acceleration limits;
+3. simulate: each joint's drive (a position actuator limited to the drive's peak torque)
+   tracks the reference with the inverse-dynamics feed-forward through the same actuator
+   (:mod:`sim.simulation.simulate`);
+4. record the tool-point path and the continuous-time joint torques, compute the summary
+   metrics and the drives' saturation intervals, write the run folder atomically through
+   :mod:`sim.simulation.runfolder` with plots, video and the sizing report, and judge the run
+   (:mod:`sim.analysis.verdict`: ``"checks"`` and ``"verdict"`` in ``summary.json``).
 """
-
 
 from __future__ import annotations
 
@@ -36,6 +31,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim import __version__
+from sim.analysis.sizing import SizingResult
+from sim.analysis.verdict import run_checks, verdict
 from sim.errors import InternalError
 from sim.scenario import Scenario
 from sim.simulation import runfolder
@@ -172,8 +169,13 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
             write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
                         **video_args)
             summary["video"] = runfolder.VIDEO_MP4
+        sizing = None
         if options.sizing:  # last: report.html links the video when there is one
-            _write_sizing(tmp, scenario, built, record, summary)
+            sizing = _write_sizing(tmp, scenario, built, record, summary)
+        checks = run_checks(arrays, summary, scenario.robot,
+                            scenario.simulation.tracking_tolerance_deg, sizing)
+        summary["checks"] = [c.to_dict() for c in checks]
+        summary["verdict"] = verdict(checks)
         runfolder.write_summary(tmp, summary)
     except BaseException:
         if tmp.exists():
@@ -203,7 +205,7 @@ def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:
 
 
 def _write_sizing(tmp: Path, scenario: Scenario, built: BuiltCell, record: runfolder.RunRecord,
-                  summary: dict[str, Any]) -> None:
+                  summary: dict[str, Any]) -> SizingResult:
     from sim.analysis.report import write_sizing
     from sim.analysis.sizing import (
         apply_overrides,
@@ -221,6 +223,7 @@ def _write_sizing(tmp: Path, scenario: Scenario, built: BuiltCell, record: runfo
                          "hardest_margin_pct": result.hardest_margin_pct,
                          "pass": bool(result.all_pass),
                          "verdict": result.verdict}
+    return result
 
 
 def _check_tcp_consistency(built: BuiltCell, scenario: Scenario) -> None:

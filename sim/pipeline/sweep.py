@@ -49,7 +49,7 @@ from sim.simulation.runfolder import SIZING_JSON
 SWEEP_COLUMNS = ("payload_kg", "speed_scale", "joint", "peak_torque_nm", "rms_torque_nm",
                  "peak_torque_id_nm", "peak_torque_sim_nm", "rms_torque_id_nm", "rms_torque_sim_nm",
                  "peak_speed_rad_s", "peak_power_w", "duration_s", "margin_pct", "pass",
-                 "limiting", "run_dir")
+                 "limiting", "verdict", "run_dir")
 
 
 # --------------------------------------------------------------------------------------------
@@ -248,6 +248,7 @@ def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
             "margin_pct": float("nan") if margin is None else float(margin),
             "pass": ("PASS" if s["pass"] else "FAIL") if "pass" in s else "",
             "limiting": s.get("limiting") or "",
+            "verdict": summary.get("verdict", ""),
             "run_dir": str(run_dir),
         })
     return rows

@@ -14,12 +14,26 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from planners.registry import Registry
 from sim.core.resources import models_dir
 from sim.errors import KinematicsError
 from sim.robots.families import Fanuc6, FiveR, KinematicFamily
+
+#: Joint speed (rad/s) from which a joint's Coulomb friction is its ``frictionloss`` in full;
+#: below it the friction torque ramps linearly through zero: ``F * clip(qd / COULOMB_SPEED, -1,
+#: 1)``, a smooth odd law that is ``F sign(qd)`` wherever ``|qd| >= 1e-3 rad/s``. The simulation
+#: applies this law (:mod:`sim.cells.compose`: one friction actuator per joint) and the inverse
+#: dynamics adds it, so both see the same friction.
+COULOMB_SPEED = 1e-3
+
+
+def coulomb(frictionloss: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
+    """Coulomb friction torque opposing nothing, ``F * clip(qd / COULOMB_SPEED, -1, 1)``, N m
+    (the torque a drive spends on friction; shapes broadcast, ``F`` per joint)."""
+    return np.asarray(frictionloss, dtype=float) * np.clip(
+        np.asarray(qd, dtype=float) / COULOMB_SPEED, -1.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -65,6 +79,10 @@ class RobotSpec:
         description: One line for ``cellsim list``.
         drives: Default drive train per joint (documented in the model's README); the
             MJCF ``armature`` equals each drive's reflected inertia.
+        payload_kg: Rated payload, kg.
+        max_accel: Joint acceleration limits, rad/s^2, shape (n_joints,): derived from the drive
+            train with the rated payload (:mod:`sim.robots.accel_limits`, rounded down to two
+            significant digits in deg/s^2; the model's README shows the derivation).
     """
 
     name: str
@@ -76,6 +94,8 @@ class RobotSpec:
     description: str = ""
     drives: tuple[Drive, ...] = ()
     joint_names: tuple[str, ...] = field(default=())
+    payload_kg: float = 0.0
+    max_accel: tuple[float, ...] = ()
 
     @property
     def n_joints(self) -> int:
@@ -126,6 +146,8 @@ for _spec in (
                 Drive(80, 0.70, 5.0e-6, 0.32, 1.0, 5000),
                 Drive(50, 0.70, 3.0e-6, 0.25, 0.8, 5000),
             ),
+            payload_kg=5.0,
+            max_accel=_deg(1800, 4500, 7500, 8800, 200000),
         ),
         RobotSpec(
             name="lrmate200ic5l",
@@ -144,6 +166,8 @@ for _spec in (
                 Drive(75, 0.70, 5.0e-6, 0.32, 1.0, 6000),
                 Drive(48, 0.70, 3.0e-6, 0.25, 0.8, 6000),
             ),
+            payload_kg=5.0,
+            max_accel=_deg(1400, 2300, 5300, 40000, 43000, 210000),
         ),
         RobotSpec(
             name="robot_5r",
@@ -163,6 +187,8 @@ for _spec in (
                 Drive(90, 0.75, 2.9e-4, 2.0, 7.8, 5000),
                 Drive(60, 0.75, 1.0e-4, 1.0, 4.0, 5000),
             ),
+            payload_kg=10.0,
+            max_accel=_deg(1200, 1700, 3700, 7000, 28000),
         ),
 ):
     ROBOTS.add(_spec.name, _spec)

@@ -141,6 +141,8 @@ class SimulationSpec(_Strict):
     feedforward: bool = True
     settle_s: float = Field(0.0, ge=0)
     enforce_speed_limits: bool = True
+    enforce_accel_limits: bool = True
+    tracking_tolerance_deg: float = Field(0.1, gt=0, le=180)
 
 
 class VideoSpec(_Strict):

@@ -42,6 +42,10 @@ class BuiltCell:
         context: Kinematics, seams and frame 0 for the Cartesian phases.
         joint_ids: Ids of the robot joints, in order, (n,).
         tcp_site, frame0_site: Ids of the sites ``tcp`` and ``frame0``.
+        force_limits: Each robot drive's torque limit at the joint (its ``forcerange``;
+            +-inf when unlimited), N m, (n, 2).
+        friction_act: Ids of the robot joints' friction actuators (joints without friction
+            have none).
     """
 
     cell: Cell
@@ -57,6 +61,8 @@ class BuiltCell:
     joint_ids: NDArray[np.int64]
     tcp_site: int
     frame0_site: int
+    force_limits: NDArray[np.float64]
+    friction_act: NDArray[np.int64]
 
 
 # --------------------------------------------------------------------------------------------
@@ -69,6 +75,7 @@ def build(scenario: Scenario) -> BuiltCell:
     import mujoco
 
     from sim.cells import build_cell
+    from sim.cells.compose import FRICTION_PREFIX
     from sim.robots.model import closed_form_model
 
     cell = build_cell(scenario.cell, scenario.robot, tool=scenario.tool,
@@ -78,7 +85,11 @@ def build(scenario: Scenario) -> BuiltCell:
         root.option.timestep = scenario.simulation.timestep_s
     sensors: list[tuple[str, int]] = []
     for i, name in enumerate(cell.actuator_names):
-        root.sensor.add("actuatorfrc", name=f"cellsim_tau{i}", actuator=root.find("actuator", name))
+        actuator = root.find("actuator", name)
+        # the control carries the feed-forward torque (ctrl = q_ref + kv/kp qd_ref + tau_ff/kp):
+        # no clamp on it; the drive's limit is its forcerange
+        actuator.ctrllimited = False
+        root.sensor.add("actuatorfrc", name=f"cellsim_tau{i}", actuator=actuator)
         sensors.append((f"tau{i}", 1))
     tcp = root.find("site", cell.tcp_site)
     root.sensor.add("framepos", name="cellsim_tcp_pos", objtype="site", objname=tcp)
@@ -112,8 +123,13 @@ def build(scenario: Scenario) -> BuiltCell:
                            robot_qpos)
     ctx = CartesianContext(kinematics=kin, seams=dict(cell.seams),
                            world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float))
+    limits = np.where(model.actuator_forcelimited[robot_act, None].astype(bool),
+                      model.actuator_forcerange[robot_act] * model.actuator_gear[robot_act, :1],
+                      np.array([-np.inf, np.inf]))
+    friction = np.array([a for a in range(model.nu)
+                         if model.actuator(a).name.startswith(f"robot/{FRICTION_PREFIX}")], dtype=int)
     return BuiltCell(cell, model, saved_xml, robot_qpos, robot_dof, robot_act, suction, slices,
-                     part_qpos, ctx, jids, tcp_site, frame0_site)
+                     part_qpos, ctx, jids, tcp_site, frame0_site, limits, friction)
 
 
 def _tool_kinematics(kin: KinematicModel, model: Any, f0: int, tcp: int,

@@ -123,11 +123,45 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "actions": [{"t": t, "action": act} for t, act in motion.actions],
         "weld": weld_metrics(a, motion, built, torch_axis),
     }
+    summary["saturation"] = saturation_intervals(a, motion, built)
     summary["singularity"] = singularity_summary(a, motion, built, rec.timestep)
     pick = pick_metrics(a, built)
     if pick is not None:
         summary.update(pick)
     return summary
+
+
+def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """``(first, last)`` indices of each run of True in a 1-D mask."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0] - 1))
+
+
+def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell
+                         ) -> list[dict[str, Any]]:
+    """Intervals in which a drive delivered its limit instead of what the servo asked.
+
+    The servo's demand is ``kp (q_ref - q) + kv (qd_ref - qd) + tau_ff`` (the drive's force
+    before its ``forcerange`` clamp, :mod:`sim.simulation.simulate`); a sample is saturated when
+    the demand exceeds the limit. Each interval gives the joint, ``t0``/``t1`` (s), the phase
+    at ``t0`` and the worst excess of the demand over the limit, N m.
+    """
+    model = built.model
+    kp = model.actuator_gainprm[built.robot_act, 0]
+    kv = -model.actuator_biasprm[built.robot_act, 2]
+    demand = (kp * (arrays["q_ref"] - arrays["q"]) + kv * (arrays["qd_ref"] - arrays["qd"])
+              + arrays["tau_ff"])
+    lo, hi = built.force_limits[:, 0], built.force_limits[:, 1]
+    excess = np.maximum(demand - hi, lo - demand)
+    t = arrays["t"]
+    joints = built.cell.robot.joints
+    out = []
+    for j, name in enumerate(joints):
+        for i0, i1 in _runs(excess[:, j] > 1e-9 * max(1.0, float(hi[j]))):
+            out.append({"joint": name, "t0": float(t[i0]), "t1": float(t[i1]),
+                        "phase": motion.phases[int(arrays["phase"][i0])].name,
+                        "worst_excess_nm": float(np.max(excess[i0:i1 + 1, j]))})
+    return sorted(out, key=lambda s: (s["t0"], s["joint"]))
 
 
 def singularity_summary(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell,

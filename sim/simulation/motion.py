@@ -244,9 +244,11 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     return motion
 
 
-def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True) -> list[str]:
+def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
+                     accel: bool = True) -> list[str]:
     """One line per joint limit the reference motion exceeds (position range from the MJCF,
-    speed limits from the robot registry), naming the phase, joint, time, value and limit."""
+    speed and acceleration limits from the robot registry), naming the phase, joint, time,
+    value and limit."""
     from planners.limits import find_limit_violations
     from sim.robots.registry import joint_ranges
 
@@ -259,6 +261,8 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True) 
         found = find_limit_violations(
             pm.trajectory, lower=rng[:, 0], upper=rng[:, 1],
             max_velocity=np.asarray(scenario.robot.max_speed) if speed else None,
+            max_acceleration=(np.asarray(scenario.robot.max_accel)
+                              if accel and scenario.robot.max_accel else None),
             joint_names=scenario.robot.joints)
         out += [f"{where}: phases[{pm.phase.index}] ({pm.name}): {v.message()}" for v in found]
     return out
@@ -267,15 +271,17 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True) 
 def check_motion_limits(scenario: Scenario, motion: Motion) -> None:
     """Raise on the first joint-limit violation of the reference motion.
 
-    Position ranges are always enforced (the joint cannot go there); speed limits unless the
-    scenario sets ``simulation.enforce_speed_limits = false`` (the sizing report then shows
-    by how much each joint is over its limit).
+    Position ranges are always enforced (the joint cannot go there); speed and acceleration
+    limits unless the scenario sets ``simulation.enforce_speed_limits`` /
+    ``enforce_accel_limits = false`` (the run's verdict then fails on that check and the
+    sizing report shows by how much each joint is over its limit).
 
     Raises:
         ScenarioError: One line naming the phase, joint, time, value and limit.
     """
     found = limit_violations(scenario, motion,
-                             speed=scenario.simulation.enforce_speed_limits)
+                             speed=scenario.simulation.enforce_speed_limits,
+                             accel=scenario.simulation.enforce_accel_limits)
     if found:
         more = f" (and {len(found) - 1} more)" if len(found) > 1 else ""
         raise ScenarioError(found[0] + more)

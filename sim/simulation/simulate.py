@@ -1,14 +1,30 @@
-"""Simulate a reference motion with the robot's position actuators and record it.
+"""Simulate a reference motion with the robot's drives and record it.
 
-With feed-forward on (the default) the drives also apply ``tau_id``, the inverse dynamics of
-the reference (``mj_inverse``), and the set-point carries the velocity feed-forward
-``ctrl = q_ref + (kv/kp) qd_ref``, so the servo force ``kp (q_ref - q) + kv (qd_ref - qd)``
-only corrects errors. Without feed-forward the arm lags by about ``(kv/kp) qd`` plus
-``tau/kp``. Steps run in C through ``mujoco.rollout`` in chunks, with the controls precomputed
-(they do not depend on the state), and every chunk is checked for NaN and MuJoCo warnings.
+Each robot joint has one drive: a MuJoCo position actuator whose force is limited by its
+``forcerange`` (the drive's peak torque at the joint, ``peak motor torque x ratio x
+efficiency``). The whole servo torque passes through it: with feed-forward on (the default)
+the control is ``ctrl = q_ref + (kv/kp) qd_ref + tau_ff / kp``, so the drive's force is
+``kp (q_ref - q) + kv (qd_ref - qd) + tau_ff``, clamped to the force range. An overloaded
+robot therefore sags and lags in the simulation itself. ``tau_ff`` is the inverse dynamics of
+the reference with MuJoCo's discrete-time correction for its implicit integrator
+(``invdiscrete``: it adds ``h (damping + kv) qdd``), which makes tracking exact; it is never
+reported as a torque. Steps run in C through ``mujoco.rollout`` in chunks, with the controls
+precomputed (they do not depend on the state), and every chunk is checked for NaN and MuJoCo
+warnings.
 
-Recorded torque ``tau`` is what the joint's drive delivers: the position actuator's force plus
-the feed-forward torque. ``tau_id`` is the inverse dynamics of the reference motion.
+Recorded torques are continuous-time joint torques (what a drive must deliver, independent of
+the timestep):
+
+* ``tau_id``, the inverse dynamics of the reference: ``M(q) qdd + c(q, qd) + g(q)`` with the
+  armature in ``M``, plus viscous damping ``b qd`` and Coulomb friction
+  ``F s(qd)``, where ``s(qd) = clip(qd / COULOMB_SPEED, -1, 1)`` is ``sign(qd)`` for
+  ``|qd| >= 1e-3 rad/s`` and linear inside (:func:`sim.robots.registry.coulomb`; the simulation
+  applies the same law with one friction actuator per joint, :mod:`sim.cells.compose`);
+* ``tau``, the torque the drive applied in the simulated motion. MuJoCo's implicit step
+  evaluates the drive's velocity term at the end-of-step speed, ``-kv qd[k+1]``; the actuator
+  force it reports is evaluated at ``qd[k]``, so ``tau = actuator force - h kv qdd_sim`` with
+  ``qdd_sim = (qd[k+1] - qd[k]) / h`` the step's own acceleration (exactly the force the step
+  applied); a saturated drive delivers its limit.
 """
 
 from __future__ import annotations
@@ -22,6 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import SimulationError
+from sim.robots.registry import coulomb
 from sim.simulation.compile import BuiltCell
 from sim.simulation.motion import Motion
 
@@ -45,22 +62,38 @@ class SimulationRecord:
 
 
 def inverse_dynamics(model: Any, built: BuiltCell, q: NDArray[np.float64],
-                     qd: NDArray[np.float64], qdd: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Joint torques that realise the reference exactly (``mj_inverse``), (N, n_joints), N m.
+                     qd: NDArray[np.float64], qdd: NDArray[np.float64], *,
+                     discrete: bool = False) -> NDArray[np.float64]:
+    """Joint torques that realise a joint motion, (N, n_joints), N m.
 
-    The robot's own dynamics with its tool and payload: gravity, inertia (with armature),
-    joint damping and friction. Contacts are switched off for the computation (a reference
+    The robot's own dynamics with its tool and payload; contacts are switched off (a reference
     that touches a part would otherwise count the contact's push as the robot's torque), the
     rest of the model (parts) stays at its initial pose and at rest, and a part held by
     suction is not included (it is in the simulated torque).
+
+    Args:
+        discrete: False (what is recorded and sized): continuous-time torques
+            ``M qdd + c + g + b qd + F s(qd)`` (module docstring), nothing from the integrator.
+            True (the feed-forward only): MuJoCo's ``mj_inverse`` with ``invdiscrete``, the
+            force that makes the implicit step reproduce ``qdd`` exactly, plus the friction.
     """
     import mujoco
 
     data = mujoco.MjData(model)
     mujoco.mj_resetData(model, data)
     out = np.zeros_like(q)
-    flags = model.opt.disableflags
-    model.opt.disableflags = flags | int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    flags, enable = model.opt.disableflags, model.opt.enableflags
+    off = int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    invdiscrete = int(mujoco.mjtEnableBit.mjENBL_INVDISCRETE)
+    if not discrete:
+        off |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)  # friction added below, exactly
+    model.opt.disableflags = flags | off
+    model.opt.enableflags = (enable | invdiscrete) if discrete else (enable & ~invdiscrete)
+    # invdiscrete would count the friction actuators' velocity slope (F / COULOMB_SPEED) as an
+    # implicit damping even where they are clamped (everywhere but |qd| < 1e-3 rad/s), where the
+    # forward step leaves it out: remove it for the computation
+    bias = model.actuator_biasprm[built.friction_act].copy()
+    model.actuator_biasprm[built.friction_act, 2] = 0.0
     try:
         for k in range(q.shape[0]):
             data.qpos[built.robot_qpos] = q[k]
@@ -71,8 +104,28 @@ def inverse_dynamics(model: Any, built: BuiltCell, q: NDArray[np.float64],
             mujoco.mj_inverse(model, data)
             out[k] = data.qfrc_inverse[built.robot_dof]
     finally:
-        model.opt.disableflags = flags
-    return out
+        model.opt.disableflags, model.opt.enableflags = flags, enable
+        model.actuator_biasprm[built.friction_act] = bias
+    # the joints' Coulomb friction is applied by friction actuators (sim.cells.compose), which
+    # mj_inverse does not count: the drive overcomes it
+    return out + coulomb(built.cell.frictionloss, qd)
+
+
+def vacuum(command: NDArray[np.bool_], dt: float,
+           time_constant: float | None = None) -> NDArray[np.float64]:
+    """Suction level in [0, 1] at each sample: a first-order lag of the valve ``command``
+    (exact for a command held over each step), time constant
+    :data:`sim.cells.tools.VACUUM_TIME_CONSTANT_S`."""
+    from scipy.signal import lfilter
+
+    from sim.cells.tools import VACUUM_TIME_CONSTANT_S
+
+    tau = VACUUM_TIME_CONSTANT_S if time_constant is None else time_constant
+    a = float(np.exp(-dt / tau))
+    u = np.asarray(command, dtype=float)
+    # y[k] = a y[k-1] + (1 - a) u[k-1], y[0] = 0
+    y = lfilter([0.0, 1.0 - a], [1.0, -a], u)
+    return np.clip(y, 0.0, 1.0)
 
 
 def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: float = 0.0,
@@ -97,17 +150,19 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
     kv = -model.actuator_biasprm[built.robot_act, 2]
 
     tau_id = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd)
-    ff = tau_id if feedforward else np.zeros_like(tau_id)
+    ff = (inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd, discrete=True) if feedforward
+          else np.zeros_like(tau_id))
 
     nu, nv = model.nu, model.nv
-    controls = np.zeros((n_steps + 1, nu + nv))
-    # A position actuator's force is kp (ctrl - q) - kv qd. With feed-forward the set-point is
-    # shifted by (kv/kp) qd_ref, so the servo acts on the velocity error too and its own force
-    # stays a small correction (the damping term alone would saturate forcerange at speed).
-    controls[:, built.robot_act] = ref.q + (kv / kp) * ref.qd if feedforward else ref.q
+    controls = np.zeros((n_steps + 1, nu))
+    # A position actuator's force is kp (ctrl - q) - kv qd, clamped to its forcerange. With
+    # feed-forward the set-point is shifted by (kv/kp) qd_ref, so the servo acts on the velocity
+    # error too, and by tau_ff / kp, so the drive also delivers the feed-forward torque: the
+    # whole torque passes through the drive and its limit.
+    controls[:, built.robot_act] = (ref.q + (kv / kp) * ref.qd + ff / kp) if feedforward \
+        else ref.q
     if built.suction_act is not None:
-        controls[:, built.suction_act] = motion.tool_state(t, "suction").astype(float)
-    controls[:, nu + built.robot_dof] = ff
+        controls[:, built.suction_act] = vacuum(motion.tool_state(t, "suction"), dt)
 
     data = mujoco.MjData(model)
     mujoco.mj_resetData(model, data)
@@ -125,7 +180,7 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
     qvel = np.zeros((n_steps + 1, nv))
     sens = np.zeros((n_steps + 1, model.nsensordata))
     qpos[0], qvel[0] = data.qpos, data.qvel
-    control_spec = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
+    control_spec = mujoco.mjtState.mjSTATE_CTRL
     scratch = mujoco.MjData(model)
 
     from tqdm import tqdm
@@ -207,6 +262,16 @@ def _arrays(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
     nj = motion.n_joints
     tau_act = np.column_stack([sens[:, built.sensor_slices[f"tau{i}"]] for i in range(nj)]) \
         if nj else np.zeros((n, 0))
+    qd_sim = qvel[:, built.robot_dof]
+    qdd_sim = _sim_acceleration(qd_sim, t)
+    # the force the implicit step applied: the drive's velocity term at the end-of-step speed
+    # (module docstring); a saturated drive applies its limit
+    model = built.model
+    kv = -model.actuator_biasprm[built.robot_act, 2]
+    h = float(model.opt.timestep)
+    lo, hi = built.force_limits[:, 0], built.force_limits[:, 1]
+    saturated = (tau_act <= lo + 1e-9 * np.abs(lo)) | (tau_act >= hi - 1e-9 * np.abs(hi))
+    tau = np.where(saturated, tau_act, tau_act - h * kv * qdd_sim)
     kin = built.context.kinematics
     T0 = built.context.world_from_frame0
     poses = np.asarray(kin.fk(ref.q[:n]), dtype=float).reshape(n, 4, 4)
@@ -216,9 +281,9 @@ def _arrays(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
         "phase": motion.phase_index(t).astype(np.int32),
         "q_ref": ref.q[:n], "qd_ref": ref.qd[:n], "qdd_ref": ref.qdd[:n],
         "qddd_ref": ref.qddd[:n],
-        "q": qpos[:, built.robot_qpos], "qd": qvel[:, built.robot_dof],
-        "qdd": _sim_acceleration(qvel[:, built.robot_dof], t),
-        "tau": tau_act + ff[:n], "tau_actuator": tau_act, "tau_ff": ff[:n],
+        "q": qpos[:, built.robot_qpos], "qd": qd_sim,
+        "qdd": qdd_sim,
+        "tau": tau, "tau_actuator": tau_act, "tau_ff": ff[:n],
         "tau_id": tau_id[:n],
         "tcp_pos": sens[:, built.sensor_slices["tcp_pos"]],
         "tcp_pos_ref": tcp_ref,

@@ -1,0 +1,63 @@
+"""Joint acceleration limits derived from the drive train (no maker publishes them).
+
+For joint ``i`` the drive's peak torque at the joint is ``T_i = peak motor torque x ratio x
+efficiency`` (the actuator's ``forcerange``). Over configurations spread through the joint
+ranges, with the rated payload as a point mass at the tcp, the acceleration the drive can give
+from rest against gravity is ``(T_i - |g_i(q)|) / M_ii(q)``, with ``M_ii`` the joint's inertia
+(links beyond it, payload and the reflected rotor inertia, the armature). The limit is the
+smallest of these: a motion within it can always be driven, whatever the pose. Velocity
+terms are left out (they vanish at rest, where a move starts and ends).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.errors import KinematicsError
+from sim.robots.registry import RobotSpec, joint_ranges
+
+#: Configurations sampled per robot (uniform in the joint ranges, fixed seed).
+SAMPLES = 4000
+
+
+def derive_accel_limits(spec: RobotSpec, payload_kg: float, samples: int = SAMPLES,
+                        seed: int = 0) -> NDArray[np.float64]:
+    """The acceleration limit of every joint (module docstring), rad/s^2, shape (n,).
+
+    Raises:
+        KinematicsError: A joint's drive cannot hold the arm against gravity somewhere in the
+            ranges (no positive limit exists).
+    """
+    import mujoco
+    from dm_control import mjcf
+
+    root = mjcf.from_path(str(spec.robot_path))
+    tcp = root.find("site", "tcp")
+    if payload_kg > 0.0:
+        body = tcp.parent.add("body", name="rated_payload", pos=tcp.pos)
+        body.add("inertial", pos=[0.0, 0.0, 0.0], mass=payload_kg, diaginertia=[1e-6] * 3)
+    model = mujoco.MjModel.from_xml_string(root.to_xml_string(), root.get_assets())
+    data = mujoco.MjData(model)
+    jids = [model.joint(j).id for j in spec.joints]
+    qadr = np.array([model.jnt_qposadr[j] for j in jids])
+    dadr = np.array([model.jnt_dofadr[j] for j in jids])
+    peak = np.array([d.peak_torque * d.gear_ratio * d.efficiency for d in spec.drives])
+    rng = np.clip(joint_ranges(spec), -np.pi, np.pi)
+    Q = np.random.default_rng(seed).uniform(rng[:, 0], rng[:, 1], size=(samples, len(jids)))
+    M = np.zeros((model.nv, model.nv))
+    worst = np.full(len(jids), np.inf)
+    for q in Q:
+        data.qpos[:] = model.qpos0
+        data.qpos[qadr] = q
+        data.qvel[:] = 0.0
+        mujoco.mj_forward(model, data)
+        mujoco.mj_fullM(model, data, M)
+        g = data.qfrc_bias[dadr]
+        a = (peak - np.abs(g)) / M[dadr, dadr]
+        worst = np.minimum(worst, a)
+    if np.any(worst <= 0.0):
+        bad = [j for j, w in zip(spec.joints, worst) if w <= 0.0]
+        raise KinematicsError(f"robot {spec.name!r}: the drives of {', '.join(bad)} cannot hold "
+                              f"the arm with {payload_kg} kg against gravity everywhere in range")
+    return worst
