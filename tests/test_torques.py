@@ -15,6 +15,7 @@ import pytest
 from sim.analysis.sizing import peak_abs, rms
 from sim.cli import main
 from sim.core.resources import shipped_scenarios
+from sim.errors import ScenarioError
 from sim.pipeline.run import RunOptions, run_scenario
 from sim.robots.registry import coulomb
 from sim.scenario import load_scenario, parse_scenario
@@ -240,3 +241,24 @@ def test_simulated_friction_is_the_coulomb_law_of_tau_id():
         mujoco.mj_forward(model, data)
         friction_force = data.actuator_force[built.friction_act[j]]
         assert friction_force == pytest.approx(-F, rel=1e-12)
+
+
+def test_size_keeps_variants_past_the_limits_with_negative_margins(tmp_path):
+    """A variant twenty times faster than seed 001's phase I (refused by `cellsim run`, whose
+    limits are enforced) stays in the sweep table with negative margins and a failed verdict;
+    the command exits 0 because it could evaluate every variant."""
+    import csv
+
+    out = tmp_path / "sweep"
+    assert main(["size", "bugnar_5r_phase1", "--speed-scale", "1,20", "--out", str(out),
+                 "--workers", "1", "--quiet"]) == 0
+    rows = list(csv.DictReader((out / "sweep.csv").open()))
+    fast = [r for r in rows if float(r["speed_scale"]) == 20.0]
+    slow = [r for r in rows if float(r["speed_scale"]) == 1.0]
+    assert len(fast) == len(slow) == 5
+    assert all(r["verdict"] == "fail" for r in fast) and all(r["verdict"] == "pass" for r in slow)
+    assert min(float(r["margin_pct"]) for r in fast) < 0
+    assert any(r["pass"] == "FAIL" for r in fast)
+    with pytest.raises(ScenarioError, match="velocity .* exceeds limit"):
+        run_scenario(load_scenario("bugnar_5r_phase1").scaled(20.0), RunOptions(
+            out_dir=tmp_path / "refused", video=False, plots=False, progress=False))
