@@ -85,7 +85,8 @@ def _pinocchio_model(xml_path: Path, tmp_path: Path):
 
 
 @pytest.mark.parametrize("name", ["kacso_lrmate100ib_sequence1", "lrmate200ic_weld_plate",
-                                  "bugnar_5r_phase1", "bugnar_5r_weld_cycle_ceiling"])
+                                  "bugnar_5r_phase1", "bugnar_5r_weld_cycle",
+                                  "bugnar_5r_weld_cycle_ceiling"])
 def test_tau_id_equals_an_independent_rnea(name, scenario_run, tmp_path):
     """tau_id = pinocchio's RNEA on the run's model.xml (+ armature qdd when pinocchio leaves it
     out) + damping qd + Coulomb friction, to 1e-6 of each joint's peak where |qd| > 1e-2."""
@@ -262,3 +263,55 @@ def test_size_keeps_variants_past_the_limits_with_negative_margins(tmp_path):
     with pytest.raises(ScenarioError, match="velocity .* exceeds limit"):
         run_scenario(load_scenario("bugnar_5r_phase1").scaled(20.0), RunOptions(
             out_dir=tmp_path / "refused", video=False, plots=False, progress=False))
+
+
+FAST_J1 = """
+name = "fast_j1"
+description = "LR Mate 200iC/5L: a fast J1 swing, arm stretched, 5 kg, a J1 motor that tops out"
+robot = "lrmate200ic5l"
+payload_kg = 5.0
+
+[[phases]]
+name = "swing"
+planner = "434"
+time_s = [0.0, 0.6, 1.2]
+joints_deg = [
+  [0.0,   -90.0, 90.0, 0.0, -90.0, 0.0],
+  [75.0,  -90.0, 90.0, 0.0, -90.0, 0.0],
+  [150.0, -90.0, 90.0, 0.0, -90.0, 0.0],
+]
+
+[drives.j1]
+max_speed_rpm = 5000.0
+rated_torque_nm = 0.1
+"""
+
+
+def test_drive_limit_follows_the_motor_torque_speed_curve(tmp_path):
+    """J1 at up to 250 deg/s on a motor that tops out at 5000 rpm (250 deg/s through its 120:1
+    reducer): the drive's limit falls along the peak curve, never above the curve at the
+    reference's speed, the drive never delivers more, J1 saturates and lags, the verdict fails.
+    With motor_speed_limits = false the limit stays the flat peak and J1 tracks."""
+    from sim.robots.registry import Drive
+
+    summary = run_scenario(parse_scenario(FAST_J1, source="fast_j1.toml"), RunOptions(
+        out_dir=tmp_path / "curve", video=False, plots=False, progress=False))
+    a = np.load(tmp_path / "curve" / "trajectory.npz")
+    drive = Drive(120, 0.75, 2.0e-5, 0.1, 2.4, 5000)  # the 200iC's J1 with the overrides
+    flat = 2.4 * 120 * 0.75
+    curve = np.minimum(drive.joint_peak_torque_at(np.abs(a["qd_ref"][:, 0])), flat)
+    limit = a["tau_limit"][:, 0]
+    assert limit.min() < 0.2 * flat  # it falls far below the flat peak near top speed
+    assert np.all(limit <= curve + 1e-9)  # conservative: never above the curve at speed
+    assert np.all(np.abs(a["tau_actuator"][:, 0]) <= limit * (1 + 1e-9) + 1e-12)
+    assert any(s["joint"] == "j1" for s in summary["saturation"])
+    assert summary["max_tracking_error_deg"][0] > 0.5 and summary["verdict"] == "fail"
+
+    flat_only = FAST_J1.replace('payload_kg = 5.0\n',
+                                'payload_kg = 5.0\n\n[simulation]\nmotor_speed_limits = false\n')
+    summary = run_scenario(parse_scenario(flat_only, source="fast_j1_flat.toml"), RunOptions(
+        out_dir=tmp_path / "flat", video=False, plots=False, progress=False))
+    a = np.load(tmp_path / "flat" / "trajectory.npz")
+    assert np.all(a["tau_limit"][:, 0] == flat)
+    assert not any(s["joint"] == "j1" for s in summary["saturation"])
+    assert summary["max_tracking_error_deg"][0] < 0.1

@@ -66,12 +66,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
+from sim.robots.registry import PEAK_KNEE_FRACTION as _PEAK_KNEE_FRACTION
 from sim.robots.registry import Drive, RobotSpec
 from sim.simulation.runfolder import SUMMARY_JSON, TRAJECTORY_NPZ, RunRecord
 
 #: Fraction of the motor's maximum speed up to which the peak torque is available (the
 #: voltage-limit knee of the peak envelope). Generic servo-motor shape, not catalogue data.
-PEAK_KNEE_FRACTION = 0.7
+PEAK_KNEE_FRACTION = _PEAK_KNEE_FRACTION
 
 #: Simulated torque within this fraction of the force range counts as saturated.
 SATURATION_TOL = 0.005
@@ -550,12 +551,7 @@ def peak_envelope(drive: Drive, speed_rpm: ArrayLike,
     Peak torque flat up to ``knee_fraction * max_speed_rpm``, then a straight voltage-limit
     slope down to the rated torque at ``max_speed_rpm``; zero above ``max_speed_rpm``.
     """
-    n = np.abs(np.asarray(speed_rpm, dtype=float))
-    n_max = float(drive.max_speed_rpm)
-    n_k = knee_fraction * n_max
-    slope = (drive.peak_torque - drive.rated_torque) / max(n_max - n_k, 1e-300)
-    out = np.where(n <= n_k, drive.peak_torque, drive.peak_torque - slope * (n - n_k))
-    return np.where(n <= n_max, out, 0.0)
+    return drive.peak_torque_at(speed_rpm, knee_fraction)
 
 
 def motor_stats(t: ArrayLike, tau_m: ArrayLike, speed_rpm: ArrayLike, drive: Drive,

@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim import __version__
-from sim.analysis.sizing import SizingResult
+from sim.analysis.sizing import SizingResult, apply_overrides
 from sim.analysis.verdict import run_checks, verdict
 from sim.errors import InternalError
 from sim.scenario import Scenario
@@ -146,9 +146,12 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
                 shutil.rmtree(failed)
             os.replace(tmp, failed)
 
+        drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
         rec = simulate(built, motion, feedforward=feedforward,
                        settle_s=scenario.simulation.settle_s, progress=options.progress,
-                       on_failure=keep_failed)
+                       on_failure=keep_failed,
+                       drives=drives if scenario.simulation.motor_speed_limits and drives
+                       else None)
         arrays = rec.arrays
         runfolder.write_trajectory(tmp, arrays)
         runfolder.write_csv(tmp, arrays, scenario.robot.joints)

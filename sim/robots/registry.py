@@ -36,6 +36,13 @@ def coulomb(frictionloss: ArrayLike, qd: ArrayLike) -> NDArray[np.float64]:
         np.asarray(qd, dtype=float) / COULOMB_SPEED, -1.0, 1.0)
 
 
+#: Motor speed, as a fraction of its maximum, up to which the peak torque is available (the
+#: generic peak curve of :meth:`Drive.peak_torque_at`).
+PEAK_KNEE_FRACTION = 0.7
+#: rad/s -> rpm.
+RPM_PER_RAD_S = 60.0 / (2.0 * np.pi)
+
+
 @dataclass(frozen=True)
 class Drive:
     """Drive train of one joint (motor + gearbox), motor-side quantities.
@@ -55,6 +62,27 @@ class Drive:
     rated_torque: float
     peak_torque: float
     max_speed_rpm: float
+
+    def peak_torque_at(self, speed_rpm: ArrayLike,
+                       knee_fraction: float = PEAK_KNEE_FRACTION) -> NDArray[np.float64]:
+        """Peak (intermittent) motor torque available at ``|speed_rpm|``, N m, motor side.
+
+        A generic S1/peak shape: the peak torque up to ``knee_fraction * max_speed_rpm``, then
+        a straight voltage-limit slope down to the rated torque at ``max_speed_rpm``; zero above
+        ``max_speed_rpm``.
+        """
+        n = np.abs(np.asarray(speed_rpm, dtype=float))
+        n_max = float(self.max_speed_rpm)
+        n_k = knee_fraction * n_max
+        slope = (self.peak_torque - self.rated_torque) / max(n_max - n_k, 1e-300)
+        out = np.where(n <= n_k, self.peak_torque, self.peak_torque - slope * (n - n_k))
+        return np.where(n <= n_max, out, 0.0)
+
+    def joint_peak_torque_at(self, joint_speed: ArrayLike) -> NDArray[np.float64]:
+        """The drive's peak torque at the joint, ``peak_torque_at(motor speed) x ratio x
+        efficiency``, N m, at joint speed(s) ``joint_speed`` (rad/s)."""
+        rpm = np.asarray(joint_speed, dtype=float) * self.gear_ratio * RPM_PER_RAD_S
+        return self.peak_torque_at(rpm) * self.gear_ratio * self.efficiency
 
     @property
     def reflected_inertia(self) -> float:

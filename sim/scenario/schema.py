@@ -142,6 +142,7 @@ class SimulationSpec(_Strict):
     settle_s: float = Field(0.0, ge=0)
     enforce_speed_limits: bool = True
     enforce_accel_limits: bool = True
+    motor_speed_limits: bool = True
     tracking_tolerance_deg: float = Field(0.1, gt=0, le=180)
 
 

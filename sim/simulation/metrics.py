@@ -142,8 +142,9 @@ def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built:
     """Intervals in which a drive delivered its limit instead of what the servo asked.
 
     The servo's demand is ``kp (q_ref - q) + kv (qd_ref - qd) + tau_ff`` (the drive's force
-    before its ``forcerange`` clamp, :mod:`sim.simulation.simulate`); a sample is saturated when
-    the demand exceeds the limit. Each interval gives the joint, ``t0``/``t1`` (s), the phase
+    before its clamp, :mod:`sim.simulation.simulate`); a sample is saturated when the demand
+    exceeds the drive's limit at that step (``tau_limit``: its ``forcerange``, or its peak
+    torque-speed curve at speed). Each interval gives the joint, ``t0``/``t1`` (s), the phase
     at ``t0`` and the worst excess of the demand over the limit, N m.
     """
     model = built.model
@@ -151,13 +152,12 @@ def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built:
     kv = -model.actuator_biasprm[built.robot_act, 2]
     demand = (kp * (arrays["q_ref"] - arrays["q"]) + kv * (arrays["qd_ref"] - arrays["qd"])
               + arrays["tau_ff"])
-    lo, hi = built.force_limits[:, 0], built.force_limits[:, 1]
-    excess = np.maximum(demand - hi, lo - demand)
+    excess = np.abs(demand) - arrays["tau_limit"]
     t = arrays["t"]
     joints = built.cell.robot.joints
     out = []
     for j, name in enumerate(joints):
-        for i0, i1 in _runs(excess[:, j] > 1e-9 * max(1.0, float(hi[j]))):
+        for i0, i1 in _runs(excess[:, j] > 1e-9 * max(1.0, float(built.force_limits[j, 1]))):
             out.append({"joint": name, "t0": float(t[i0]), "t1": float(t[i1]),
                         "phase": motion.phases[int(arrays["phase"][i0])].name,
                         "worst_excess_nm": float(np.max(excess[i0:i1 + 1, j]))})

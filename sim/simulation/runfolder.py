@@ -80,6 +80,7 @@ ARRAYS: dict[str, ArraySpec] = {
     "tau_actuator": ArraySpec("(N, n)", "N m", "position servo's part of tau"),
     "tau_ff": ArraySpec("(N, n)", "N m", "feed-forward part of tau"),
     "tau_id": ArraySpec("(N, n)", "N m", "inverse dynamics of the reference"),
+    "tau_limit": ArraySpec("(N, n)", "N m", "the drive's torque limit at the joint at each step"),
     "tcp_pos": ArraySpec("(N, 3)", "m", "simulated tool point, world"),
     "tcp_pos_ref": ArraySpec("(N, 3)", "m", "reference tool point, world"),
     "tcp_quat": ArraySpec("(N, 4)", "-", "simulated tcp orientation (w, x, y, z), world"),

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -38,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import SimulationError
-from sim.robots.registry import coulomb
+from sim.robots.registry import Drive, coulomb
 from sim.simulation.compile import BuiltCell
 from sim.simulation.motion import Motion
 
@@ -128,11 +129,29 @@ def vacuum(command: NDArray[np.bool_], dt: float,
     return np.clip(y, 0.0, 1.0)
 
 
+#: Steps between updates of the drives' speed-dependent torque limit while it binds, s / h.
+ENVELOPE_STEPS = 10
+
+
+def _joint_peak(drives: Sequence[Drive], speed: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each drive's peak torque at the joint at joint speeds ``speed`` (..., n), N m."""
+    return np.stack([d.joint_peak_torque_at(speed[..., j]) for j, d in enumerate(drives)],
+                    axis=-1)
+
+
 def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: float = 0.0,
              progress: bool = True,
-             on_failure: Callable[[dict[str, NDArray[Any]], str], None] | None = None
-             ) -> SimulationRecord:
-    """Simulate the reference motion with position actuators; see the module docstring.
+             on_failure: Callable[[dict[str, NDArray[Any]], str], None] | None = None,
+             drives: Sequence[Drive] | None = None) -> SimulationRecord:
+    """Simulate the reference motion with the robot's drives; see the module docstring.
+
+    Args:
+        drives: The drive of each joint. When given, each drive's limit follows its peak
+            torque-speed curve (:meth:`sim.robots.registry.Drive.joint_peak_torque_at`, never
+            above the actuator's ``forcerange``): where the curve is below the flat peak for
+            the reference's or the joint's speed, the limit is updated every
+            :data:`ENVELOPE_STEPS` steps to the curve's value at the highest of those speeds
+            over the next steps (conservative). None: the constant ``forcerange``.
 
     Raises:
         SimulationError: NaN or a MuJoCo warning; the message names the time and the joint.
@@ -164,6 +183,11 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
     if built.suction_act is not None:
         controls[:, built.suction_act] = vacuum(motion.tool_state(t, "suction"), dt)
 
+    flat = built.force_limits[:, 1]
+    limit = np.tile(flat, (n_steps + 1, 1))  # the drive's limit at each step, N m
+    env_ref = None if drives is None else np.minimum(_joint_peak(drives, np.abs(ref.qd)), flat)
+    saved_range = model.actuator_forcerange[built.robot_act].copy()
+
     data = mujoco.MjData(model)
     mujoco.mj_resetData(model, data)
     data.qpos[built.robot_qpos] = ref.q[0]
@@ -192,6 +216,10 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
     try:
         while k < n_steps:
             m = min(CHUNK_STEPS, n_steps - k)
+            if env_ref is not None:
+                m, lim = _envelope_chunk(drives, env_ref, flat, state, qvel_slice, built, k, m)
+                model.actuator_forcerange[built.robot_act] = np.column_stack([-lim, lim])
+                limit[k:k + m] = lim
             for w in scratch.warning:
                 w.number = 0
             t_start = time.perf_counter()
@@ -207,21 +235,47 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
                 bad_step, message = problem
                 partial = _arrays(built, motion, t[:k + bad_step + 1], ref, tau_id, ff,
                                   qpos[:k + bad_step + 1], qvel[:k + bad_step + 1],
-                                  sens[:k + bad_step + 1])
+                                  sens[:k + bad_step + 1], limit[:k + bad_step + 1])
                 if on_failure is not None:
                     on_failure(partial, message)
                 raise SimulationError(message)
             state = st[-1].copy()
             k += m
             bar.update(m)
+        # sensors of the final state
+        if env_ref is not None:
+            limit[n_steps] = limit[n_steps - 1] if n_steps else flat
+            model.actuator_forcerange[built.robot_act] = np.column_stack(
+                [-limit[n_steps], limit[n_steps]])
+        mujoco.mj_setState(model, scratch, state, spec)
+        mujoco.mj_forward(model, scratch)
+        sens[n_steps] = scratch.sensordata
     finally:
         bar.close()
-    # sensors of the final state
-    mujoco.mj_setState(model, scratch, state, spec)
-    mujoco.mj_forward(model, scratch)
-    sens[n_steps] = scratch.sensordata
-    arrays = _arrays(built, motion, t, ref, tau_id, ff, qpos, qvel, sens)
+        model.actuator_forcerange[built.robot_act] = saved_range
+    arrays = _arrays(built, motion, t, ref, tau_id, ff, qpos, qvel, sens, limit)
     return SimulationRecord(arrays=arrays, wall_s=wall, steps=n_steps, timestep=dt)
+
+
+def _envelope_chunk(drives: Sequence[Drive], env_ref: NDArray[np.float64],
+                    flat: NDArray[np.float64], state: NDArray[np.float64], qvel_slice: slice,
+                    built: BuiltCell, k: int, m: int) -> tuple[int, NDArray[np.float64]]:
+    """Length and drive limits of the next rollout chunk from step ``k`` (at most ``m``).
+
+    Where neither the reference's speeds over the chunk nor the joints' present speeds reach
+    the falling part of the peak curve, the limit is the flat ``forcerange`` and the chunk runs
+    up to the first step where the curve would bind. Otherwise a short chunk of
+    :data:`ENVELOPE_STEPS` steps runs at the curve's lowest value over it.
+    """
+    eps = 1e-12
+    qd_now = np.abs(state[qvel_slice][built.robot_dof])
+    env_now = np.minimum(_joint_peak(drives, qd_now), flat)
+    binds = np.any(env_ref[k:k + m + 1] < flat * (1 - eps), axis=1)
+    first = int(np.argmax(binds)) if binds.any() else None
+    if not np.any(env_now < flat * (1 - eps)) and (first is None or first > 1):
+        return (m if first is None else min(m, first - 1)), flat.copy()
+    m = min(ENVELOPE_STEPS, m)
+    return m, np.minimum(env_now, env_ref[k:k + m + 1].min(axis=0))
 
 
 def _instability(model: Any, scratch: Any, st: NDArray[np.float64], t0: float, dt: float,
@@ -257,7 +311,8 @@ def _instability(model: Any, scratch: Any, st: NDArray[np.float64], t0: float, d
 
 def _arrays(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
             tau_id: NDArray[np.float64], ff: NDArray[np.float64], qpos: NDArray[np.float64],
-            qvel: NDArray[np.float64], sens: NDArray[np.float64]) -> dict[str, NDArray[Any]]:
+            qvel: NDArray[np.float64], sens: NDArray[np.float64],
+            limit: NDArray[np.float64]) -> dict[str, NDArray[Any]]:
     n = t.size
     nj = motion.n_joints
     tau_act = np.column_stack([sens[:, built.sensor_slices[f"tau{i}"]] for i in range(nj)]) \
@@ -269,8 +324,8 @@ def _arrays(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
     model = built.model
     kv = -model.actuator_biasprm[built.robot_act, 2]
     h = float(model.opt.timestep)
-    lo, hi = built.force_limits[:, 0], built.force_limits[:, 1]
-    saturated = (tau_act <= lo + 1e-9 * np.abs(lo)) | (tau_act >= hi - 1e-9 * np.abs(hi))
+    hi = limit[:n]
+    saturated = np.abs(tau_act) >= hi * (1 - 1e-9)
     tau = np.where(saturated, tau_act, tau_act - h * kv * qdd_sim)
     kin = built.context.kinematics
     T0 = built.context.world_from_frame0
@@ -283,7 +338,7 @@ def _arrays(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
         "qddd_ref": ref.qddd[:n],
         "q": qpos[:, built.robot_qpos], "qd": qd_sim,
         "qdd": qdd_sim,
-        "tau": tau, "tau_actuator": tau_act, "tau_ff": ff[:n],
+        "tau": tau, "tau_actuator": tau_act, "tau_ff": ff[:n], "tau_limit": hi,
         "tau_id": tau_id[:n],
         "tcp_pos": sens[:, built.sensor_slices["tcp_pos"]],
         "tcp_pos_ref": tcp_ref,
