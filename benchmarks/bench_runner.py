@@ -21,6 +21,7 @@ import time
 import mujoco
 import numpy as np
 
+from sim.analysis.sizing import apply_overrides
 from sim.core.resources import shipped_scenarios
 from sim.scenario import load_scenario
 from sim.simulation.compile import build
@@ -51,12 +52,15 @@ def main() -> None:
         sc = load_scenario(name)
         built = build(sc)
         motion = build_motion(sc, built.context)
+        # the drives as the runner passes them (their torque-speed curves limit the actuators)
+        drives = apply_overrides(sc.robot.drives, sc.drives, sc.robot.joints)
+        drives = drives if sc.simulation.motor_speed_limits and drives else None
         best_sim = best_total = best_bare = np.inf
         steps = 0
         for _ in range(args.repeat):
             t0 = time.perf_counter()
             rec = simulate(built, motion, feedforward=sc.simulation.feedforward,
-                           settle_s=sc.simulation.settle_s, progress=False)
+                           settle_s=sc.simulation.settle_s, progress=False, drives=drives)
             best_total = min(best_total, time.perf_counter() - t0)
             best_sim = min(best_sim, rec.wall_s)
             steps = rec.steps
