@@ -17,7 +17,7 @@ absorb) and ``mean P = 1/T int P dt`` (net, negative when the joint mostly brake
 cycle ``int |P| dt`` and the regenerative net energy ``int P dt``. ``T`` is the cycle duration
 ``t[-1] - t[0]``.
 
-Motor side (:class:`MotorStats`), with a :class:`sim.robots.Drive` (ratio ``N``, efficiency
+Motor side (:class:`MotorStats`), with a :class:`sim.robots.registry.Drive` (ratio ``N``, efficiency
 ``eta``, rotor inertia ``J_r`` motor side) per joint::
 
     tau_load = tau_joint - armature * qdd            # joint torque without the rotor inertia

@@ -46,11 +46,6 @@ class RunCheck:
         return {"name": self.name, "joint": self.joint, "value": self.value,
                 "limit": self.limit, "unit": self.unit, "pass": self.passed}
 
-    def line(self) -> str:
-        """One line for the terminal, e.g. ``speed j2: 357.1 deg/s > limit 270 deg/s``."""
-        return (f"{self.name} {self.joint}: {self.value:.4g} {self.unit} over the limit "
-                f"{self.limit:.4g} {self.unit}")
-
 
 def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], spec: RobotSpec,
                tracking_tolerance_deg: float, sizing: SizingResult | None = None

@@ -19,7 +19,8 @@ pick             lrmate200ic5l           vacuum_gripper   vacuum_gripper    floo
 (None: bare)     every robot             none             any, or none      floor, ceiling
 ===============  ======================  ===============  ================  =================
 
-Names in the compiled model: robot joints ``robot/j1..jN``, actuators ``robot/a1..aN``, sites
+Names in the compiled model: robot joints ``robot/j1..jN``, actuators ``robot/a1..aN`` (the
+drives) and ``robot/friction_j1..`` (each joint's Coulomb friction, :mod:`sim.cells.compose`), sites
 ``robot/frame0``, ``robot/flange``, ``robot/tcp`` (moved onto the tool tip), tool elements
 ``robot/tool/...`` (tip site ``robot/tool/tip``, suction ``robot/tool/suction``), payload body
 ``robot/payload``; cell elements keep their plain names (``part0``, cameras ``overview`` and

@@ -41,7 +41,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fps", type=float, help="video frames per second")
     p.add_argument("--camera", action="append", metavar="NAME",
                    help="cell camera to film (repeat to tile several side by side)")
-    p.add_argument("--quiet", action="store_true", help="no progress bars, only the result line")
+    p.add_argument("--quiet", action="store_true", help="no progress bars (the result lines only)")
     p.add_argument("--strict", action="store_true",
                    help="exit with 1 when the run's verdict is fail (a saturated drive, a joint "
                         "over its speed or acceleration limit, tracking worse than the "

@@ -22,8 +22,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "size", help="actuator-sizing sweep over payloads and speed scales",
         description="Simulate SCENARIO for every combination of --payload and --speed-scale "
-                    "(in parallel), size every joint's actuator, and write sweep.csv, sweep.md "
-                    "and sweep.png with one run folder per variant.")
+                    "(in parallel), size every joint's actuator, and write sweep.csv, sweep.md, "
+                    "sweep.json and sweep.png with one run folder per variant. Variants are "
+                    "simulated even past the robot's speed or acceleration limits (the "
+                    "scenario's enforce_* keys are not applied): they stay in the tables with "
+                    "negative margins and their run's verdict. Exit 0 when every variant was "
+                    "evaluated.")
     p.add_argument("scenario", metavar="SCENARIO",
                    help="a scenario file, or a shipped scenario's name (see `cellsim list`)")
     p.add_argument("--payload", default=None, metavar="KG,..",

@@ -3,10 +3,12 @@
 For joint ``i`` the drive's peak torque at the joint is ``T_i = peak motor torque x ratio x
 efficiency`` (the actuator's ``forcerange``). Over configurations spread through the joint
 ranges, with the rated payload as a point mass at the tcp, the acceleration the drive can give
-from rest against gravity is ``(T_i - |g_i(q)|) / M_ii(q)``, with ``M_ii`` the joint's inertia
-(links beyond it, payload and the reflected rotor inertia, the armature). The limit is the
-smallest of these: a motion within it can always be driven, whatever the pose. Velocity
-terms are left out (they vanish at rest, where a move starts and ends).
+the joint alone from rest against gravity and Coulomb friction ``F_i`` is
+``(T_i - F_i - |g_i(q)|) / M_ii(q)``, with ``M_ii`` the joint's inertia (links beyond it,
+payload and the reflected rotor inertia, the armature). The limit is the smallest of these.
+It is a per-joint figure: velocity terms (zero at rest, where a move starts and ends) and the
+coupling between joints accelerating together are left out, which the simulation's
+saturation check and the sizing report cover.
 """
 
 from __future__ import annotations
@@ -43,7 +45,8 @@ def derive_accel_limits(spec: RobotSpec, payload_kg: float, samples: int = SAMPL
     qadr = np.array([model.jnt_qposadr[j] for j in jids])
     dadr = np.array([model.jnt_dofadr[j] for j in jids])
     peak = np.array([d.peak_torque * d.gear_ratio * d.efficiency for d in spec.drives])
-    rng = np.clip(joint_ranges(spec), -np.pi, np.pi)
+    friction = model.dof_frictionloss[dadr]
+    rng = joint_ranges(spec)
     Q = np.random.default_rng(seed).uniform(rng[:, 0], rng[:, 1], size=(samples, len(jids)))
     M = np.zeros((model.nv, model.nv))
     worst = np.full(len(jids), np.inf)
@@ -54,7 +57,7 @@ def derive_accel_limits(spec: RobotSpec, payload_kg: float, samples: int = SAMPL
         mujoco.mj_forward(model, data)
         mujoco.mj_fullM(model, data, M)
         g = data.qfrc_bias[dadr]
-        a = (peak - np.abs(g)) / M[dadr, dadr]
+        a = (peak - friction - np.abs(g)) / M[dadr, dadr]
         worst = np.minimum(worst, a)
     if np.any(worst <= 0.0):
         bad = [j for j, w in zip(spec.joints, worst) if w <= 0.0]

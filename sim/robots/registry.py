@@ -175,7 +175,7 @@ for _spec in (
                 Drive(50, 0.70, 3.0e-6, 0.25, 0.8, 5000),
             ),
             payload_kg=5.0,
-            max_accel=_deg(1800, 4500, 7500, 8800, 200000),
+            max_accel=_deg(1800, 4500, 7500, 8700, 200000),
         ),
         RobotSpec(
             name="lrmate200ic5l",
@@ -216,7 +216,7 @@ for _spec in (
                 Drive(60, 0.75, 1.0e-4, 1.0, 4.0, 5000),
             ),
             payload_kg=10.0,
-            max_accel=_deg(1200, 1700, 3700, 7000, 28000),
+            max_accel=_deg(1200, 1700, 3700, 6900, 28000),
         ),
 ):
     ROBOTS.add(_spec.name, _spec)

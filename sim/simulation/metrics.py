@@ -123,7 +123,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "actions": [{"t": t, "action": act} for t, act in motion.actions],
         "weld": weld_metrics(a, motion, built, torch_axis),
     }
-    summary["saturation"] = saturation_intervals(a, motion, built)
+    summary["saturation"] = saturation_intervals(a, motion, built, feedforward=feedforward)
     summary["singularity"] = singularity_summary(a, motion, built, rec.timestep)
     pick = pick_metrics(a, built)
     if pick is not None:
@@ -137,12 +137,13 @@ def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
     return list(zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0] - 1))
 
 
-def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell
-                         ) -> list[dict[str, Any]]:
+def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell,
+                         *, feedforward: bool = True) -> list[dict[str, Any]]:
     """Intervals in which a drive delivered its limit instead of what the servo asked.
 
-    The servo's demand is ``kp (q_ref - q) + kv (qd_ref - qd) + tau_ff`` (the drive's force
-    before its clamp, :mod:`sim.simulation.simulate`); a sample is saturated when the demand
+    The servo's demand is ``kp (q_ref - q) + kv (qd_ref - qd) + tau_ff`` with feed-forward and
+    ``kp (q_ref - q) - kv qd`` without (the drive's force before its clamp,
+    :mod:`sim.simulation.simulate`); a sample is saturated when the demand
     exceeds the drive's limit at that step (``tau_limit``: its ``forcerange``, or its peak
     torque-speed curve at speed). Each interval gives the joint, ``t0``/``t1`` (s), the phase
     at ``t0`` and the worst excess of the demand over the limit, N m.
@@ -150,8 +151,9 @@ def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built:
     model = built.model
     kp = model.actuator_gainprm[built.robot_act, 0]
     kv = -model.actuator_biasprm[built.robot_act, 2]
-    demand = (kp * (arrays["q_ref"] - arrays["q"]) + kv * (arrays["qd_ref"] - arrays["qd"])
-              + arrays["tau_ff"])
+    demand = kp * (arrays["q_ref"] - arrays["q"]) - kv * arrays["qd"]
+    if feedforward:
+        demand = demand + kv * arrays["qd_ref"] + arrays["tau_ff"]
     excess = np.abs(demand) - arrays["tau_limit"]
     t = arrays["t"]
     joints = built.cell.robot.joints

@@ -10,7 +10,7 @@ A run folder DIR holds (``FILES`` lists them):
 * ``model.xml``: the compiled cell (``mujoco.MjModel.from_xml_path``);
 * ``scenario.toml``: the scenario as given; ``manifest.json``: versions and hashes;
 * ``summary.json``: ``scenario``, ``robot``, ``joints`` (names), ``phases``
-  (``[{"name", "kind", "t0", "t1"}]``), ``duration_s``, metrics, ``sizing`` verdict, ...;
+  (``[{"name", "kind", "t0", "t1"}]``), ``duration_s``, metrics, ``saturation``, ``sizing``, ``checks``, ``verdict``, ...;
 * ``trajectory.npz``: the recorded arrays (``ARRAYS`` gives each one's shape and unit);
   ``trajectory.csv``: the main ones as columns;
 * ``video.mp4``, ``plots/*.png``, the sizing report (``sizing.md``, ``sizing.csv``,

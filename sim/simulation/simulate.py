@@ -213,20 +213,35 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
                disable=not progress or not sys.stderr.isatty())
     wall = 0.0
     k = 0
+    short_until = 0  # steps before which the envelope runs in short chunks (see below)
+    # the constraint solver's warm start carries over from chunk to chunk (it is not part of
+    # the state), so that results do not depend on where the chunks end
+    warmstart = data.qacc_warmstart.copy()
     try:
         while k < n_steps:
             m = min(CHUNK_STEPS, n_steps - k)
+            flat_chunk = True
             if env_ref is not None:
-                m, lim = _envelope_chunk(drives, env_ref, flat, state, qvel_slice, built, k, m)
+                m, lim = _envelope_chunk(drives, env_ref, flat, state, qvel_slice, built, k, m,
+                                         short=k < short_until)
+                flat_chunk = bool(np.all(lim == flat))
                 model.actuator_forcerange[built.robot_act] = np.column_stack([-lim, lim])
                 limit[k:k + m] = lim
             for w in scratch.warning:
                 w.number = 0
             t_start = time.perf_counter()
             st, sd = rollout.rollout(model, scratch, state, controls[k:k + m][None],
-                                     control_spec=control_spec)
+                                     control_spec=control_spec, initial_warmstart=warmstart)
             wall += time.perf_counter() - t_start
             st, sd = st[0], sd[0]
+            if env_ref is not None and flat_chunk and m > ENVELOPE_STEPS:
+                # a joint that sags or lags may pass its curve's knee inside a flat chunk
+                # chosen from the speeds at its start: then run that stretch again, short
+                speeds = np.abs(st[:, qvel_slice][:, built.robot_dof]).max(axis=0)
+                if np.any(_joint_peak(drives, speeds) < flat * (1 - 1e-12)):
+                    short_until = k + m
+                    continue
+            warmstart = scratch.qacc_warmstart.copy()
             qpos[k + 1:k + m + 1] = st[:, qpos_slice]
             qvel[k + 1:k + m + 1] = st[:, qvel_slice]
             sens[k:k + m] = sd
@@ -248,6 +263,7 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
             model.actuator_forcerange[built.robot_act] = np.column_stack(
                 [-limit[n_steps], limit[n_steps]])
         mujoco.mj_setState(model, scratch, state, spec)
+        scratch.ctrl[:] = controls[n_steps]  # the final sample's own control (not in the state)
         mujoco.mj_forward(model, scratch)
         sens[n_steps] = scratch.sensordata
     finally:
@@ -259,20 +275,22 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
 
 def _envelope_chunk(drives: Sequence[Drive], env_ref: NDArray[np.float64],
                     flat: NDArray[np.float64], state: NDArray[np.float64], qvel_slice: slice,
-                    built: BuiltCell, k: int, m: int) -> tuple[int, NDArray[np.float64]]:
+                    built: BuiltCell, k: int, m: int, short: bool = False
+                    ) -> tuple[int, NDArray[np.float64]]:
     """Length and drive limits of the next rollout chunk from step ``k`` (at most ``m``).
 
     Where neither the reference's speeds over the chunk nor the joints' present speeds reach
     the falling part of the peak curve, the limit is the flat ``forcerange`` and the chunk runs
-    up to the first step where the curve would bind. Otherwise a short chunk of
-    :data:`ENVELOPE_STEPS` steps runs at the curve's lowest value over it.
+    up to the first step where the curve would bind. Otherwise (or when ``short``: a flat chunk
+    from here saw a joint pass its curve's knee) a short chunk of :data:`ENVELOPE_STEPS` steps
+    runs at the curve's lowest value over it.
     """
     eps = 1e-12
     qd_now = np.abs(state[qvel_slice][built.robot_dof])
     env_now = np.minimum(_joint_peak(drives, qd_now), flat)
     binds = np.any(env_ref[k:k + m + 1] < flat * (1 - eps), axis=1)
     first = int(np.argmax(binds)) if binds.any() else None
-    if not np.any(env_now < flat * (1 - eps)) and (first is None or first > 1):
+    if not short and not np.any(env_now < flat * (1 - eps)) and (first is None or first > 1):
         return (m if first is None else min(m, first - 1)), flat.copy()
     m = min(ENVELOPE_STEPS, m)
     return m, np.minimum(env_now, env_ref[k:k + m + 1].min(axis=0))
