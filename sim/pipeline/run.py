@@ -109,8 +109,8 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         CellsimError: A user mistake or an unstable simulation (one-line message).
     """
     options = options or RunOptions()
-    out_dir = Path(options.out_dir) if options.out_dir else default_out_dir(scenario)
-    out_dir = out_dir.resolve()
+    out_dir = runfolder.check_out_dir(options.out_dir if options.out_dir
+                                      else default_out_dir(scenario))
     feedforward = (scenario.simulation.feedforward if options.feedforward is None
                    else options.feedforward)
 
@@ -133,6 +133,7 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
     try:
+        runfolder.write_marker(tmp)
         runfolder.write_text(tmp, runfolder.MODEL_XML, built.xml)
         runfolder.write_text(tmp, runfolder.SCENARIO_TOML, scenario.text)
         runfolder.write_text(tmp, runfolder.MANIFEST_JSON,
@@ -142,8 +143,11 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
             runfolder.write_trajectory(tmp, partial)
             runfolder.write_text(tmp, runfolder.ERROR_TXT, message + "\n")
             failed = runfolder.failed_folder(out_dir)
-            if failed.exists():
+            if runfolder.is_run_folder(failed):
                 shutil.rmtree(failed)
+            elif failed.exists() or failed.is_symlink():  # not ours: never replaced
+                failed = Path(tempfile.mkdtemp(prefix=failed.name + "-", dir=out_dir.parent))
+                failed.rmdir()
             os.replace(tmp, failed)
 
         drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
@@ -180,6 +184,7 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         summary["checks"] = [c.to_dict() for c in checks]
         summary["verdict"] = verdict(checks)
         runfolder.write_summary(tmp, summary)
+        runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
     except BaseException:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
@@ -190,7 +195,7 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         shutil.rmtree(trash, ignore_errors=True)
     os.replace(tmp, out_dir)
     stale = runfolder.failed_folder(out_dir)
-    if stale.exists():
+    if runfolder.is_run_folder(stale):
         shutil.rmtree(stale, ignore_errors=True)
     return summary
 

@@ -16,7 +16,10 @@ from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag
 
 from planners.registry import PLANNERS
 
-_NAME_PATTERN = r"^[A-Za-z0-9_.-]+$"
+#: Names (scenario, phases) are plain folder names: letters, digits, ``_ . -``, not starting
+#: with a dot (``.`` and ``..`` would make the default run folder the working directory or
+#: ``runs/`` itself).
+_NAME_PATTERN = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*$"
 
 #: Boundary-condition keys of a joint phase: (quantity, end, unit suffix) -> planner keyword.
 _BOUNDARY_KEYS: dict[str, tuple[str, float]] = {}

@@ -49,6 +49,9 @@ REPORT_HTML = "report.html"
 SIZING_CHARTS_DIR = "sizing"
 #: Suffix of the folder a failed run leaves next to the one it would have written.
 FAILED_SUFFIX = ".failed"
+#: The marker file cellsim writes first into every run folder: a folder is cellsim's (and may
+#: be replaced by a later run) only when it holds this file.
+MARKER = ".cellsim-run"
 
 #: Every file (or folder) a complete run folder may hold, in the order a person reads them.
 FILES: tuple[str, ...] = (SUMMARY_JSON, REPORT_HTML, SIZING_MD, SIZING_CSV, SIZING_JSON,
@@ -387,6 +390,54 @@ def load_run(run_dir: str | Path) -> RunRecord:
 def as_record(run: str | Path | RunRecord) -> RunRecord:
     """A :class:`RunRecord` from a run folder path or a record (returned as is)."""
     return run if isinstance(run, RunRecord) else load_run(run)
+
+
+# ------------------------------------------------------------------------------------ safety
+def is_run_folder(path: str | Path) -> bool:
+    """Whether ``path`` is a real folder (not a symbolic link) that cellsim wrote (it holds
+    the :data:`MARKER` file)."""
+    p = Path(path)
+    return p.is_dir() and not p.is_symlink() and (p / MARKER).is_file()
+
+
+def write_marker(folder: str | Path) -> Path:
+    """Write the :data:`MARKER` file that makes ``folder`` cellsim's."""
+    from sim import __version__
+
+    return write_text(folder, MARKER, json.dumps({"written_by": "cellsim",
+                                                  "cellsim": __version__}) + "\n")
+
+
+def check_out_dir(requested: str | Path) -> Path:
+    """The absolute run folder for a requested one, if cellsim may write (and replace) it.
+
+    A run replaces only a folder cellsim wrote (it holds :data:`MARKER`) or an empty one; it
+    never writes through a symbolic link, into a file's place, or over the working directory
+    or a folder that contains it.
+
+    Raises:
+        RunFolderError: One line naming the path and what is wrong with it.
+    """
+    raw = Path(requested)
+    if raw.name in ("", ".", ".."):
+        raise RunFolderError(f"run folder {str(requested)!r}: give a folder name, not "
+                             f"{str(requested)!r} (cellsim replaces the whole folder)")
+    if raw.is_symlink():
+        raise RunFolderError(f"run folder {str(raw)!r} is a symbolic link; cellsim writes only "
+                             "into a real folder (choose another --out)")
+    target = raw.parent.resolve() / raw.name
+    cwd = Path.cwd().resolve()
+    if target == cwd or target in cwd.parents:
+        raise RunFolderError(f"run folder {str(target)!r} is the working directory or contains "
+                             "it; choose another --out")
+    if target.exists() and not target.is_dir():
+        raise RunFolderError(f"run folder {str(target)!r} is a file; cellsim does not replace "
+                             "it (choose another --out)")
+    if target.is_dir() and not is_run_folder(target) and any(target.iterdir()):
+        raise RunFolderError(f"run folder {str(target)!r} exists and was not written by cellsim "
+                             f"(no {MARKER} in it); cellsim does not replace it: choose another "
+                             "--out, or remove the folder yourself")
+    return target
 
 
 # ------------------------------------------------------------------------------------ writing
