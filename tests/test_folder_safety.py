@@ -81,3 +81,19 @@ def test_check_out_dir_is_the_one_gate(tmp_path):
         check_out_dir(link)
     with pytest.raises(RunFolderError, match="give a folder name"):
         check_out_dir("..")
+
+
+def test_a_run_folder_of_cellsim_0_1_without_the_marker_is_still_cellsim_s(tmp_path):
+    """Folders written before the marker existed carry cellsim's manifest.json: a rerun may
+    replace them; a folder whose manifest.json is anything else stays refused."""
+    old = tmp_path / "old_run"
+    old.mkdir()
+    (old / "manifest.json").write_text('{"cellsim": "0.1.0", "scenario_sha256": "ab"}\n')
+    (old / "summary.json").write_text("{}\n")
+    assert is_run_folder(old)
+    assert main([*RUN, "--out", str(old)]) == 0 and (old / MARKER).is_file()
+    other = _user_folder(tmp_path / "other")
+    (other / "manifest.json").write_text('{"name": "my web app"}\n')
+    assert not is_run_folder(other)
+    with pytest.raises(RunFolderError, match="not written by cellsim"):
+        check_out_dir(other)

@@ -394,10 +394,19 @@ def as_record(run: str | Path | RunRecord) -> RunRecord:
 
 # ------------------------------------------------------------------------------------ safety
 def is_run_folder(path: str | Path) -> bool:
-    """Whether ``path`` is a real folder (not a symbolic link) that cellsim wrote (it holds
-    the :data:`MARKER` file)."""
+    """Whether ``path`` is a real folder (not a symbolic link) that cellsim wrote: it holds the
+    :data:`MARKER` file, or (a run folder of cellsim 0.1, before the marker) a
+    ``manifest.json`` that names cellsim and the scenario's hash."""
     p = Path(path)
-    return p.is_dir() and not p.is_symlink() and (p / MARKER).is_file()
+    if not p.is_dir() or p.is_symlink():
+        return False
+    if (p / MARKER).is_file():
+        return True
+    try:
+        manifest = json.loads((p / MANIFEST_JSON).read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return False
+    return isinstance(manifest, dict) and {"cellsim", "scenario_sha256"} <= manifest.keys()
 
 
 def write_marker(folder: str | Path) -> Path:
