@@ -20,5 +20,14 @@ def _default_gl() -> str:
     return "disable"  # simulation still works; rendering says what to install
 
 
+#: Values of ``MUJOCO_GL`` that mujoco accepts on Linux (it refuses to import with any other).
+_MUJOCO_GL_VALUES = ("", "disable", "disabled", "off", "false", "0", "enable", "enabled", "on",
+                     "true", "1", "glfw", "glx", "egl", "osmesa")
+
 if "MUJOCO_GL" not in _os.environ:
+    _os.environ["MUJOCO_GL"] = _default_gl()
+elif _os.environ["MUJOCO_GL"].lower().strip() not in _MUJOCO_GL_VALUES:
+    # A value mujoco refuses would break every command, rendering or not: keep it aside for
+    # the rendering commands to report (sim.render.gl.configure_gl) and use the default.
+    _os.environ["CELLSIM_INVALID_MUJOCO_GL"] = _os.environ["MUJOCO_GL"]
     _os.environ["MUJOCO_GL"] = _default_gl()

@@ -210,13 +210,18 @@ def configure_gl(preferred: str | None = None) -> str:
         The active backend name.
 
     Raises:
-        RenderError: Unknown name; the requested backend (or every backend) does not work
-            here, with what to install; or mujoco was imported earlier with a backend that
+        RenderError: Unknown name; ``MUJOCO_GL`` set to a value that is no backend (and no
+            ``preferred``); the requested backend (or every backend) does not work here, with
+            what to install; or mujoco was imported earlier with a backend that
             cannot be switched.
     """
     global _configured
     if preferred is not None:
         preferred = _check_name(preferred)
+    invalid = os.environ.get("CELLSIM_INVALID_MUJOCO_GL")
+    if preferred is None and invalid is not None:
+        raise RenderError(f"MUJOCO_GL={invalid!r} is not an OpenGL backend; set MUJOCO_GL to "
+                          f"one of {', '.join(BACKENDS)}, unset it, or give --gl")
     if _configured is not None and preferred in (None, _configured):
         return _configured
     if preferred is not None:
