@@ -86,7 +86,7 @@ def _pinocchio_model(xml_path: Path, tmp_path: Path):
 
 @pytest.mark.parametrize("name", ["kacso_lrmate100ib_sequence1", "lrmate200ic_weld_plate",
                                   "bugnar_5r_phase1", "bugnar_5r_weld_cycle",
-                                  "bugnar_5r_weld_cycle_ceiling"])
+                                  "bugnar_5r_weld_cycle_ceiling", "lrmate200ic_pick_place"])
 def test_tau_id_equals_an_independent_rnea(name, scenario_run, tmp_path):
     """tau_id = pinocchio's RNEA on the run's model.xml (+ armature qdd when pinocchio leaves it
     out) + damping qd + Coulomb friction, to 1e-6 of each joint's peak where |qd| > 1e-2."""

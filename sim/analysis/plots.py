@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from sim.core.intervals import true_runs
 from sim.errors import UsageError
 from sim.simulation.runfolder import PLOTS_DIR, REQUIRED_FOR_PLOTS, RunRecord, as_record
 
@@ -153,7 +154,7 @@ def tool_path_figure(record: RunRecord) -> Any:
     if record.has("arc_on"):
         arc = record.get("arc_on").astype(bool)
         first = True
-        for a, b in _runs(arc):
+        for a, b in true_runs(arc):
             ax.plot(*act[a:b].T, color=_BEAD, lw=4.0, alpha=0.8,
                     label="seam (arc on)" if first else None)
             first = False
@@ -180,12 +181,6 @@ def tool_path_figure(record: RunRecord) -> Any:
     ax2.grid(True, lw=0.3)
     ax2.set_title("tool point position error", pad=14)
     return fig
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    m = np.concatenate([[False], np.asarray(mask, dtype=bool), [False]]).astype(np.int8)
-    edges = np.flatnonzero(np.diff(m))
-    return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
 
 
 def tracking_error_figure(record: RunRecord) -> Any:

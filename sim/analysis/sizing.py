@@ -67,7 +67,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.robots.registry import PEAK_KNEE_FRACTION as _PEAK_KNEE_FRACTION
-from sim.robots.registry import Drive, RobotSpec
+from sim.robots.registry import RPM_PER_RAD_S, Drive, RobotSpec
 from sim.simulation.runfolder import SUMMARY_JSON, TRAJECTORY_NPZ, RunRecord
 
 #: Fraction of the motor's maximum speed up to which the peak torque is available (the
@@ -87,7 +87,6 @@ BASES = ("worst", "id", "sim")
 #: Keys ``trajectory.npz`` must hold.
 TRAJECTORY_KEYS = ("t", "q_ref", "qd_ref", "qdd_ref", "q", "qd", "tau", "tau_id")
 
-RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 
 
 # --------------------------------------------------------------------------------------------

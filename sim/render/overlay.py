@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from sim.core.intervals import true_runs
 from sim.render.interp import interp_rows, sample_index
 from sim.simulation.runfolder import RunRecord
 
@@ -113,13 +114,6 @@ def simplify_polyline(points: np.ndarray, tolerance: float, max_points: int) -> 
         tol *= 2.0
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """[start, stop) index ranges where ``mask`` is true."""
-    m = np.concatenate([[False], np.asarray(mask, dtype=bool), [False]])
-    edges = np.flatnonzero(np.diff(m.astype(np.int8)))
-    return list(zip(edges[::2].tolist(), edges[1::2].tolist()))
-
-
 class PathOverlay:
     """Trails and bead of one run, ready to be added to a scene at any time.
 
@@ -147,7 +141,7 @@ class PathOverlay:
             self.actual, self.actual_t = act[idx], self.t[idx]
             if record.has("arc_on"):
                 arc = record.get("arc_on").astype(bool)
-                runs = _runs(arc)
+                runs = true_runs(arc)
                 lengths = [
                     float(np.linalg.norm(np.diff(act[a:b], axis=0), axis=1).sum()) for a, b in runs
                 ]

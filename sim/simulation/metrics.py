@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
+from sim.core.intervals import true_runs
 from sim.scenario import Scenario
 from sim.simulation.compile import BuiltCell
 from sim.simulation.motion import Motion
@@ -131,12 +132,6 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
     return summary
 
 
-def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
-    """``(first, last)`` indices of each run of True in a 1-D mask."""
-    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
-    return list(zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0] - 1))
-
-
 def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell,
                          *, feedforward: bool = True) -> list[dict[str, Any]]:
     """Intervals in which a drive delivered its limit instead of what the servo asked.
@@ -159,7 +154,9 @@ def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built:
     joints = built.cell.robot.joints
     out = []
     for j, name in enumerate(joints):
-        for i0, i1 in _runs(excess[:, j] > 1e-9 * max(1.0, float(built.force_limits[j, 1]))):
+        tol = 1e-9 * max(1.0, float(built.force_limits[j, 1]))
+        for i0, stop in true_runs(excess[:, j] > tol):
+            i1 = stop - 1
             out.append({"joint": name, "t0": float(t[i0]), "t1": float(t[i1]),
                         "phase": motion.phases[int(arrays["phase"][i0])].name,
                         "worst_excess_nm": float(np.max(excess[i0:i1 + 1, j]))})

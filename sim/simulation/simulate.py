@@ -62,9 +62,32 @@ class SimulationRecord:
 # --------------------------------------------------------------------------------------------
 
 
+def _inverse_model(model: Any, built: BuiltCell, discrete: bool) -> Any:
+    """A copy of ``model`` set up for :func:`inverse_dynamics` (the caller's model untouched)."""
+    import copy
+
+    import mujoco
+
+    m = copy.copy(model)
+    off = int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+    invdiscrete = int(mujoco.mjtEnableBit.mjENBL_INVDISCRETE)
+    if discrete:
+        m.opt.enableflags |= invdiscrete
+        # invdiscrete would count the friction actuators' velocity slope (F / COULOMB_SPEED) as
+        # an implicit damping even where they are clamped (everywhere but |qd| < 1e-3 rad/s),
+        # where the forward step leaves it out: remove it for the computation
+        m.actuator_biasprm[built.friction_act, 2] = 0.0
+    else:
+        m.opt.enableflags &= ~invdiscrete
+        off |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)  # friction added exactly, below
+    m.opt.disableflags |= off
+    return m
+
+
 def inverse_dynamics(model: Any, built: BuiltCell, q: NDArray[np.float64],
                      qd: NDArray[np.float64], qdd: NDArray[np.float64], *,
-                     discrete: bool = False) -> NDArray[np.float64]:
+                     discrete: bool | tuple[bool, ...] = False
+                     ) -> NDArray[np.float64] | tuple[NDArray[np.float64], ...]:
     """Joint torques that realise a joint motion, (N, n_joints), N m.
 
     The robot's own dynamics with its tool and payload; contacts are switched off (a reference
@@ -77,39 +100,29 @@ def inverse_dynamics(model: Any, built: BuiltCell, q: NDArray[np.float64],
             ``M qdd + c + g + b qd + F s(qd)`` (module docstring), nothing from the integrator.
             True (the feed-forward only): MuJoCo's ``mj_inverse`` with ``invdiscrete``, the
             force that makes the implicit step reproduce ``qdd`` exactly, plus the friction.
+            A tuple of these computes each in one pass over the samples and returns a tuple.
     """
     import mujoco
 
+    modes = discrete if isinstance(discrete, tuple) else (discrete,)
+    models = [_inverse_model(model, built, d) for d in modes]
     data = mujoco.MjData(model)
     mujoco.mj_resetData(model, data)
-    out = np.zeros_like(q)
-    flags, enable = model.opt.disableflags, model.opt.enableflags
-    off = int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
-    invdiscrete = int(mujoco.mjtEnableBit.mjENBL_INVDISCRETE)
-    if not discrete:
-        off |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)  # friction added below, exactly
-    model.opt.disableflags = flags | off
-    model.opt.enableflags = (enable | invdiscrete) if discrete else (enable & ~invdiscrete)
-    # invdiscrete would count the friction actuators' velocity slope (F / COULOMB_SPEED) as an
-    # implicit damping even where they are clamped (everywhere but |qd| < 1e-3 rad/s), where the
-    # forward step leaves it out: remove it for the computation
-    bias = model.actuator_biasprm[built.friction_act].copy()
-    model.actuator_biasprm[built.friction_act, 2] = 0.0
-    try:
-        for k in range(q.shape[0]):
-            data.qpos[built.robot_qpos] = q[k]
-            data.qvel[:] = 0.0
-            data.qvel[built.robot_dof] = qd[k]
-            data.qacc[:] = 0.0
-            data.qacc[built.robot_dof] = qdd[k]
-            mujoco.mj_inverse(model, data)
+    data.qvel[:] = 0.0
+    data.qacc[:] = 0.0
+    outs = [np.zeros_like(q) for _ in modes]
+    for k in range(q.shape[0]):
+        data.qpos[built.robot_qpos] = q[k]
+        data.qvel[built.robot_dof] = qd[k]
+        data.qacc[built.robot_dof] = qdd[k]
+        for m, out in zip(models, outs):
+            mujoco.mj_inverse(m, data)
             out[k] = data.qfrc_inverse[built.robot_dof]
-    finally:
-        model.opt.disableflags, model.opt.enableflags = flags, enable
-        model.actuator_biasprm[built.friction_act] = bias
     # the joints' Coulomb friction is applied by friction actuators (sim.cells.compose), which
     # mj_inverse does not count: the drive overcomes it
-    return out + coulomb(built.cell.frictionloss, qd)
+    friction = coulomb(built.cell.frictionloss, qd)
+    result = tuple(out + friction for out in outs)
+    return result if isinstance(discrete, tuple) else result[0]
 
 
 def vacuum(command: NDArray[np.bool_], dt: float,
@@ -168,9 +181,11 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
     kp = model.actuator_gainprm[built.robot_act, 0]
     kv = -model.actuator_biasprm[built.robot_act, 2]
 
-    tau_id = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd)
-    ff = (inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd, discrete=True) if feedforward
-          else np.zeros_like(tau_id))
+    if feedforward:  # both in one pass over the samples
+        tau_id, ff = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd, discrete=(False, True))
+    else:
+        tau_id = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd)
+        ff = np.zeros_like(tau_id)
 
     nu, nv = model.nu, model.nv
     controls = np.zeros((n_steps + 1, nu))

@@ -23,6 +23,12 @@ from numpy.typing import ArrayLike, NDArray
 from sim.errors import KinematicsError
 
 
+def annulus_gap(rho: float, r_in: float, r_out: float) -> float:
+    """How far (m) a planar distance ``rho`` is outside the annulus [r_in, r_out] (<= 0 inside):
+    how far a two-link arm with that reach range misses a point at distance ``rho``."""
+    return max(rho - r_out, r_in - rho)
+
+
 def geometric_from_frames(axes: NDArray[np.float64], points: NDArray[np.float64],
                           T: NDArray[np.float64]) -> NDArray[np.float64]:
     """Geometric Jacobian from joint axes (..., n, 3), points on them (..., n, 3) and the tool

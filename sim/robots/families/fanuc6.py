@@ -30,24 +30,14 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.core.rotations import rot_z
+from sim.core.rotations import rot_x, rot_y, rot_z
 from sim.errors import SingularityWarning, UnreachableError
 from sim.robots.closed_form import fk_fanuc6
-from sim.robots.families.base import KinematicFamily
+from sim.robots.families.base import KinematicFamily, annulus_gap
 
 #: |sin theta5| or distance of the wrist centre from the J1 axis (m) below which the pose is
 #: singular.
 SINGULAR_TOL = 1e-9
-
-
-def _rx(a: float) -> NDArray[np.float64]:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def _ry(a: float) -> NDArray[np.float64]:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def _mdh_batch(alpha: float, d: float, theta: NDArray[np.float64], r: float) -> NDArray[np.float64]:
@@ -60,11 +50,6 @@ def _mdh_batch(alpha: float, d: float, theta: NDArray[np.float64], r: float) -> 
     T[..., 2, 0], T[..., 2, 1], T[..., 2, 2], T[..., 2, 3] = sa * st, sa * ct, ca, r * ca
     T[..., 3, 3] = 1.0
     return T
-
-
-def _annulus_gap(rho: float, r_in: float, r_out: float) -> float:
-    """How far (m) a planar distance ``rho`` is outside the annulus [r_in, r_out] (<= 0 inside)."""
-    return max(rho - r_out, r_in - rho)
 
 
 class Fanuc6(KinematicFamily):
@@ -136,7 +121,7 @@ class Fanuc6(KinematicFamily):
         for shoulder, t1 in (("front", t1_base), ("back", t1_base + np.pi)):
             c1, s1 = np.cos(t1), np.sin(t1)
             A = c1 * w[0] + s1 * w[1] - d2
-            gaps.append(_annulus_gap(float(np.hypot(A, w[2])), abs(d3 - L), d3 + L))
+            gaps.append(annulus_gap(float(np.hypot(A, w[2])), abs(d3 - L), d3 + L))
             K = (A**2 + w[2] ** 2 - d3**2 - L**2) / (2 * d3 * L)
             if abs(K) > 1.0 + 1e-12:
                 continue
@@ -145,13 +130,13 @@ class Fanuc6(KinematicFamily):
                 m = R4 * np.cos(t3) - d4 * np.sin(t3)
                 n = R4 * np.sin(t3) + d4 * np.cos(t3)
                 t2 = np.arctan2(w[2], A) - np.arctan2(d3 + n, m)
-                R03 = (rot_z(t1) @ _rx(np.pi / 2) @ rot_z(np.pi / 2 + t2) @ rot_z(t3))
-                W = _rx(np.pi / 2).T @ R03.T @ R  # = Rz(t4) Ry(t5) Rz(t6)
+                R03 = (rot_z(t1) @ rot_x(np.pi / 2) @ rot_z(np.pi / 2 + t2) @ rot_z(t3))
+                W = rot_x(np.pi / 2).T @ R03.T @ R  # = Rz(t4) Ry(t5) Rz(t6)
                 s5 = float(np.hypot(W[0, 2], W[1, 2]))
                 if s5 < SINGULAR_TOL:
                     t5 = 0.0 if W[2, 2] > 0 else np.pi
                     t4 = float(current[3])
-                    X = (rot_z(t4) @ _ry(t5)).T @ W
+                    X = (rot_z(t4) @ rot_y(t5)).T @ W
                     t6 = float(np.arctan2(X[1, 0], X[0, 0]))
                     warnings.warn("6-axis IK: wrist singularity (theta5 = 0, J4 and J6 aligned): "
                                   f"J4 kept at its current value {np.rad2deg(t4):.3f} deg",

@@ -46,7 +46,7 @@ from sim.core.rotations import (
 )
 from sim.errors import KinematicsError, SingularityWarning, UnreachableError
 from sim.robots.closed_form import fk_5r
-from sim.robots.families.base import KinematicFamily
+from sim.robots.families.base import KinematicFamily, annulus_gap
 
 #: Distance from the J1 axis (m) below which the pose is singular.
 SINGULAR_TOL = 1e-9
@@ -76,11 +76,6 @@ def screw_table_5r(dims: dict[str, float]) -> tuple[NDArray[np.float64], NDArray
     p = np.array([[0, 0, 0], [l1, 0, 0], [l1, 0, d1], [l1 + l2, 0, d1], [l1 + l2, 0, d1]],
                  dtype=float)
     return k, p, np.array([l1 + l2 + l3, 0.0, d1])
-
-
-def _annulus_gap(rho: float, r_in: float, r_out: float) -> float:
-    """How far (m) a planar distance ``rho`` is outside the annulus [r_in, r_out] (<= 0 inside)."""
-    return max(rho - r_out, r_in - rho)
 
 
 class FiveR(KinematicFamily):
@@ -160,7 +155,7 @@ class FiveR(KinematicFamily):
             u = r - l1 - l3 * np.cos(beta)
             v = p[2] + l3 * np.sin(beta)
             s3 = (d1**2 + l2**2 - u**2 - v**2) / (2 * d1 * l2)
-            gaps.append(_annulus_gap(float(np.hypot(u, v)), abs(d1 - l2), d1 + l2))
+            gaps.append(annulus_gap(float(np.hypot(u, v)), abs(d1 - l2), d1 + l2))
             if abs(s3) > 1.0 + 1e-12:
                 continue
             s3 = float(np.clip(s3, -1.0, 1.0))
