@@ -21,6 +21,13 @@ the robot's total mass equals the published (or chosen) figure. MuJoCo integrate
 primitives (``inertiafromgeom``) in a scratch model, and the result is written out as an
 explicit ``<inertial>`` per body.
 
+Collision geometry (class ``collision``, group 3): the visual primitives themselves, except a
+few stand-ins shortened where two links' primitives overlap by construction at a joint
+(:func:`trimmed`, explained by an XML comment next to the geom): the J1 turret over the base
+column, the forearm capsules that would reach into the wrist fork, the 200iC's upper-arm capsule
+that would fill its elbow. No ``<exclude>`` is needed; every other pair of bodies that are not
+parent and child collides (``tests/test_self_collision.py``).
+
 Gains: ``kp_j = omega_n**2 * Imin_j`` and ``kv_j = 2 * zeta * omega_n * sqrt(Imin_j * Imax_j)``
 with ``Imin_j``, ``Imax_j`` the smallest and largest diagonal of the joint-space inertia matrix
 (armature included) over a configuration sample, ``omega_n`` the chosen closed-loop natural
@@ -67,6 +74,10 @@ class Geom:
     pos: tuple[float, ...] | None = None
     mass: float | None = None  # motors only
     collide: bool = True
+    # collision stand-ins for this visual primitive, each inside it (trimmed where two links'
+    # primitives overlap at a joint by construction); None: the primitive itself
+    coll: tuple[Geom, ...] | None = None
+    note: str = ""  # why a collision stand-in is trimmed (written as an XML comment)
 
 
 def cyl(a, b, r, kind="cast", mass=None, collide=True) -> Geom:
@@ -79,6 +90,34 @@ def cap(a, b, r, kind="cast", collide=True) -> Geom:
 
 def box(pos, half, kind="cast", collide=True) -> Geom:
     return Geom("box", kind, pos=tuple(pos), size=tuple(half), collide=collide)
+
+
+def trimmed(g: Geom, fromto, note: str) -> Geom:
+    """``g`` (visual primitive unchanged) whose collision stand-in is the same primitive over the
+    shorter segment ``fromto``, inside ``g``; ``note`` says why (an XML comment)."""
+    g.coll = (Geom(g.type, g.kind, fromto=tuple(fromto), size=g.size, note=note),)
+    return g
+
+
+# The J1 turret's collision cylinder stops this far above the base column it turns on: the
+# two faces coincide by construction and would touch at every J1 angle.
+BEARING_GAP = 0.001  # m
+BEARING_NOTE = "collision: 1 mm above the base column that the J1 turret turns on"
+
+
+#: Radius of the LR Mate 200iC's elbow hub (link3's cylinder about the J3 axis), m.
+ELBOW_HUB_R = 0.056
+
+
+def fork_trim(g: Geom, end: float, wrist: float, joint: str, limit_deg: float) -> Geom:
+    """The forearm capsule ``g`` (along +x, from x = g.fromto[0]) whose collision stand-in ends
+    at ``end`` (its tip at ``end`` + radius) instead of reaching into the wrist: between the
+    fork cheeks the wrist bend folds the flange back towards the forearm."""
+    gap = round((wrist - end - g.size[0]) * 1000)
+    note = (f"collision: the forearm capsule ends {gap} mm short of the wrist centre, between "
+            f"the fork cheeks, so that the flange clears it at the {joint} limits "
+            f"(+-{limit_deg:g} deg)")
+    return trimmed(g, (*g.fromto[:3], end, 0, 0), note)
 
 
 @dataclass
@@ -124,7 +163,9 @@ class RobotDef:
     cameras: list[tuple[str, tuple[float, float, float], tuple[float, float, float]]]
     stat_center: tuple[float, float, float]
     stat_extent: float
-    excludes: list[tuple[str, str]] = field(default_factory=list)
+    # (body1, body2, why): only pairs that the real joint makes touch; the reason is written
+    # into the XML next to the <exclude>
+    excludes: list[tuple[str, str, str]] = field(default_factory=list)
     report_pose_deg: tuple[float, ...] | None = None  # a seed pose whose tcp the README reports
     report_pose_label: str = ""
 
@@ -169,7 +210,7 @@ def lrmate100ib(spec: RobotSpec) -> RobotDef:
     link3 = Body("link3", (0, 0, d1), "j3", (0, 1, 0), "size2", comment="J3: elbow about y (seed k3 = (0,1,0))",
                  geoms=[cyl((0, -0.050, 0), (0, 0.050, 0), 0.050),
                         box((-0.055, 0, 0), (0.055, 0.048, 0.048)),
-                        cap((0, 0, 0), (0.165, 0, 0), 0.040),
+                        fork_trim(cap((0, 0, 0), (0.165, 0, 0), 0.040), 0.130, l2, "J4", 120),
                         box((0.19, 0.041, 0), (0.035, 0.008, 0.030)),
                         box((0.19, -0.041, 0), (0.035, 0.008, 0.030)),
                         cyl((-0.150, 0, 0.020), (-0.110, 0, 0.020), 0.026, "motor", 0.9),
@@ -182,7 +223,8 @@ def lrmate100ib(spec: RobotSpec) -> RobotDef:
                  children=[link3])
     link1 = Body("link1", (0, 0, h), "j1", (0, 0, 1), "size1",
                  comment="J1: waist about z; body origin on the J1 axis at the J2 height (seed frame 0)",
-                 geoms=[cyl((0, 0, -0.160), (0, 0, -0.080), 0.082),
+                 geoms=[trimmed(cyl((0, 0, -0.160), (0, 0, -0.080), 0.082),
+                                (0, 0, -0.160 + BEARING_GAP, 0, 0, -0.080), BEARING_NOTE),
                         box((0.070, 0, -0.045), (0.090, 0.070, 0.045)),
                         cyl((l1, -0.075, 0), (l1, 0.075, 0), 0.060),
                         cyl((l1, -0.075, 0), (l1, -0.150, 0), 0.042, "motor", 1.8)],
@@ -223,7 +265,6 @@ def lrmate100ib(spec: RobotSpec) -> RobotDef:
                  ("side", (0.3, -1.6, 0.55), (0.3, 0, 0.35)),
                  ("top", (0.3, 0.0, 1.9), (0.3, 0, 0.35))],
         stat_center=(0.25, 0, 0.35), stat_extent=1.0,
-        excludes=[("base", "link2")],
     )
 
 
@@ -251,27 +292,35 @@ def lrmate200ic5l(spec: RobotSpec) -> RobotDef:
     link4 = Body("link4", (0, 0, d4), "j4", (1, 0, 0), "size3",
                  comment="J4: forearm roll about z4 = +x at q = 0 (URDF axis -x: theta4 = -J4)",
                  geoms=[cyl((0, 0, 0), (0.060, 0, 0), 0.050),
-                        cap((0.060, 0, 0), (0.345, 0, 0), 0.042),
-                        cyl((0.070, 0, 0.044), (0.130, 0, 0.044), 0.022, "motor", 0.5),
-                        cyl((0.070, 0, -0.044), (0.130, 0, -0.044), 0.020, "motor", 0.4),
+                        fork_trim(cap((0.060, 0, 0), (0.345, 0, 0), 0.042), 0.315, R4, "J5", 120),
+                        # J5/J6 motors 150-210 mm along the forearm: nearer the elbow, the
+                        # lower one met the upper arm once the elbow closed below 35 deg
+                        # (J3 < -55 deg), where the welding table's seams put it
+                        cyl((0.150, 0, 0.044), (0.210, 0, 0.044), 0.022, "motor", 0.5),
+                        cyl((0.150, 0, -0.044), (0.210, 0, -0.044), 0.020, "motor", 0.4),
                         box((0.375, 0.044, 0), (0.040, 0.008, 0.034)),
                         box((0.375, -0.044, 0), (0.040, 0.008, 0.034))],
                  children=[link5])
     link3 = Body("link3", (0, 0, d3), "j3", (0, -1, 0), "size2",
                  comment="J3: elbow about z3 = -y (URDF axis -y: theta3 = J3)",
-                 geoms=[cyl((0, -0.056, 0), (0, 0.056, 0), 0.056),
+                 geoms=[cyl((0, -0.056, 0), (0, 0.056, 0), ELBOW_HUB_R),
                         box((-0.025, 0, 0.045), (0.070, 0.056, 0.055)),
                         cyl((-0.160, 0, d4), (-0.095, 0, d4), 0.032, "motor", 0.7)],
                  children=[link4])
     link2 = Body("link2", (d2, 0, 0), "j2", (0, -1, 0), "size1",
                  comment="J2: shoulder about z2 = -y (URDF axis +y: theta2 = -J2)",
                  geoms=[cyl((0, -0.055, 0), (0, 0.055, 0), 0.060),
-                        cap((0, 0, 0), (0, 0, d3), 0.050),
+                        trimmed(cap((0, 0, 0), (0, 0, d3), 0.050),
+                                (0, 0, 0, 0, 0, d3 - ELBOW_HUB_R - 0.050),
+                                "collision: the upper-arm capsule ends where the elbow's bearing "
+                                "housing begins (link3's hub, r 56 mm about J3, on which the "
+                                "forearm roll housing, link4, turns at every J3 angle)"),
                         cyl((0, 0.056, d3), (0, 0.120, d3), 0.038, "motor", 1.1)],
                  children=[link3])
     link1 = Body("link1", (0, 0, h), "j1", (0, 0, 1), "size1",
                  comment="J1: waist about z0 (URDF axis +z: theta1 = J1); origin on J1 at the J2 height",
-                 geoms=[cyl((0, 0, -0.160), (0, 0, -0.070), 0.086),
+                 geoms=[trimmed(cyl((0, 0, -0.160), (0, 0, -0.070), 0.086),
+                                (0, 0, -0.160 + BEARING_GAP, 0, 0, -0.070), BEARING_NOTE),
                         box((0.025, 0, -0.040), (0.085, 0.072, 0.045)),
                         cyl((d2, -0.075, 0), (d2, 0.075, 0), 0.062),
                         cyl((d2, -0.075, 0), (d2, -0.145, 0), 0.044, "motor", 1.6)],
@@ -311,9 +360,6 @@ def lrmate200ic5l(spec: RobotSpec) -> RobotDef:
                  ("side", (0.4, -2.0, 0.6), (0.4, 0, 0.4)),
                  ("top", (0.4, 0.0, 2.3), (0.4, 0, 0.4))],
         stat_center=(0.3, 0, 0.4), stat_extent=1.2,
-        # link3 is only the elbow housing: the forearm roll (link4) turns inside it, against
-        # the end of the upper arm (link2)
-        excludes=[("base", "link2"), ("link2", "link4")],
     )
 
 
@@ -341,7 +387,7 @@ def robot_5r(spec: RobotSpec) -> RobotDef:
     link3 = Body("link3", (0, 0, d1), "j3", (0, 1, 0), "size2", comment="J3: elbow about y (seed k3)",
                  geoms=[cyl((0, -0.115, 0), (0, 0.115, 0), 0.115),
                         box((-0.130, 0, 0), (0.130, 0.105, 0.105)),
-                        cap((0, 0, 0), (0.500, 0, 0), 0.080),
+                        fork_trim(cap((0, 0, 0), (0.500, 0, 0), 0.080), 0.410, l2, "J4", 135),
                         box((0.540, 0.074, 0), (0.070, 0.014, 0.062)),
                         box((0.540, -0.074, 0), (0.070, 0.014, 0.062)),
                         cyl((-0.360, 0, 0.045), (-0.260, 0, 0.045), 0.055, "motor", 4.0),
@@ -354,7 +400,8 @@ def robot_5r(spec: RobotSpec) -> RobotDef:
                  children=[link3])
     link1 = Body("link1", (0, 0, h), "j1", (0, 0, 1), "size1",
                  comment="J1: waist about z, the axis of the cylindrical part; origin at the J2 height",
-                 geoms=[cyl((0, 0, -0.250), (0, 0, -0.120), 0.200),
+                 geoms=[trimmed(cyl((0, 0, -0.250), (0, 0, -0.120), 0.200),
+                                (0, 0, -0.250 + BEARING_GAP, 0, 0, -0.120), BEARING_NOTE),
                         box((0.080, 0, -0.060), (0.220, 0.160, 0.090)),
                         cyl((l1, -0.160, 0), (l1, 0.160, 0), 0.140),
                         cyl((l1, -0.160, 0), (l1, -0.300, 0), 0.095, "motor", 14.0)],
@@ -392,9 +439,6 @@ def robot_5r(spec: RobotSpec) -> RobotDef:
                  ("side", (0.8, -4.5, 1.2), (0.8, 0, 0.9)),
                  ("top", (0.6, 0.0, 5.0), (0.6, 0, 0.6))],
         stat_center=(0.6, 0, 0.9), stat_extent=2.6,
-        # the wrist (link5) folds back past the forearm's end (link3) inside J4's +-135 deg,
-        # as a real offset wrist housing does; the primitive shapes would overlap there
-        excludes=[("base", "link2"), ("link3", "link5")],
         report_pose_deg=(-15.2, 116.82, -1.3, 1.4, -0.206),
         report_pose_label="Seed 001 phase-I end pose",
     )
@@ -470,8 +514,12 @@ def _body_xml(rd: RobotDef, b: Body, ind: int, inertials: dict | None, mass_mode
         out.append(q + _geom_xml(g, "visual", _material(g), mass_mode))
     if mass_mode is None:
         for g in b.geoms:
-            if g.collide:
-                out.append(q + _geom_xml(g, "collision", "", None))
+            if not g.collide:
+                continue
+            for c in (g,) if g.coll is None else g.coll:
+                if c.note:
+                    out.append(f"{q}<!-- {c.note} -->")
+                out.append(q + _geom_xml(c, "collision", "", None))
     for s in b.sites:
         if s.comment:
             out.append(f"{q}<!-- {s.comment} -->")
@@ -539,7 +587,8 @@ def _robot_xml(rd: RobotDef, spec: RobotSpec, inertials: dict | None, mass_mode:
     if mass_mode is None:
         if rd.excludes:
             L.append("  <contact>")
-            for a, b in rd.excludes:
+            for a, b, why in rd.excludes:
+                L.append(f"    <!-- {why} -->")
                 L.append(f'    <exclude body1="{a}" body2="{b}"/>')
             L += ["  </contact>", ""]
         L.append("  <actuator>")

@@ -195,7 +195,7 @@ for _spec in (
                 Drive(48, 0.70, 3.0e-6, 0.25, 0.8, 6000),
             ),
             payload_kg=5.0,
-            max_accel=_deg(1400, 2300, 5300, 40000, 43000, 210000),
+            max_accel=_deg(1400, 2300, 5200, 40000, 43000, 210000),
         ),
         RobotSpec(
             name="robot_5r",
