@@ -22,6 +22,11 @@ class ScenarioError(CellsimError):
     """A scenario file is malformed or inconsistent; the message names the file and field."""
 
 
+class ReachError(ScenarioError):
+    """A scenario's target or path is out of reach, or reachable only outside the joint ranges
+    (``cellsim check`` reports it as a finding; elsewhere it is a scenario mistake)."""
+
+
 class KinematicsError(CellsimError):
     """Base class of kinematics errors."""
 

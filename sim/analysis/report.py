@@ -37,6 +37,7 @@ from sim.analysis.sizing import (
     load_summary,
     peak_envelope,
 )
+from sim.simulation.collisions import CLEARANCE_RANGE_M
 from sim.simulation.runfolder import (
     REPORT_HTML,
     SIZING_CHARTS_DIR,
@@ -388,6 +389,42 @@ img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}
 """
 
 
+def collision_rows(summary: Mapping[str, Any]) -> tuple[list[list[str]], list[list[str]]]:
+    """Rows of the collisions table and of the per-phase clearance table of a summary."""
+    coll = [[str(c["phase"]), f"{c['t0']:.3f}-{c['t1']:.3f}", str(c["kind"]),
+             f"{c['bodies'][0]} / {c['bodies'][1]}", f"{c['geoms'][0]} / {c['geoms'][1]}",
+             f"{c['depth_mm']:.2f}"] for c in summary.get("collisions", ())]
+
+    def mm(v: Any) -> str:
+        return f"> {CLEARANCE_RANGE_MM:g}" if v is None else f"{v:.1f}"
+
+    clear = [[str(c["phase"]), mm(c.get("tool_mm")),
+              " / ".join(c.get("tool_pair", ())) or "-", mm(c.get("arm_mm")),
+              " / ".join(c.get("arm_pair", ())) or "-"] for c in summary.get("clearance", ())]
+    return coll, clear
+
+
+#: Clearance is measured up to this distance, mm.
+CLEARANCE_RANGE_MM = 1e3 * CLEARANCE_RANGE_M
+_COLL_HEAD = ("phase", "t (s)", "kind", "bodies", "worst geoms", "depth (mm)")
+_CLEAR_HEAD = ("phase", "tool (mm)", "tool closest pair", "arm (mm)", "arm closest pair")
+
+
+def _collision_html(summary: Mapping[str, Any]) -> list[str]:
+    if "collisions" not in summary:
+        return []
+    coll, clear = collision_rows(summary)
+    out = ["<h2>Collisions and clearance</h2>"]
+    if coll:
+        out.append(f'<p class="verdict fail">{len(coll)} collision(s): the motion is not '
+                   "physically possible.</p>")
+        out.append(_html_table(_COLL_HEAD, coll))
+    else:
+        out.append('<p class="verdict">No collision along the whole motion.</p>')
+    out.append(_html_table(_CLEAR_HEAD, clear))
+    return out
+
+
 def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapping[str, Any],
                 video: str | None = None) -> str:
     """Text of the self-contained ``report.html`` (charts as base64 data URIs)."""
@@ -415,6 +452,7 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
                    f'<p><a href="{esc(video)}">{esc(video)}</a></p>')
     cls = "verdict" if result.passed else "verdict fail"
     out.append(f'<h2>Verdict</h2><p class="{cls}">{esc(result.verdict)}</p>')
+    out += _collision_html(summary)
     out.append("<h2>Per joint</h2>")
     out.append(_html_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
     out.append("<h2>Checks</h2>")

@@ -12,10 +12,17 @@ is per joint:
 * ``acceleration``: the largest reference joint acceleration, deg/s^2, against the robot's
   acceleration limit (derived from its drive train, :mod:`sim.robots.accel_limits`);
 * the sizing checks (:mod:`sim.analysis.sizing`: joint torque, motor RMS and peak torque,
-  motor speed, torque-speed envelope), the joint speed excepted (it is ``speed`` above).
+  motor speed, torque-speed envelope), the joint speed excepted (it is ``speed`` above);
+* ``collision``: one per collision interval (:mod:`sim.simulation.collisions`; ``subject``
+  names the phase and the two bodies), the penetration in mm against 0; one passed check with
+  value 0 when there is none;
+* ``clearance`` (a *warning*): per phase, the smaller of the tool's and the arm's clearance to
+  the cell, mm, against the scenario's ``simulation.clearance_mm``.
 
-``summary.json`` holds ``"checks"`` (each ``name``, ``joint``, ``value``, ``limit``, ``unit``,
-``pass``) and ``"verdict"``: ``"pass"`` when every check passed, else ``"fail"``.
+``summary.json`` holds ``"checks"`` (each ``name``, ``joint`` ("" when the check is not a
+joint's), ``subject``, ``value``, ``limit``, ``unit``, ``pass``, ``severity``) and
+``"verdict"``: ``"pass"`` when every check of severity ``error`` passed, else ``"fail"``. A
+failed warning does not fail the run; ``"warnings"`` counts them.
 """
 
 from __future__ import annotations
@@ -33,7 +40,7 @@ from sim.robots.registry import RobotSpec
 
 @dataclass(frozen=True)
 class RunCheck:
-    """One check of one joint: ``value`` against ``limit`` (both in ``unit``)."""
+    """One check: ``value`` against ``limit`` (both in ``unit``), of a joint or a ``subject``."""
 
     name: str
     joint: str
@@ -41,16 +48,19 @@ class RunCheck:
     limit: float
     unit: str
     passed: bool
+    severity: str = "error"
+    subject: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "joint": self.joint, "value": self.value,
-                "limit": self.limit, "unit": self.unit, "pass": self.passed}
+        return {"name": self.name, "joint": self.joint, "subject": self.subject or self.joint,
+                "value": self.value, "limit": self.limit, "unit": self.unit,
+                "pass": self.passed, "severity": self.severity}
 
 
 def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], spec: RobotSpec,
-               tracking_tolerance_deg: float, sizing: SizingResult | None = None
-               ) -> list[RunCheck]:
-    """Every check of a run (module docstring), joint by joint."""
+               tracking_tolerance_deg: float, sizing: SizingResult | None = None,
+               clearance_mm: float = 5.0) -> list[RunCheck]:
+    """Every check of a run (module docstring): joint by joint, then collisions, clearance."""
     checks: list[RunCheck] = []
     track = np.degrees(np.max(np.abs(np.asarray(arrays["q"]) - arrays["q_ref"]), axis=0))
     speed = np.degrees(np.max(np.abs(np.asarray(arrays["qd"])), axis=0))
@@ -77,9 +87,37 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                     continue
                 checks.append(RunCheck(c.key, j.joint, float(c.used), float(c.limit), c.unit,
                                        bool(c.passed)))
+    checks += motion_checks(summary, clearance_mm)
+    return checks
+
+
+def motion_checks(summary: Mapping[str, Any], clearance_mm: float) -> list[RunCheck]:
+    """The ``collision`` checks (errors) and the per-phase ``clearance`` checks (warnings) of
+    a summary's ``"collisions"`` and ``"clearance"`` (none when the summary has neither)."""
+    checks: list[RunCheck] = []
+    if "collisions" in summary:
+        for c in summary["collisions"]:
+            subject = f"{c['phase']}: {c['bodies'][0]} / {c['bodies'][1]} ({c['t0']:.3f}-{c['t1']:.3f} s)"
+            checks.append(RunCheck("collision", "", float(c["depth_mm"]), 0.0, "mm", False,
+                                   subject=subject))
+        if not summary["collisions"]:
+            checks.append(RunCheck("collision", "", 0.0, 0.0, "mm", True, subject="whole cycle"))
+    for c in summary.get("clearance", ()):
+        values = [v for v in (c.get("tool_mm"), c.get("arm_mm")) if v is not None]
+        if not values:
+            continue
+        value = min(values)
+        checks.append(RunCheck("clearance", "", float(value), float(clearance_mm), "mm",
+                               bool(value >= clearance_mm), severity="warning",
+                               subject=str(c["phase"])))
     return checks
 
 
 def verdict(checks: Sequence[RunCheck]) -> str:
-    """``"pass"`` when every check passed, else ``"fail"``."""
-    return "pass" if all(c.passed for c in checks) else "fail"
+    """``"pass"`` when every check of severity ``error`` passed, else ``"fail"``."""
+    return "pass" if all(c.passed for c in checks if c.severity == "error") else "fail"
+
+
+def warnings_count(checks: Sequence[RunCheck]) -> int:
+    """Number of failed warning checks."""
+    return sum(1 for c in checks if c.severity == "warning" and not c.passed)

@@ -137,6 +137,8 @@ class Cell:
         description: The cell's one-line description.
         frictionloss: Coulomb friction of each robot joint, N m, (n,), applied by the friction
             actuators ``robot/friction_jN`` (:mod:`sim.cells.compose`).
+        objects: Geom names of each cell object made of several geoms (a ring of staves).
+        seam_objects: Objects each seam joins (its workpieces), by seam name.
     """
 
     name: str
@@ -162,6 +164,8 @@ class Cell:
     dims: dict[str, float] = field(default_factory=dict)
     description: str = ""
     frictionloss: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    objects: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    seam_objects: dict[str, tuple[str, ...]] = field(default_factory=dict)
     _rig: RobotRig | None = field(default=None, repr=False)
 
     def compile(self) -> mujoco.MjModel:
@@ -273,6 +277,9 @@ def build_cell(cell: CellSpec | None, robot: RobotSpec, *,
         start_q=layout.start_q, payload_kg=payload, tip_site=tip_site_name(rig),
         dims={k: float(v) for k, v in layout.dims.items()}, description=cspec.description,
         frictionloss=rig.statics.frictionloss.copy(),
+        objects={name: tuple(g.full_identifier for g in geoms)
+                 for name, geoms in layout.objects.items()},
+        seam_objects=dict(layout.seam_objects),
         _rig=rig)
 
 

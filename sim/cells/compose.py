@@ -20,10 +20,12 @@ Steps (:func:`prepare_robot`, :func:`new_world`, :func:`attach_robot`, :func:`fi
    an attachment frame: ``floor`` mount = upright at a height (a riser or column), ``ceiling`` =
    turned 180 deg about the world x axis (base up, J1 axis pointing down) under a ceiling plate.
 
-Contacts: the cell's static geometry and the parts use the bit masks of :mod:`sim.cells.tools`, so the
-robot's links (MuJoCo's default ``contype = conaffinity = 1``) never touch the cell: clearance is
-a geometric question, and contact forces must not pollute the joint torques used for sizing.
-Parts touch the fixtures, each other and the suction cup.
+Contacts: the cell's static geometry and the parts use the bit masks of :mod:`sim.cells.tools`;
+the robot's link geoms get ``contype = conaffinity = 0`` in a cell (:func:`prepare_robot`), so
+in the simulation the arm touches neither itself nor the cell: collisions are a geometric
+question answered along the motion on a check model (:mod:`sim.simulation.collisions`), and
+contact forces must not pollute the joint torques used for sizing. Parts touch the fixtures,
+each other and the suction cup.
 """
 
 from __future__ import annotations
@@ -266,6 +268,11 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
     for key in robot.find_all("key"):
         key.remove()
     robot.model = ROBOT_PREFIX
+    # the arm makes no contact in the simulation (module docstring): its collision geoms are
+    # checked geometrically by sim.simulation.collisions
+    for geom in robot.find_all("geom"):
+        geom.contype = 0
+        geom.conaffinity = 0
     if tool is not None and tool.suction_gain_n > 0.0:
         # implicitfast diverged with an adhesion-held 0.5 kg part (the part tumbles); the full
         # implicit integrator (also supported by mj_inverse's invdiscrete) holds it: see sim.cells.tools
@@ -402,21 +409,25 @@ def add_box(body: mjcf.Element, name: str, center, half_size, material: str,
 
 def add_ring(body: mjcf.Element, name: str, r_in: float, r_out: float, z0: float, z1: float,
              material: str, n: int = 72, phi0: float = 0.0, phi1: float = 2 * np.pi,
-             center=(0.0, 0.0), contact: bool = True) -> None:
+             center=(0.0, 0.0), contact: bool = True) -> list[mjcf.Element]:
     """Cylindrical shell segment (annulus r_in..r_out, z0..z1) from ``n`` box staves.
 
     Each stave's outer face is tangent to ``r_out`` at its middle (the true cylinder is met at
-    ``n`` lines; the faceting error at r_out is ``r_out (1/cos(pi/n) - 1)``).
+    ``n`` lines; the faceting error at r_out is ``r_out (1/cos(pi/n) - 1)``). Returns the
+    staves (one object of the cell: :attr:`Layout.objects`).
     """
+    staves = []
     dphi = (phi1 - phi0) / n
     half_w = r_out * np.tan(dphi / 2.0)
     rm = (r_in + r_out) / 2.0
     for k in range(n):
         phi = phi0 + (k + 0.5) * dphi
         R = np.array([[np.cos(phi), -np.sin(phi), 0], [np.sin(phi), np.cos(phi), 0], [0, 0, 1.0]])
-        add_box(body, f"{name}{k}", [center[0] + rm * np.cos(phi), center[1] + rm * np.sin(phi),
-                                     (z0 + z1) / 2], [(r_out - r_in) / 2, half_w, (z1 - z0) / 2],
-                material, R=R, contact=contact)
+        staves.append(add_box(
+            body, f"{name}{k}", [center[0] + rm * np.cos(phi), center[1] + rm * np.sin(phi),
+                                 (z0 + z1) / 2], [(r_out - r_in) / 2, half_w, (z1 - z0) / 2],
+            material, R=R, contact=contact))
+    return staves
 
 
 # ---------------------------------------------------------------------------- finishing
@@ -433,6 +444,11 @@ class Layout:
         cameras: Camera names.
         start_q: Robot configuration at the start of the first seam (welding cells), rad.
         dims: Key dimensions of the cell for reports, m (names documented by each builder).
+        objects: Cell objects made of several geoms (a ring of staves), by object name; a
+            static geom in no object is an object of its own (its name). Collision reports
+            name objects, not staves.
+        seam_objects: Names of the objects each seam joins (the seam's workpieces): the
+            welding wire may touch them while the arc is on along that seam.
     """
 
     world: mjcf.RootElement
@@ -444,6 +460,8 @@ class Layout:
     start_q: NDArray[np.float64] | None = None
     home_q: NDArray[np.float64] | None = None
     dims: dict[str, float] = field(default_factory=dict)
+    objects: dict[str, list[mjcf.Element]] = field(default_factory=dict)
+    seam_objects: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
 
 def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:

@@ -117,6 +117,11 @@ class ToolSpec:
             approach axis, m. The tip lies on that axis (straight tool).
         kind: ``"torch"`` or ``"gripper"``.
         suction_gain_n: Adhesion force at full suction (``ctrl = 1``), N; 0 for a torch.
+        work_geoms: The tool's geoms that touch the work by design (names inside the tool
+            model): a torch's welding wire, which may touch the seam's workpiece while the arc
+            is on; a gripper's cup lip, which may touch the part it picks. Every other geom of
+            the tool (nozzle, torch body, ...) must never touch anything
+            (:mod:`sim.simulation.collisions`).
     """
 
     name: str
@@ -125,6 +130,7 @@ class ToolSpec:
     length_m: float
     kind: str = "torch"
     suction_gain_n: float = 0.0
+    work_geoms: tuple[str, ...] = ()
 
 
 #: The shipped tools by name.
@@ -136,6 +142,7 @@ for _spec in (
             mass_kg=1.0,
             length_m=0.145,
             kind="torch",
+            work_geoms=("wire",),
         ),
         ToolSpec(
             name="mig_torch_long",
@@ -143,6 +150,7 @@ for _spec in (
             mass_kg=1.7,
             length_m=0.300,
             kind="torch",
+            work_geoms=("wire",),
         ),
         ToolSpec(
             name="vacuum_gripper",
@@ -151,6 +159,7 @@ for _spec in (
             length_m=0.100,
             kind="gripper",
             suction_gain_n=SUCTION_GAIN_N,
+            work_geoms=tuple(f"lip{k}" for k in range(8)),
         ),
 ):
     TOOLS.add(_spec.name, _spec)

@@ -136,8 +136,8 @@ def build(rig: RobotRig, mount: str) -> Layout:
 
     # part: shell (outside the seam radius) + flush annular head (inside)
     wb = world.worldbody
-    add_ring(wb, "shell", R, R + SHELL_WALL, 0.0, zs, "steel", n=96)
-    add_ring(wb, "head", R - HEAD_WIDTH, R, zs - HEAD_THICKNESS, zs, "dark_steel", n=96)
+    shell = add_ring(wb, "shell", R, R + SHELL_WALL, 0.0, zs, "steel", n=96)
+    head = add_ring(wb, "head", R - HEAD_WIDTH, R, zs - HEAD_THICKNESS, zs, "dark_steel", n=96)
     # seam line (visual): 4 mm wide, 0.5 mm proud, over the welded arc
     # seam line (visual): 4 mm wide, 0.5 mm proud, over the welded arc (counter-clockwise in
     # world from the start on the floor; hanging, the world azimuth runs the other way)
@@ -169,5 +169,7 @@ def build(rig: RobotRig, mount: str) -> Layout:
         "seam_sweep_deg": float(np.degrees(phi_end - phi0)),
     }
     return Layout(world=world, world_from_frame0=T0, seams={seam.name: seam}, cameras=cameras,
-                  start_q=start_q, home_q=np.zeros(rig.spec.n_joints), dims=dims)
+                  start_q=start_q, home_q=np.zeros(rig.spec.n_joints), dims=dims,
+                  objects={"shell": shell, "head": head},
+                  seam_objects={seam.name: ("shell", "head")})
 

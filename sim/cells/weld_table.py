@@ -134,7 +134,7 @@ def build(rig: RobotRig, mount: str) -> Layout:
                 description="2F fillet at the foot of a curved wall (R 0.50 m about J1)")
     axis_w = T0[:2, 3]  # J1 axis (x, y) in world
     z_plate_w = w([0, 0, PLATE_TOP])[2]
-    add_ring(wb, "wall", ARC_R, ARC_R + WALL_T, z_plate_w, z_plate_w + WALL_H, "steel", n=24,
+    wall = add_ring(wb, "wall", ARC_R, ARC_R + WALL_T, z_plate_w, z_plate_w + WALL_H, "steel", n=24,
              phi0=a0 - np.deg2rad(7.0), phi1=a1 + np.deg2rad(7.0), center=axis_w)
     add_ring(wb, "arc_mark", ARC_R - 0.003, ARC_R, z_plate_w, z_plate_w + 0.0008, "seam", n=24,
              phi0=a0, phi1=a1, center=axis_w, contact=False)
@@ -157,5 +157,8 @@ def build(rig: RobotRig, mount: str) -> Layout:
             "line_length": r1 - r0, "arc_radius": ARC_R, "arc_sweep_deg": ARC_DEG[1] - ARC_DEG[0],
             "wall_height": WALL_H}
     return Layout(world=world, world_from_frame0=T0, seams=seams, cameras=cameras,
-                  start_q=start_q, home_q=rig.home_q.copy(), dims=dims)
+                  start_q=start_q, home_q=rig.home_q.copy(), dims=dims,
+                  objects={"wall": wall},
+                  seam_objects={"line": ("v_plate_left", "v_plate_right"),
+                                "arc": ("wall", "base_plate")})
 

@@ -9,7 +9,9 @@ no ``summary.json``; a run that fails mid-simulation keeps what it recorded in
 
 The run's verdict (``summary.json`` ``"verdict"``, :mod:`sim.analysis.verdict`) fails when the
 run tracks worse than its tolerance, saturates a drive, exceeds a speed or acceleration limit
-or a sizing limit; the failed checks are printed. Exit codes: 0 when the run was simulated
+or a sizing limit, or collides (the robot with itself, the tool or the arm with the cell, a held
+part with the cell: :mod:`sim.simulation.collisions`); the failed checks and the collisions are
+printed, and a phase closer to the cell than ``simulation.clearance_mm`` is a warning. Exit codes: 0 when the run was simulated
 (whatever its verdict), 1 with ``--strict`` when the verdict is fail, 2 for a mistake in the
 input.
 """
@@ -43,9 +45,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="cell camera to film (repeat to tile several side by side)")
     p.add_argument("--quiet", action="store_true", help="no progress bars (the result lines only)")
     p.add_argument("--strict", action="store_true",
-                   help="exit with 1 when the run's verdict is fail (a saturated drive, a joint "
-                        "over its speed or acceleration limit, tracking worse than the "
-                        "tolerance, a sizing limit exceeded)")
+                   help="exit with 1 when the run's verdict is fail (a collision, a saturated "
+                        "drive, a joint over its speed or acceleration limit, tracking worse "
+                        "than the tolerance, a sizing limit exceeded)")
     p.set_defaults(func=run)
 
 
@@ -92,16 +94,24 @@ def run(args: argparse.Namespace) -> int:
         s = summary["sizing"]
         print(f"  sizing: hardest joint {s['hardest_joint']} (margin {s['hardest_margin_pct']:.1f} %),"
               f" {'all pass' if s['pass'] else 'FAIL'}")
-    failed = [c for c in summary.get("checks", []) if not c["pass"]]
+    checks = summary.get("checks", [])
+    failed = [c for c in checks if not c["pass"] and c.get("severity", "error") == "error"]
+    warned = [c for c in checks if not c["pass"] and c.get("severity") == "warning"]
     for s in summary.get("saturation", [])[:10]:
         print(f"  saturation {s['joint']}: {s['t0']:.3f}-{s['t1']:.3f} s ({s['phase']}), "
               f"demand over the drive's limit by up to {s['worst_excess_nm']:.4g} N m")
+    for c in summary.get("collisions", [])[:10]:
+        print(f"  collision {c['bodies'][0]} / {c['bodies'][1]}: {c['t0']:.3f}-{c['t1']:.3f} s "
+              f"({c['phase']}), {c['depth_mm']:.1f} mm deep ({c['geoms'][0]}, {c['geoms'][1]})")
+    for c in warned:
+        print(f"  warning: {c['name']} {c.get('subject') or c['joint']}: {c['value']:.4g} "
+              f"{c['unit']} (below {c['limit']:.4g} {c['unit']})")
     if failed:
         print(f"  verdict: FAIL ({len(failed)} check(s) failed)")
         for c in failed:
-            print(f"    {c['name']} {c['joint']}: {c['value']:.4g} {c['unit']} against the "
-                  f"limit {c['limit']:.4g} {c['unit']}")
+            print(f"    {c['name']} {c.get('subject') or c['joint']}: {c['value']:.4g} "
+                  f"{c['unit']} against the limit {c['limit']:.4g} {c['unit']}")
     else:
-        print(f"  verdict: pass ({len(summary.get('checks', []))} checks)")
+        print(f"  verdict: pass ({len(checks)} checks, {len(warned)} warning(s))")
     print(f"  results in {out}/")
     return 1 if args.strict and summary.get("verdict") == "fail" else 0

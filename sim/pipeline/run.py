@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from sim import __version__
 from sim.analysis.sizing import SizingResult, apply_overrides
-from sim.analysis.verdict import run_checks, verdict
+from sim.analysis.verdict import run_checks, verdict, warnings_count
 from sim.errors import InternalError
 from sim.scenario import Scenario
 from sim.simulation import runfolder
@@ -161,6 +161,7 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         runfolder.write_csv(tmp, arrays, scenario.robot.joints)
 
         summary = make_summary(scenario, built, motion, rec, feedforward)
+        add_collisions(summary, built, motion, arrays)
         # post-processing reads the record in memory, never the files just written; the
         # folder only becomes visible (moved into place) once everything succeeded
         record = runfolder.RunRecord.from_arrays(
@@ -180,9 +181,11 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         if options.sizing:  # last: report.html links the video when there is one
             sizing = _write_sizing(tmp, scenario, built, record, summary)
         checks = run_checks(arrays, summary, scenario.robot,
-                            scenario.simulation.tracking_tolerance_deg, sizing)
+                            scenario.simulation.tracking_tolerance_deg, sizing,
+                            clearance_mm=scenario.simulation.clearance_mm)
         summary["checks"] = [c.to_dict() for c in checks]
         summary["verdict"] = verdict(checks)
+        summary["warnings"] = warnings_count(checks)
         runfolder.write_summary(tmp, summary)
         runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
     except BaseException:
@@ -198,6 +201,24 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
     if runfolder.is_run_folder(stale):
         shutil.rmtree(stale, ignore_errors=True)
     return summary
+
+
+def add_collisions(summary: dict[str, Any], built: BuiltCell, motion: Any,
+                   arrays: dict[str, NDArray[Any]]) -> None:
+    """Check the recorded motion for collisions and clearance (:mod:`sim.simulation.collisions`)
+    and put ``collisions``, ``clearance``, ``allowed_contacts`` and ``collision_check_s`` in
+    the summary."""
+    import time
+
+    from sim.simulation.collisions import check_motion, phase_seams, samples_from_arrays
+
+    start = time.perf_counter()
+    report = check_motion(built, samples_from_arrays(arrays), [pm.name for pm in motion.phases],
+                          phase_seams(motion))
+    summary["collisions"] = report.collisions
+    summary["clearance"] = report.clearance
+    summary["allowed_contacts"] = report.allowed
+    summary["collision_check_s"] = time.perf_counter() - start
 
 
 def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:

@@ -153,6 +153,8 @@ class FrameRenderer:
                 f"could not create a {self.width}x{self.height} OpenGL renderer: {exc}"
             ) from exc
         self._geoms = self._renderer.scene.geoms
+        self.painter = CollisionPainter(model, self.record.summary.get("collisions", ())
+                                        if self.record.summary else ())
         self._tiles = [np.empty((self.height, self.width, 3), np.uint8) for _ in self.camera_ids]
 
     # -- life cycle ---------------------------------------------------------------------
@@ -234,6 +236,7 @@ class FrameRenderer:
         single = len(self.camera_ids) == 1
         for k, cid in enumerate(self.camera_ids):
             r.update_scene(self.data, cid)
+            self.painter.paint(r.scene, time)
             if self.overlay is not None:
                 self.overlay.add_to_scene(r.scene, time, self.height, self._geoms)
             if single:
@@ -244,3 +247,57 @@ class FrameRenderer:
         if self.caption if caption is None else caption:
             draw_caption(out, self.caption_at(time))
         return out
+
+
+#: Colour of the geoms that collide, while they touch (RGBA).
+COLLISION_RGBA = (1.0, 0.08, 0.05, 1.0)
+
+
+class CollisionPainter:
+    """Draws the geoms of a run's collisions (``summary["collisions"]``) in red while they touch.
+
+    A robot link's collision geoms are hidden in the video (group 3): the whole link (its
+    visual geoms) is painted instead; a tool, cell or part geom is painted itself.
+    """
+
+    def __init__(self, model: Any, collisions: Sequence[dict[str, Any]]) -> None:
+        import mujoco
+
+        self._mj = mujoco
+        self.intervals: list[tuple[float, float, frozenset[int]]] = []
+        for c in collisions:
+            ids: set[int] = set()
+            for name in c.get("all_geoms", c.get("geoms", ())):
+                g = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, str(name))
+                if g < 0:
+                    continue
+                body = int(model.geom_bodyid[g])
+                bname = model.body(body).name
+                if bname.startswith("robot/") and not bname.startswith("robot/tool/"):
+                    ids.update(int(k) for k in np.flatnonzero(model.geom_bodyid == body))
+                else:
+                    ids.add(g)
+            if ids:
+                self.intervals.append((float(c["t0"]), float(c["t1"]), frozenset(ids)))
+
+    def active(self, time: float) -> frozenset[int]:
+        """Geom ids in collision at ``time`` (s)."""
+        out: set[int] = set()
+        for t0, t1, ids in self.intervals:
+            if t0 <= time <= t1:
+                out |= ids
+        return frozenset(out)
+
+    def paint(self, scene: Any, time: float) -> int:
+        """Paint the colliding geoms of ``scene`` red; returns how many were painted."""
+        ids = self.active(time) if self.intervals else frozenset()
+        if not ids:
+            return 0
+        geom = self._mj.mjtObj.mjOBJ_GEOM
+        n = 0
+        for i in range(scene.ngeom):
+            g = scene.geoms[i]
+            if g.objtype == geom and g.objid in ids:
+                g.rgba[:] = COLLISION_RGBA
+                n += 1
+        return n

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from planners.base import JointState, sample_times
 from planners.errors import PlannerError
-from sim.errors import CellsimError, ScenarioError
+from sim.errors import CellsimError, ReachError, ScenarioError
 from sim.scenario import (
     CartesianPhase,
     HoldPhase,
@@ -345,11 +345,11 @@ def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianCont
     try:
         sols = solve_ik(ctx.kinematics, T, current=q0)
     except CellsimError as exc:
-        raise ScenarioError(f"{label}.{key}: {exc}") from None
+        raise ReachError(f"{label}.{key}: {exc}") from None
     good = [s for s in sols if s.within_limits]
     if not good:
-        raise ScenarioError(f"{label}.{key}: the pose is reachable only outside the joint "
-                            "ranges")
+        raise ReachError(f"{label}.{key}: the pose is reachable only outside the joint "
+                         "ranges")
     return np.asarray(good[0].q, dtype=float)
 
 
@@ -434,7 +434,7 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     try:
         q_via = np.asarray(ik_path(kin, poses, q_start=q0), dtype=float)
     except CellsimError as exc:
-        raise ScenarioError(f"{label}: {exc}") from None
+        raise ReachError(f"{label}: {exc}") from None
     jump = np.abs(q_via[0] - q0)
     if np.any(jump > 1e-6):
         j = int(np.argmax(jump))

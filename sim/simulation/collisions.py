@@ -1,0 +1,569 @@
+"""Collisions and clearance along a motion: the robot, its tool, the cell and the parts.
+
+The physics model keeps contacts that are part of the work only (parts on fixtures, the suction
+cup on a part): a contact of the arm or the torch with the cell would push back and pollute the
+joint torques used for sizing, and a real robot does not bounce off a fixture; it crashes.
+Collisions are therefore a geometric question, answered along the recorded (or reference)
+motion on a *check model*: a copy of the compiled cell whose contact masks are set here.
+
+What is checked (:class:`CollisionModel`):
+
+* **geoms**: the robot links' collision geoms (group 3), every geom of the tool, every static
+  cell geom that collides in the physics model (fixtures, workpieces, the floor; markers such as
+  the seam lines and slots do not) and the parts;
+* **pairs**: robot link with robot link (MuJoCo's parent-child filter and the robot's declared
+  ``<exclude>`` pairs apply: adjacent links meet at their joint), tool with robot link (not the
+  flange link it is mounted on), robot or tool with any cell object or part, part with cell
+  object or part.
+
+Allowed contacts are declared (:func:`allowed_contacts`), not guessed:
+
+* the tool's *work geoms* (:attr:`sim.cells.tools.ToolSpec.work_geoms`): the welding wire with
+  the workpieces of the seam the phase welds (:attr:`sim.cells.Cell.seam_objects`) while the
+  arc is on; the cup lip with the part it picks, from the start of the phase before suction
+  comes on (the descent) to the end of the phase after it goes off (the retract);
+* a part with the cell or another part while it is not held (it rests), and while held in the
+  phase where suction comes on and the next one (lift-off from where it rested) and in the phase
+  where suction goes off and the one before (set-down in its slot);
+* everything else (nozzle, torch body, arm, a held part in transfer) never.
+
+A contact is a collision when its penetration exceeds :data:`PENETRATION_TOLERANCE_M` (0.1 mm,
+below the soft-contact sinkage of a resting part and the wire's touch at a seam start).
+Collisions are reported as intervals (:func:`find_collisions`): ``t0``, ``t1`` (s), the phase
+at ``t0``, the two ``bodies`` (robot body, tool body, cell object or part), the worst geom pair
+(``geoms``), every geom involved (``all_geoms``, for the video) and the worst penetration
+``depth_mm`` at ``t_worst``.
+
+Clearance (:func:`clearance`): per phase, the smallest distance from the tool (its geoms but the
+work geoms: nozzle and torch body) and from the arm (the links but the fixed base) to any cell
+object or part, allowed contacts left out. MuJoCo's narrow phase computes the distances of the
+pairs closer than :data:`CLEARANCE_RANGE_M` (the check model's geom margin); the scan runs every
+:data:`CLEARANCE_STRIDE_S` and is refined at every sample around each phase's closest sample. A
+phase farther than the range reports ``null``; a phase closer than the scenario's
+``simulation.clearance_mm`` (default 5 mm) is a failed warning check of the verdict.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.errors import InternalError
+from sim.simulation.compile import BuiltCell
+
+#: Penetration a contact may have without being a collision, m.
+PENETRATION_TOLERANCE_M = 1e-4
+#: Distances are measured up to this range, m (the check model's geom margin).
+CLEARANCE_RANGE_M = 0.1
+#: Period of the clearance scan before refinement, s.
+CLEARANCE_STRIDE_S = 0.01
+
+#: Roles of the checked geoms.
+LINK, TOOL, CELL, PART = "link", "tool", "cell", "part"
+_BITS = {LINK: 1, TOOL: 2, CELL: 4, PART: 8}
+_AFFINITY = {LINK: 1 | 2 | 4 | 8, TOOL: 1 | 4 | 8, CELL: 1 | 2 | 8, PART: 1 | 2 | 4 | 8}
+_ROLE_CODE = {LINK: 0, TOOL: 1, CELL: 2, PART: 3}
+
+
+@dataclass(frozen=True)
+class CheckGeom:
+    """One checked geom.
+
+    Attributes:
+        id: Geom id in the compiled cell.
+        name: Geom name (``robot/link4/...``; unnamed robot geoms get ``<body>#<k>``).
+        role: ``link``, ``tool``, ``cell`` or ``part``.
+        owner: What a report names: the robot body, the tool body, the cell object or the part.
+        work: A tool work geom (wire, cup lip).
+        base: A geom of the robot's fixed base (left out of the arm's clearance).
+    """
+
+    id: int
+    name: str
+    role: str
+    owner: str
+    work: bool = False
+    base: bool = False
+
+
+@dataclass
+class MotionSamples:
+    """A motion sampled for checking, N samples.
+
+    Attributes:
+        t: Times, s, (N,).
+        qpos: Full MuJoCo qpos of the cell, (N, nq).
+        phase: Phase index of each sample, (N,).
+        arc_on: Arc on, (N,).
+        suction: Suction on, (N,).
+    """
+
+    t: NDArray[np.float64]
+    qpos: NDArray[np.float64]
+    phase: NDArray[np.int64]
+    arc_on: NDArray[np.bool_]
+    suction: NDArray[np.bool_]
+
+    @property
+    def dt(self) -> float:
+        return float(np.median(np.diff(self.t))) if self.t.size > 1 else 1.0
+
+
+@dataclass(frozen=True)
+class AllowedContact:
+    """Contacts between geoms ``a`` and ``b`` are allowed on the samples where ``when`` is set,
+    up to a penetration of ``max_depth_m``."""
+
+    a: frozenset[int]
+    b: frozenset[int]
+    when: NDArray[np.bool_]
+    reason: str
+    max_depth_m: float = np.inf
+
+    def mask(self, s: NDArray[np.int64], g1: NDArray[np.int64], g2: NDArray[np.int64],
+             dist: NDArray[np.float64] | None = None) -> NDArray[np.bool_]:
+        """Which contacts (sample ``s``, geoms ``g1``, ``g2``, distance ``dist``, m; arrays)
+        this declaration allows."""
+        a, b = np.fromiter(self.a, int), np.fromiter(self.b, int)
+        pair = (np.isin(g1, a) & np.isin(g2, b)) | (np.isin(g1, b) & np.isin(g2, a))
+        ok = pair & self.when[s]
+        if dist is not None and np.isfinite(self.max_depth_m):
+            ok &= -dist <= self.max_depth_m
+        return ok
+
+
+@dataclass
+class Contacts:
+    """Contacts found on a set of samples (one row per geom pair and sample, closest only)."""
+
+    s: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
+    g1: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
+    g2: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
+    dist: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    def select(self, keep: NDArray[np.bool_]) -> Contacts:
+        return Contacts(self.s[keep], self.g1[keep], self.g2[keep], self.dist[keep])
+
+    @staticmethod
+    def concat(parts: Sequence[Contacts]) -> Contacts:
+        if not parts:
+            return Contacts()
+        return Contacts(*(np.concatenate([getattr(p, k) for p in parts])
+                          for k in ("s", "g1", "g2", "dist")))
+
+
+class CollisionModel:
+    """The check model of a compiled cell: which geoms are checked, as what, against what.
+
+    Args:
+        built: The compiled cell.
+
+    Attributes:
+        geoms: Checked geoms by id.
+        model: Check model for collisions (geom margins 0).
+        range_model: Check model for clearance (cell and part geoms with margin
+            :data:`CLEARANCE_RANGE_M`).
+    """
+
+    def __init__(self, built: BuiltCell) -> None:
+        import mujoco
+
+        self.built = built
+        src = built.model
+        cell = built.cell
+        tool_prefix = "robot/tool/"
+        work = {f"{tool_prefix}{g}" for g in (cell.tool.work_geoms if cell.tool else ())}
+        object_of = {g: obj for obj, geoms in cell.objects.items() for g in geoms}
+        parts = set(cell.parts)
+        geoms: dict[int, CheckGeom] = {}
+        unnamed: dict[int, int] = {}
+        for g in range(src.ngeom):
+            body = int(src.geom_bodyid[g])
+            bname = src.body(body).name
+            gname = src.geom(g).name
+            if not gname:
+                unnamed[body] = unnamed.get(body, 0) + 1
+                gname = f"{bname}#{unnamed[body] - 1}"
+            if gname.startswith(tool_prefix) or bname.startswith(tool_prefix):
+                geoms[g] = CheckGeom(g, gname, TOOL, bname, work=gname in work)
+            elif bname.startswith("robot/"):
+                if src.geom_group[g] == 3:
+                    geoms[g] = CheckGeom(g, gname, LINK, bname,
+                                         base=bool(src.body_weldid[body] == 0))
+            elif bname in parts:
+                geoms[g] = CheckGeom(g, gname, PART, bname)
+            elif src.body_weldid[body] == 0 and (src.geom_contype[g] | src.geom_conaffinity[g]):
+                geoms[g] = CheckGeom(g, gname, CELL, object_of.get(gname, gname))
+        self.geoms = geoms
+        self.model = self._masked(src, 0.0)
+        self.range_model = self._masked(src, CLEARANCE_RANGE_M)
+        self._data = mujoco.MjData(self.model)
+        self._range_data = mujoco.MjData(self.range_model)
+        n = src.ngeom
+        self.role = np.full(n, -1)
+        self.is_work = np.zeros(n, bool)
+        self.is_base = np.zeros(n, bool)
+        for g, cg in geoms.items():
+            self.role[g] = _ROLE_CODE[cg.role]
+            self.is_work[g] = cg.work
+            self.is_base[g] = cg.base
+
+    def _masked(self, src: Any, margin: float) -> Any:
+        """The cell recompiled with the check masks (and ``margin`` on cell and part geoms).
+
+        The masks are set before compiling, not on a compiled copy: MuJoCo's compiler leaves
+        geoms that collide with nothing out of their body's bounding-volume tree, so a geom
+        enabled after compiling would be skipped by the broad phase.
+        """
+        mujoco = _mujoco()
+        spec = mujoco.MjSpec.from_string(self.built.xml)
+        geoms = spec.geoms
+        if len(geoms) != src.ngeom or any(
+                g.name != src.geom(i).name for i, g in enumerate(geoms) if g.name):
+            raise InternalError("the check model's geoms do not match the compiled cell's")
+        for i, g in enumerate(geoms):
+            cg = self.geoms.get(i)
+            g.contype = _BITS[cg.role] if cg else 0
+            g.conaffinity = _AFFINITY[cg.role] if cg else 0
+            g.margin = margin if cg and cg.role in (CELL, PART) else 0.0
+            g.gap = 0.0
+        try:
+            m = spec.compile()
+        except ValueError as exc:
+            raise InternalError(f"the check model does not compile: {exc}") from exc
+        m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        return m
+
+    def ids(self, role: str | None = None, owner: str | None = None) -> frozenset[int]:
+        """Ids of the checked geoms with that role and/or owner."""
+        return frozenset(g for g, cg in self.geoms.items()
+                         if (role is None or cg.role == role) and (owner is None or cg.owner == owner))
+
+    def scan(self, qpos: NDArray[np.float64], samples: NDArray[np.int64], *,
+             ranged: bool = False) -> Contacts:
+        """Contacts at the given samples of ``qpos`` (N, nq): penetrations, or every pair
+        closer than :data:`CLEARANCE_RANGE_M` when ``ranged``."""
+        mujoco = _mujoco()
+        m, d = (self.range_model, self._range_data) if ranged else (self.model, self._data)
+        out_s, out_g, out_d = [], [], []
+        for i in samples:
+            d.qpos[:] = qpos[i]
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_collision(m, d)
+            n = d.ncon
+            if n:
+                dist = d.contact.dist[:n]
+                keep = dist < (CLEARANCE_RANGE_M if ranged else -PENETRATION_TOLERANCE_M)
+                if keep.any():
+                    out_s.append(np.full(int(keep.sum()), i))
+                    out_g.append(d.contact.geom[:n][keep].copy())
+                    out_d.append(dist[keep].copy())
+        if not out_s:
+            return Contacts()
+        g = np.concatenate(out_g)
+        g1, g2 = np.minimum(g[:, 0], g[:, 1]), np.maximum(g[:, 0], g[:, 1])
+        s, dist = np.concatenate(out_s), np.concatenate(out_d)
+        # one row per (sample, pair): the closest of the pair's contact points
+        order = np.lexsort((dist, g2, g1, s))
+        s, g1, g2, dist = s[order], g1[order], g2[order], dist[order]
+        first = np.ones(s.size, bool)
+        first[1:] = (s[1:] != s[:-1]) | (g1[1:] != g1[:-1]) | (g2[1:] != g2[:-1])
+        return Contacts(s[first], g1[first], g2[first], dist[first])
+
+
+def _mujoco() -> Any:
+    import mujoco
+
+    return mujoco
+
+
+# --------------------------------------------------------------------------------------------
+# Allowed contacts
+# --------------------------------------------------------------------------------------------
+
+
+def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    from sim.core.intervals import true_runs
+
+    return true_runs(mask)
+
+
+def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
+                     phase_seams: Sequence[str | None]) -> list[AllowedContact]:
+    """The contacts the work makes on purpose (module docstring), as declarations.
+
+    Args:
+        cm: The check model.
+        samples: The sampled motion.
+        phase_seams: The seam each phase follows (None when it follows none), by phase index.
+    """
+    built = cm.built
+    cell = built.cell
+    n = samples.t.size
+    out: list[AllowedContact] = []
+    work = frozenset(g for g, cg in cm.geoms.items() if cg.work)
+    # the welding wire with the seam's workpieces while the arc is on
+    if work and samples.arc_on.any():
+        all_work = frozenset().union(*(cm.ids(CELL, obj) for objs in cell.seam_objects.values()
+                                       for obj in objs)) if cell.seam_objects else frozenset()
+        for k, seam in enumerate(phase_seams):
+            when = samples.arc_on & (samples.phase == k)
+            if not when.any():
+                continue
+            objs = cell.seam_objects.get(seam, ()) if seam is not None else ()
+            pieces = (frozenset().union(*(cm.ids(CELL, o) for o in objs)) if objs else all_work)
+            if pieces:
+                out.append(AllowedContact(work, pieces, when,
+                                          f"wire on the workpiece of seam {seam!r}, arc on"))
+        # the wire touching a workpiece with the arc off: touch sensing, or its tip in the
+        # corner of a fillet at a seam's start or end (a wire of radius r whose tip centre is in
+        # a 90 deg corner overlaps both plates by r / sqrt(2)); deeper is a collision
+    if work and cell.seam_objects and cell.tool is not None and cell.tool.kind == "torch":
+        all_work = frozenset().union(*(cm.ids(CELL, obj) for objs in cell.seam_objects.values()
+                                       for obj in objs))
+        radius = max(float(built.model.geom_size[g, 0]) for g in work)
+        out.append(AllowedContact(work, all_work, np.ones(n, bool),
+                                  f"wire touching a workpiece (up to its radius, "
+                                  f"{radius * 1e3:.1f} mm)", max_depth_m=radius))
+    # parts: at rest, lifted off, set down; the cup lip with the part it picks
+    part_ids = {p: cm.ids(PART, p) for p in cell.parts}
+    if not part_ids:
+        return out
+    others = cm.ids(CELL) | frozenset().union(*part_ids.values())
+    held = {p: np.zeros(n, bool) for p in part_ids}
+    for i_on, stop in _runs(samples.suction):
+        p = _picked_part(cm, samples, i_on)
+        if p is None:
+            continue
+        held[p][i_on:stop] = True
+        k_on, k_off = int(samples.phase[i_on]), int(samples.phase[stop - 1])
+        if stop < n:
+            k_off = int(samples.phase[stop])
+        window = (samples.phase >= k_on - 1) & (samples.phase <= k_off + 1)
+        if work:
+            out.append(AllowedContact(work, part_ids[p], window, f"cup lip on {p}, picking it"))
+        settle = held[p] & (np.isin(samples.phase, (k_on, k_on + 1, k_off - 1, k_off)))
+        out.append(AllowedContact(part_ids[p], others - part_ids[p], settle,
+                                  f"{p} lifted off or set down"))
+    for p, ids in part_ids.items():
+        out.append(AllowedContact(ids, others - ids, ~held[p], f"{p} at rest"))
+    return out
+
+
+def _picked_part(cm: CollisionModel, samples: MotionSamples, i: int) -> str | None:
+    """The part nearest to the tool point when suction comes on at sample ``i``."""
+    mujoco = _mujoco()
+    built = cm.built
+    m, d = cm.model, cm._data
+    d.qpos[:] = samples.qpos[i]
+    mujoco.mj_kinematics(m, d)
+    tcp = d.site_xpos[built.tcp_site]
+    best, best_d = None, np.inf
+    for p in built.cell.parts:
+        dist = float(np.linalg.norm(d.xpos[m.body(p).id] - tcp))
+        if dist < best_d:
+            best, best_d = p, dist
+    return best
+
+
+def _allowed_mask(c: Contacts, allowed: Sequence[AllowedContact]) -> NDArray[np.bool_]:
+    ok = np.zeros(c.s.size, bool)
+    for rule in allowed:
+        if c.s.size:
+            ok |= rule.mask(c.s, c.g1, c.g2, c.dist)
+    return ok
+
+
+# --------------------------------------------------------------------------------------------
+# Reports
+# --------------------------------------------------------------------------------------------
+
+
+def _kind(cm: CollisionModel, g1: int, g2: int) -> str:
+    roles = {cm.geoms[g1].role, cm.geoms[g2].role}
+    if roles <= {LINK, TOOL}:
+        return "self"
+    if PART in roles and roles & {LINK, TOOL}:
+        return "part"
+    if PART in roles:
+        return "held_part"
+    return "cell"
+
+
+def _ordered(cm: CollisionModel, g1: int, g2: int) -> tuple[int, int]:
+    """Robot side first (link, tool, part, cell)."""
+    order = {LINK: 0, TOOL: 1, PART: 2, CELL: 3}
+    a, b = cm.geoms[g1], cm.geoms[g2]
+    return (g1, g2) if order[a.role] <= order[b.role] else (g2, g1)
+
+
+def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
+                    allowed: Sequence[AllowedContact]) -> list[dict[str, Any]]:
+    """Collision intervals along the motion, every sample checked (module docstring)."""
+    c = cm.scan(samples.qpos, np.arange(samples.t.size))
+    c = c.select(~_allowed_mask(c, allowed))
+    groups: dict[tuple[str, str], list[int]] = {}
+    for r in range(c.s.size):
+        a, b = _ordered(cm, int(c.g1[r]), int(c.g2[r]))
+        groups.setdefault((cm.geoms[a].owner, cm.geoms[b].owner), []).append(r)
+    out = []
+    for (oa, ob), rows in groups.items():
+        rows_a = np.array(rows)
+        s = c.s[rows_a]
+        uniq = np.unique(s)
+        cuts = np.flatnonzero(np.diff(uniq) > 1)
+        starts = np.concatenate([[0], cuts + 1])
+        ends = np.concatenate([cuts, [uniq.size - 1]])
+        for i0, i1 in zip(starts, ends, strict=True):
+            lo, hi = uniq[i0], uniq[i1]
+            sel = rows_a[(s >= lo) & (s <= hi)]
+            w = sel[int(np.argmin(c.dist[sel]))]
+            a, b = _ordered(cm, int(c.g1[w]), int(c.g2[w]))
+            names = sorted({cm.geoms[int(g)].name for g in np.concatenate([c.g1[sel], c.g2[sel]])})
+            out.append({
+                "t0": float(samples.t[lo]), "t1": float(samples.t[hi]),
+                "phase": phase_names[int(samples.phase[lo])],
+                "kind": _kind(cm, a, b),
+                "bodies": [oa, ob],
+                "geoms": [cm.geoms[a].name, cm.geoms[b].name],
+                "all_geoms": names,
+                "depth_mm": float(-c.dist[w] * 1e3),
+                "t_worst": float(samples.t[c.s[w]]),
+            })
+    return sorted(out, key=lambda e: (e["t0"], e["bodies"]))
+
+
+def clearance(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
+              allowed: Sequence[AllowedContact]) -> list[dict[str, Any]]:
+    """Per phase: the tool's and the arm's smallest distance to the cell (module docstring).
+
+    Each entry: ``phase``, ``tool_mm`` and ``arm_mm`` (null beyond :data:`CLEARANCE_RANGE_M`),
+    with the ``tool_pair``/``arm_pair`` (geom names) and ``tool_t``/``arm_t`` where they occur.
+    Allowed contacts (and the tool near the part it picks, in the same windows) are left out.
+    """
+    n = samples.t.size
+    stride = max(1, int(round(CLEARANCE_STRIDE_S / max(samples.dt, 1e-12))))
+    coarse = np.unique(np.concatenate([np.arange(0, n, stride), _phase_ends(samples)]))
+    c = cm.scan(samples.qpos, coarse, ranged=True)
+    c = _clearance_rows(cm, c, allowed)
+    groups = ("tool", "arm")
+    best: dict[tuple[int, str], tuple[float, int]] = {}
+    for k in range(len(phase_names)):
+        for grp, rows in _group_rows(cm, c).items():
+            sel = rows & (samples.phase[c.s] == k)
+            if sel.any():
+                r = np.flatnonzero(sel)[int(np.argmin(c.dist[sel]))]
+                best[(k, grp)] = (float(c.dist[r]), int(c.s[r]))
+    # refine at every sample around each phase's closest coarse sample
+    refine = sorted({i for (_, _), (_, s0) in best.items()
+                     for i in range(max(0, s0 - stride), min(n, s0 + stride + 1))})
+    fine = _clearance_rows(cm, cm.scan(samples.qpos, np.array(refine, int), ranged=True),
+                           allowed) if refine else Contacts()
+    both = Contacts.concat([c, fine])
+    rows_by = _group_rows(cm, both)
+    out = []
+    for k, name in enumerate(phase_names):
+        entry: dict[str, Any] = {"phase": name}
+        for grp in groups:
+            sel = rows_by[grp] & (samples.phase[both.s] == k)
+            if sel.any():
+                r = np.flatnonzero(sel)[int(np.argmin(both.dist[sel]))]
+                a, b = _ordered(cm, int(both.g1[r]), int(both.g2[r]))
+                entry[f"{grp}_mm"] = max(0.0, float(both.dist[r] * 1e3))
+                entry[f"{grp}_pair"] = [cm.geoms[a].name, cm.geoms[b].name]
+                entry[f"{grp}_t"] = float(samples.t[both.s[r]])
+            else:
+                entry[f"{grp}_mm"] = None
+        out.append(entry)
+    return out
+
+
+def _phase_ends(samples: MotionSamples) -> NDArray[np.int64]:
+    ph = samples.phase
+    edges = np.flatnonzero(np.diff(ph) != 0)
+    return np.concatenate([edges, edges + 1, [ph.size - 1]]).astype(int)
+
+
+def _clearance_rows(cm: CollisionModel, c: Contacts, allowed: Sequence[AllowedContact]
+                    ) -> Contacts:
+    """Pairs of the robot (tool but its work geoms, links but the base) with the cell or a part,
+    leaving out allowed pairs and the tool near a part it may touch."""
+    r1, r2 = cm.role[c.g1], cm.role[c.g2]
+    robot = _ROLE_CODE[LINK], _ROLE_CODE[TOOL]
+    world = _ROLE_CODE[CELL], _ROLE_CODE[PART]
+    keep = ((np.isin(r1, robot) & np.isin(r2, world)) | (np.isin(r2, robot) & np.isin(r1, world)))
+    keep &= ~(cm.is_work[c.g1] | cm.is_work[c.g2] | cm.is_base[c.g1] | cm.is_base[c.g2])
+    c = c.select(keep)
+    ok = _allowed_mask(c, allowed)
+    # the whole tool near a part its lip may touch: picking, not a clearance
+    tool, parts = cm.ids(TOOL), cm.ids(PART)
+    for rule in allowed:
+        if rule.a & tool and rule.b <= parts and c.s.size:
+            ok |= AllowedContact(tool, rule.b, rule.when, rule.reason).mask(c.s, c.g1, c.g2)
+    return c.select(~ok)
+
+
+def _group_rows(cm: CollisionModel, c: Contacts) -> dict[str, NDArray[np.bool_]]:
+    tool = (cm.role[c.g1] == _ROLE_CODE[TOOL]) | (cm.role[c.g2] == _ROLE_CODE[TOOL])
+    link = (cm.role[c.g1] == _ROLE_CODE[LINK]) | (cm.role[c.g2] == _ROLE_CODE[LINK])
+    return {"tool": tool, "arm": link}
+
+
+# --------------------------------------------------------------------------------------------
+# One call
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass
+class CollisionReport:
+    """Collisions (intervals) and per-phase clearance of a motion (module docstring)."""
+
+    collisions: list[dict[str, Any]]
+    clearance: list[dict[str, Any]]
+    allowed: list[str]
+
+
+def check_motion(built: BuiltCell, samples: MotionSamples, phase_names: Sequence[str],
+                 phase_seams: Sequence[str | None], *, with_clearance: bool = True
+                 ) -> CollisionReport:
+    """Check a sampled motion for collisions (and clearance) on the cell's check model."""
+    cm = CollisionModel(built)
+    allowed = allowed_contacts(cm, samples, phase_seams)
+    collisions = find_collisions(cm, samples, phase_names, allowed)
+    clear = clearance(cm, samples, phase_names, allowed) if with_clearance else []
+    return CollisionReport(collisions, clear, sorted({a.reason for a in allowed}))
+
+
+def samples_from_arrays(arrays: Any) -> MotionSamples:
+    """The recorded motion of a run (``t``, ``qpos``, ``phase``, ``arc_on``, ``suction``)."""
+    t = np.asarray(arrays["t"], dtype=float)
+    return MotionSamples(t, np.asarray(arrays["qpos"], dtype=float),
+                         np.asarray(arrays["phase"]).astype(int),
+                         np.asarray(arrays["arc_on"]).astype(bool),
+                         np.asarray(arrays["suction"]).astype(bool))
+
+
+def samples_from_motion(built: BuiltCell, motion: Any, dt: float) -> MotionSamples:
+    """The reference motion sampled every ``dt`` s, parts where the cell puts them (its
+    ``home`` keyframe): what ``cellsim check`` checks, without dynamics."""
+    n = int(np.floor(motion.duration / dt + 1e-9)) + 1
+    t = motion.t0 + dt * np.arange(n)
+    if t[-1] < motion.t1 - 1e-12:
+        t = np.append(t, motion.t1)
+    mujoco = _mujoco()
+    model = built.model
+    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
+    base = model.key_qpos[key] if key >= 0 else model.qpos0
+    qpos = np.tile(base, (t.size, 1))
+    qpos[:, built.robot_qpos] = motion.at(t).q
+    return MotionSamples(t, qpos, np.asarray(motion.phase_index(t)).astype(int),
+                         motion.tool_state(t, "arc"), motion.tool_state(t, "suction"))
+
+
+def phase_seams(motion: Any) -> list[str | None]:
+    """The seam each phase of a motion follows (None where it follows none)."""
+    return [None if pm.seam is None else pm.seam.name for pm in motion.phases]

@@ -1,0 +1,325 @@
+"""Collisions and clearance (issue 11): the robot may not go through itself, its tool or its cell.
+
+Specifications:
+
+* a linear move that plunges the torch through the welding table's base plate reports a
+  tool-plate collision starting when the wire tip reaches the plate top, fails the verdict, and
+  makes ``cellsim run --strict`` and ``cellsim check`` exit 1;
+* a joint move folding the LR Mate 200iC/5L's forearm down into its own base reports a
+  self-collision in that phase, with the same consequences;
+* the clearance reported for a cylinder tool over a box fixture equals the analytic distance;
+* every shipped scenario passes ``cellsim check`` (seed 000's sequence excepted: it exceeds the
+  100iB's J2 speed and acceleration limits by design) and runs with ``"collisions": []``;
+* allowed contacts are declared: the wire on the seam's workpiece while the arc is on, the cup
+  lip on the part it picks; the nozzle never.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sim.cli import main
+from sim.core.resources import shipped_scenarios
+from sim.pipeline.run import RunOptions, run_scenario
+from sim.scenario import load_scenario, parse_scenario
+
+HEAD = """name = "{name}"
+description = "collision test"
+robot = "lrmate200ic5l"
+{cell}
+
+[[phases]]
+name = "start"
+planner = "434"
+time_s = [0.0, 0.5, 1.0]
+joints_deg = [[0, 0, 0, 0, -90, 0], [0, 0, 0, 0, -90, 0], [0, 0, 0, 0, -90, 0]]
+"""
+
+#: Torch pointing down above the base plate (top at z = -150 mm in frame 0, clear of the V
+#: plates and the wall), then straight down 100 mm at 50 mm/s: 50 mm through the plate top.
+PLUNGE = HEAD.format(name="plunge", cell='cell = "weld_table"\ntool = "mig_torch"') + """
+[[phases]]
+name = "above"
+planner = "434"
+durations_s = [1.5]
+to_mm = [330.0, 120.0, -100.0]
+euler_zyx_deg = [0.0, 0.0, 180.0]
+
+[[phases]]
+name = "plunge"
+kind = "linear"
+to_mm = [330.0, 120.0, -200.0]
+speed_mm_s = 50.0
+"""
+
+#: The forearm folded down into the robot's own base (bare scene, no tool).
+FOLD = HEAD.format(name="fold", cell="") + """
+[[phases]]
+name = "fold"
+planner = "434"
+durations_s = [3.0]
+joints_deg = [[0.0, 60.0, -140.0, 0.0, -90.0, 0.0]]
+"""
+
+
+def _write(tmp_path: Path, text: str, name: str) -> Path:
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    return path
+
+
+def _run(tmp_path_factory, text: str, name: str):
+    """Run a scenario text (no video, plots or sizing): (folder, scenario path, summary)."""
+    tmp = tmp_path_factory.mktemp(name)
+    path = _write(tmp, text, name)
+    summary = run_scenario(load_scenario(path), RunOptions(
+        out_dir=tmp / "run", video=False, plots=False, sizing=False, progress=False))
+    return tmp, path, summary
+
+
+@pytest.fixture(scope="module")
+def plunge_run(tmp_path_factory):
+    return _run(tmp_path_factory, PLUNGE, "plunge")
+
+
+@pytest.fixture(scope="module")
+def fold_run(tmp_path_factory):
+    return _run(tmp_path_factory, FOLD, "fold")
+
+
+def _plate_top(run_dir: Path) -> float:
+    import mujoco
+
+    m = mujoco.MjModel.from_xml_path(str(run_dir / "model.xml"))
+    g = m.geom("base_plate")
+    return float(m.geom_pos[g.id][2] + m.geom_size[g.id][2])
+
+
+def test_plunge_reports_tool_plate_collision_from_the_plate_top(plunge_run):
+    tmp, _, summary = plunge_run
+    run_dir = tmp / "run"
+    traj = np.load(run_dir / "trajectory.npz")
+    t, tip_z = traj["t"], traj["tcp_pos"][:, 2]
+    top = _plate_top(run_dir)
+    t_hit = float(t[np.argmax(tip_z <= top)])  # the wire tip reaches the plate top
+    hits = [c for c in summary["collisions"]
+            if c["bodies"] == ["robot/tool/torch", "base_plate"]]
+    assert hits, summary["collisions"]
+    first = hits[0]
+    assert first["phase"] == "plunge" and first["kind"] == "cell"
+    assert t_hit - 0.05 <= first["t0"] <= t_hit + 0.5, (t_hit, first)
+    # 50 mm through the plate top: the worst penetration is tens of mm, found at the end
+    assert first["depth_mm"] > 20.0
+    assert summary["verdict"] == "fail"
+    failed = [c for c in summary["checks"] if c["name"] == "collision" and not c["pass"]]
+    assert failed and all(c["severity"] == "error" for c in failed)
+
+
+def test_plunge_strict_run_and_check_exit_1(plunge_run, capsys):
+    tmp, path, _ = plunge_run
+    assert main(["run", str(path), "--strict", "--no-video", "--no-plots", "--quiet",
+                 "--out", str(tmp / "strict")]) == 1
+    assert "collision robot/tool/torch / base_plate" in capsys.readouterr().out
+    assert main(["check", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "collision: plunge: cell collision robot/tool/torch / base_plate" in out
+
+
+def test_fold_reports_a_self_collision_in_its_phase(fold_run, capsys):
+    _, path, summary = fold_run
+    selfs = [c for c in summary["collisions"] if c["kind"] == "self"]
+    assert selfs, summary["collisions"]
+    assert all(c["phase"] == "fold" for c in selfs)
+    into_base = [c for c in selfs if c["bodies"][0] in ("robot/base", "robot/link1")
+                 or c["bodies"][1] in ("robot/base", "robot/link1")]
+    assert into_base, selfs
+    assert summary["verdict"] == "fail"
+    assert main(["check", str(path)]) == 1
+    assert "self collision" in capsys.readouterr().out
+
+
+def test_fold_strict_exits_1(fold_run, tmp_path):
+    _, path, _ = fold_run
+    assert main(["run", str(path), "--strict", "--no-video", "--no-plots", "--quiet",
+                 "--out", str(tmp_path / "strict")]) == 1
+
+
+def _torch_samples(built, poses):
+    """Samples of a static torch at each pose (frame 0, (4, 4)), one phase each."""
+    from sim.robots.ik import solve_ik
+    from sim.simulation.collisions import MotionSamples
+
+    qs = []
+    for T in poses:
+        sols = [s for s in solve_ik(built.context.kinematics, T,
+                                    current=np.radians([0, 0, 0, 0, -90, 0]))
+                if s.within_limits]
+        qs.append(sols[0].q)
+    n = len(qs)
+    qpos = np.tile(built.model.key_qpos[0], (n, 1))
+    qpos[:, built.robot_qpos] = np.array(qs)
+    return MotionSamples(t=np.arange(n) * 1.0, qpos=qpos, phase=np.arange(n),
+                         arc_on=np.zeros(n, bool), suction=np.zeros(n, bool))
+
+
+@pytest.mark.parametrize("tilt_deg", [0.0, 10.0, 25.0])
+@pytest.mark.parametrize("height_mm", [3.0, 12.0, 40.0])
+def test_clearance_equals_the_analytic_distance(tilt_deg, height_mm):
+    """A straight torch (cylinders: contact tip r 4 mm ending 15 mm behind the wire tip, nozzle
+    r 11 mm ending 17 mm behind it) tilted by ``tilt`` over the base plate (a box): the tool's
+    clearance is the height of the lowest point of its cylinders' end discs over the plate top,
+    ``min(z_end - r sin(tilt))`` (the wire is a work geom and left out)."""
+    from sim.core.rotations import rot_y
+    from sim.simulation.collisions import check_motion
+    from sim.simulation.compile import build
+
+    sc = parse_scenario(PLUNGE)
+    built = build(sc)
+    top0 = -0.150  # plate top in frame 0
+    a = np.radians(tilt_deg)
+    R = np.array([[1.0, 0, 0], [0, -1.0, 0], [0, 0, -1.0]]) @ rot_y(a)  # tool z down, tilted
+    axis = R[:, 2]
+    # the wire tip (tcp) such that the contact tip's end disc sits height_mm over the plate
+    tip_z = top0 + height_mm * 1e-3 - 0.015 * (-axis[2]) + 0.004 * np.sin(a)
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = [0.33, 0.12, tip_z]
+    samples = _torch_samples(built, [T])
+    report = check_motion(built, samples, ["static"], [None])
+    ends = {"contact_tip": (0.015, 0.004), "nozzle": (0.017, 0.011)}
+    expected = min(tip_z + back * (-axis[2]) - r * np.sin(a) - top0 for back, r in ends.values())
+    got = report.clearance[0]["tool_mm"]
+    assert got == pytest.approx(expected * 1e3, abs=0.1), report.clearance[0]
+    assert report.clearance[0]["tool_pair"][1] == "base_plate"
+
+
+def test_nozzle_on_the_workpiece_is_a_collision_while_the_wire_is_allowed():
+    """Arc on along a seam: the wire may touch the seam's workpiece, the nozzle never."""
+    from sim.simulation.collisions import (
+        CollisionModel,
+        allowed_contacts,
+        find_collisions,
+    )
+    from sim.simulation.compile import build
+
+    built = build(parse_scenario(PLUNGE))
+    top0 = -0.150
+    R = np.diag([1.0, -1.0, -1.0])
+    poses = []
+    for sink in (0.005, 0.030):  # the wire 5 mm into the plate; then the nozzle 13 mm into it
+        T = np.eye(4)
+        T[:3, :3] = R
+        T[:3, 3] = [0.33, 0.12, top0 - sink]
+        poses.append(T)
+    samples = _torch_samples(built, poses)
+    samples.arc_on[:] = True
+    samples.phase[:] = 0
+    cm = CollisionModel(built)
+    allowed = allowed_contacts(cm, samples, ["arc"])  # the arc seam's workpieces: wall, plate
+    found = [c for c in find_collisions(cm, samples, ["weld"], allowed) if c["kind"] == "cell"]
+    assert found and all(c["t0"] == 1.0 for c in found)  # not at 0: the wire alone is allowed
+    plate = [c for c in found if c["bodies"] == ["robot/tool/torch", "base_plate"]]
+    assert len(plate) == 1 and plate[0]["geoms"][0] in ("robot/tool/nozzle",
+                                                         "robot/tool/contact_tip")
+    assert "robot/tool/wire" not in [c["geoms"][0] for c in found if c["bodies"][1] in
+                                     ("base_plate", "wall")]
+    # the same with the arc off: the wire 5 mm deep is a collision too
+    samples.arc_on[:] = False
+    found = [c for c in find_collisions(cm, samples, ["move"],
+                                        allowed_contacts(cm, samples, ["arc"]))
+             if c["kind"] == "cell"]
+    assert found and found[0]["t0"] == 0.0
+    assert found[0]["bodies"] == ["robot/tool/torch", "base_plate"]
+    assert "robot/tool/wire" in found[0]["all_geoms"]
+
+
+CHECK_FAILS = {"kacso_lrmate100ib_sequence1": "limit"}
+
+
+@pytest.mark.parametrize("name", sorted(shipped_scenarios()))
+def test_shipped_scenario_passes_cellsim_check(name, capsys):
+    rc = main(["check", name])
+    out = capsys.readouterr().out
+    if name in CHECK_FAILS:
+        assert rc == 1
+        kinds = {line.split(":")[0] for line in out.splitlines() if ": " in line}
+        assert kinds <= {CHECK_FAILS[name], name}, out
+    else:
+        assert rc == 0, out
+        assert "collision" not in out
+
+
+@pytest.mark.parametrize("name", sorted(shipped_scenarios()))
+def test_shipped_scenario_runs_without_collision(name, scenario_run):
+    run_dir, summary = scenario_run(name)
+    assert summary["collisions"] == [], summary["collisions"]
+    stored = json.loads((run_dir / "summary.json").read_text())
+    assert stored["collisions"] == []
+    assert {c["phase"] for c in stored["clearance"]} == {p["name"] for p in stored["phases"]}
+    assert any(c["name"] == "collision" and c["pass"] for c in stored["checks"])
+
+
+def test_video_paints_the_colliding_geoms_red_while_they_touch(plunge_run):
+    """The renderer's scene (built without OpenGL here) has the torch and the plate red inside
+    the collision interval and their own colours before it."""
+    import mujoco
+
+    from sim.render.frames import COLLISION_RGBA, CollisionPainter
+
+    tmp, _, summary = plunge_run
+    model = mujoco.MjModel.from_xml_path(str(tmp / "run" / "model.xml"))
+    data = mujoco.MjData(model)
+    traj = np.load(tmp / "run" / "trajectory.npz")
+    hit = next(c for c in summary["collisions"] if c["bodies"][1] == "base_plate")
+    painter = CollisionPainter(model, summary["collisions"])
+    plate, nozzle = model.geom("base_plate").id, model.geom("robot/tool/nozzle").id
+    for time, inside in ((hit["t0"] - 0.5, False), (0.5 * (hit["t0"] + hit["t1"]), True)):
+        i = int(np.searchsorted(traj["t"], time))
+        data.qpos[:] = traj["qpos"][i]
+        mujoco.mj_kinematics(model, data)
+        scene = mujoco.MjvScene(model, maxgeom=2000)
+        mujoco.mjv_updateScene(model, data, mujoco.MjvOption(), None, mujoco.MjvCamera(),
+                               mujoco.mjtCatBit.mjCAT_ALL, scene)
+        painted = painter.paint(scene, float(traj["t"][i]))
+        red = {int(g.objid) for g in scene.geoms[:scene.ngeom]
+               if g.objtype == mujoco.mjtObj.mjOBJ_GEOM
+               and np.allclose(g.rgba, COLLISION_RGBA)}
+        assert (painted > 0) is inside
+        assert ({plate, nozzle} <= red) is inside, (time, red)
+
+
+def test_held_part_in_transfer_hitting_the_cell_is_a_collision():
+    """The pick scenario's reference with part0 pushed into the infeed table during a transfer
+    phase: a collision while suction holds it, allowed (resting contact) when it does not."""
+    from sim.simulation.collisions import (
+        CollisionModel,
+        allowed_contacts,
+        find_collisions,
+        phase_seams,
+        samples_from_motion,
+    )
+    from sim.simulation.compile import build
+    from sim.simulation.motion import build_motion
+
+    sc = load_scenario("lrmate200ic_pick_place")
+    built = build(sc)
+    motion = build_motion(sc, built.context)
+    samples = samples_from_motion(built, motion, 0.01)
+    names = [pm.name for pm in motion.phases]
+    k = names.index("above_slot0")
+    sel = samples.phase == k
+    adr = built.part_qpos[0]
+    samples.qpos[np.ix_(sel, adr[2:3])] -= 0.01  # 10 mm down into the infeed table
+    cm = CollisionModel(built)
+    found = find_collisions(cm, samples, names, allowed_contacts(cm, samples, phase_seams(motion)))
+    held = [c for c in found if c["kind"] == "held_part"]
+    assert held and all(c["phase"] == "above_slot0" for c in held), found
+    assert held[0]["bodies"] == ["part0", "infeed_top"]
+    assert held[0]["depth_mm"] == pytest.approx(10.0, abs=0.5)
+    samples.suction[:] = False  # nothing held: a part resting on the table is not a collision
+    found = find_collisions(cm, samples, names, allowed_contacts(cm, samples, phase_seams(motion)))
+    assert not [c for c in found if c["kind"] == "held_part"]
