@@ -197,8 +197,9 @@ def test_clearance_equals_the_analytic_distance(tilt_deg, height_mm):
     assert report.clearance[0]["tool_pair"][1] == "base_plate"
 
 
-def test_nozzle_on_the_workpiece_is_a_collision_while_the_wire_is_allowed():
-    """Arc on along a seam: the wire may touch the seam's workpiece, the nozzle never."""
+def _wire_sinks(sinks_mm, arc_on: bool):
+    """Collisions of a torch pointing down with its wire tip sunk into the base plate (a
+    workpiece of the 'arc' seam), one static sample per depth, one phase welding 'arc'."""
     from sim.simulation.collisions import (
         CollisionModel,
         allowed_contacts,
@@ -207,34 +208,65 @@ def test_nozzle_on_the_workpiece_is_a_collision_while_the_wire_is_allowed():
     from sim.simulation.compile import build
 
     built = build(parse_scenario(PLUNGE))
-    top0 = -0.150
-    R = np.diag([1.0, -1.0, -1.0])
     poses = []
-    for sink in (0.005, 0.030):  # the wire 5 mm into the plate; then the nozzle 13 mm into it
+    for sink in sinks_mm:
         T = np.eye(4)
-        T[:3, :3] = R
-        T[:3, 3] = [0.33, 0.12, top0 - sink]
+        T[:3, :3] = np.diag([1.0, -1.0, -1.0])
+        T[:3, 3] = [0.33, 0.12, -0.150 - sink * 1e-3]
         poses.append(T)
     samples = _torch_samples(built, poses)
-    samples.arc_on[:] = True
+    samples.arc_on[:] = arc_on
     samples.phase[:] = 0
     cm = CollisionModel(built)
-    allowed = allowed_contacts(cm, samples, ["arc"])  # the arc seam's workpieces: wall, plate
-    found = [c for c in find_collisions(cm, samples, ["weld"], allowed) if c["kind"] == "cell"]
-    assert found and all(c["t0"] == 1.0 for c in found)  # not at 0: the wire alone is allowed
+    found = find_collisions(cm, samples, ["weld"], allowed_contacts(cm, samples, ["arc"]))
+    return [c for c in found if c["kind"] == "cell"]
+
+
+def test_wire_in_the_pool_is_allowed_with_the_arc_on_the_nozzle_never():
+    """Arc on along the seam: the wire 1 mm into its workpiece is the tip in the weld pool
+    (allowed up to its radius + 1 mm); 5 mm deep, or the nozzle on the plate, is a collision."""
+    found = _wire_sinks([1.0, 5.0, 30.0], arc_on=True)
+    assert found and all(c["t0"] >= 1.0 for c in found)  # not at 0: 1 mm is allowed
     plate = [c for c in found if c["bodies"] == ["robot/tool/torch", "base_plate"]]
-    assert len(plate) == 1 and plate[0]["geoms"][0] in ("robot/tool/nozzle",
-                                                         "robot/tool/contact_tip")
-    assert "robot/tool/wire" not in [c["geoms"][0] for c in found if c["bodies"][1] in
-                                     ("base_plate", "wall")]
-    # the same with the arc off: the wire 5 mm deep is a collision too
-    samples.arc_on[:] = False
-    found = [c for c in find_collisions(cm, samples, ["move"],
-                                        allowed_contacts(cm, samples, ["arc"]))
-             if c["kind"] == "cell"]
+    assert len(plate) == 1 and plate[0]["t0"] == 1.0 and plate[0]["t1"] == 2.0
+    assert plate[0]["geoms"][0] in ("robot/tool/nozzle", "robot/tool/contact_tip")
+    assert "robot/tool/wire" in plate[0]["all_geoms"]
+
+
+def test_wire_touching_with_the_arc_off_only_up_to_its_radius():
+    """Arc off: the wire may touch a workpiece up to its radius (0.6 mm: touch sensing, a tip
+    in a fillet's corner); 1 mm deep is a collision from the first sample."""
+    assert _wire_sinks([0.5], arc_on=False) == []
+    found = _wire_sinks([1.0, 30.0], arc_on=False)
     assert found and found[0]["t0"] == 0.0
     assert found[0]["bodies"] == ["robot/tool/torch", "base_plate"]
-    assert "robot/tool/wire" in found[0]["all_geoms"]
+    assert found[0]["depth_mm"] > 10.0 and "robot/tool/wire" in found[0]["all_geoms"]
+
+
+def test_clearance_finds_the_minimum_between_coarse_samples():
+    """The torch goes down and up twice over the plate, its contact tip's lowest point at
+    ``h(t) = min(10 + 400 |t - 0.055|, 10.8 + 400 |t - 0.15|)`` mm: the true minimum, 10 mm at
+    0.055 s, lies between two coarse samples (every 10 ms) and a shallower dip (10.8 mm) sits on
+    one; the reported clearance is the true minimum."""
+    from sim.simulation.collisions import check_motion
+    from sim.simulation.compile import build
+
+    built = build(parse_scenario(PLUNGE))
+    t = np.arange(0.0, 0.2005, 0.001)
+    h = np.minimum(10.0 + 400.0 * np.abs(t - 0.055), 10.8 + 400.0 * np.abs(t - 0.15))
+    poses = []
+    for hk in h:
+        T = np.eye(4)
+        T[:3, :3] = np.diag([1.0, -1.0, -1.0])
+        T[:3, 3] = [0.33, 0.12, -0.150 + hk * 1e-3 - 0.015]  # contact tip end 15 mm up
+        poses.append(T)
+    samples = _torch_samples(built, poses)
+    samples.t = t
+    samples.phase[:] = 0
+    report = check_motion(built, samples, ["dips"], [None])
+    entry = report.clearance[0]
+    assert entry["tool_mm"] == pytest.approx(10.0, abs=0.1), entry
+    assert entry["tool_t"] == pytest.approx(0.055, abs=1e-9)
 
 
 CHECK_FAILS = {"kacso_lrmate100ib_sequence1": "limit"}
@@ -293,8 +325,9 @@ def test_video_paints_the_colliding_geoms_red_while_they_touch(plunge_run):
 
 
 def test_held_part_in_transfer_hitting_the_cell_is_a_collision():
-    """The pick scenario's reference with part0 pushed into the infeed table during a transfer
-    phase: a collision while suction holds it, allowed (resting contact) when it does not."""
+    """The pick scenario's reference with part0 pushed 10 mm into the infeed table during a
+    transfer phase: a collision while suction holds it, and when it rests too (deeper than a
+    resting contact's 1 mm); 0.5 mm deep at rest is a resting contact."""
     from sim.simulation.collisions import (
         CollisionModel,
         allowed_contacts,
@@ -320,6 +353,131 @@ def test_held_part_in_transfer_hitting_the_cell_is_a_collision():
     assert held and all(c["phase"] == "above_slot0" for c in held), found
     assert held[0]["bodies"] == ["part0", "infeed_top"]
     assert held[0]["depth_mm"] == pytest.approx(10.0, abs=0.5)
-    samples.suction[:] = False  # nothing held: a part resting on the table is not a collision
+    # nothing held: a part resting 0.5 mm into the table is a resting contact; 10 mm is not
+    samples.suction[:] = False
     found = find_collisions(cm, samples, names, allowed_contacts(cm, samples, phase_seams(motion)))
-    assert not [c for c in found if c["kind"] == "held_part"]
+    assert [c["bodies"] for c in found] == [["part0", "infeed_top"]]
+    samples.qpos[np.ix_(sel, adr[2:3])] += 0.0095
+    found = find_collisions(cm, samples, names, allowed_contacts(cm, samples, phase_seams(motion)))
+    assert found == []
+
+
+@pytest.mark.parametrize("text", [PLUNGE, FOLD], ids=["plunge", "fold"])
+def test_the_coarse_scan_skips_no_sample_that_collides(text):
+    """Checking only the intervals the coarse scan cannot rule out finds the same collisions as
+    checking every sample of the reference (1 kHz)."""
+    from sim.simulation import collisions as C
+    from sim.simulation.compile import build
+    from sim.simulation.motion import build_motion
+
+    sc = parse_scenario(text)
+    built = build(sc)
+    motion = build_motion(sc, built.context)
+    samples = C.samples_from_motion(built, motion, 0.001)
+    cm = C.CollisionModel(built)
+    allowed = C.allowed_contacts(cm, samples, C.phase_seams(motion))
+    names = [pm.name for pm in motion.phases]
+    fast = C.find_collisions(cm, samples, names, allowed)
+    every = cm.scan(samples.qpos, np.arange(samples.t.size))
+    every = every.select(~C._allowed_mask(every, allowed))
+    colliding = np.unique(every.s)
+    assert colliding.size > 0
+    # every colliding sample lies in a reported interval of its pair
+    spans = [(c["t0"], c["t1"]) for c in fast]
+    for i in colliding:
+        assert any(t0 <= samples.t[i] <= t1 for t0, t1 in spans), samples.t[i]
+    # and the intervals begin and end on colliding samples (none invented)
+    firsts = {float(samples.t[i]) for i in colliding}
+    assert all(c["t0"] in firsts and c["t1"] in firsts for c in fast)
+    # the bound does its job: far fewer samples are checked one by one than there are
+    coarse = C.coarse_samples(samples)
+    checked = C._intervals_to_check(cm, samples, coarse,
+                                    cm.scan(samples.qpos, coarse, ranged=True), allowed)
+    assert sum(b - a + 1 for a, b in checked) < samples.t.size
+
+
+def test_motion_bound_bounds_every_geom_displacement():
+    """Within each coarse interval of the fold, no checked geom's centre moves farther than
+    :func:`motion_bound` (computed from joint travel and reach, not from the geoms' paths)."""
+    import mujoco
+
+    from sim.simulation import collisions as C
+    from sim.simulation.compile import build
+    from sim.simulation.motion import build_motion
+
+    sc = parse_scenario(FOLD)
+    built = build(sc)
+    motion = build_motion(sc, built.context)
+    samples = C.samples_from_motion(built, motion, 0.001)
+    cm = C.CollisionModel(built)
+    coarse = C.coarse_samples(samples)
+    bound = C.motion_bound(cm, samples, coarse)[C.LINK]  # the robot's geoms (no part here)
+    model, data = cm.model, mujoco.MjData(cm.model)
+    ids = np.array(sorted(cm.geoms))
+    pos = np.empty((samples.t.size, ids.size, 3))
+    for i in range(samples.t.size):
+        data.qpos[:] = samples.qpos[i]
+        mujoco.mj_kinematics(model, data)
+        pos[i] = data.geom_xpos[ids]
+    for k in range(len(coarse) - 1):
+        seg = pos[coarse[k]:coarse[k + 1] + 1]
+        moved = np.max(np.linalg.norm(seg - seg[0], axis=2))
+        assert moved <= bound[k] + 1e-12, (k, moved, bound[k])
+    assert np.max(bound) > 0.0
+
+
+
+def _pick_with(part: str, phase: str, shift, suction: bool | None = None):
+    """Collisions of the pick scenario's reference with ``part`` moved by ``shift`` (m, world)
+    during ``phase`` (optionally with suction forced on or off everywhere)."""
+    from sim.simulation import collisions as C
+    from sim.simulation.compile import build
+    from sim.simulation.motion import build_motion
+
+    sc = load_scenario("lrmate200ic_pick_place")
+    built = build(sc)
+    motion = build_motion(sc, built.context)
+    samples = C.samples_from_motion(built, motion, 0.005)
+    names = [pm.name for pm in motion.phases]
+    sel = samples.phase == names.index(phase)
+    adr = built.part_qpos[built.cell.parts.index(part)]
+    samples.qpos[np.ix_(sel, adr[:3])] += np.asarray(shift, float)
+    if suction is not None:
+        samples.suction[:] = suction
+    cm = C.CollisionModel(built)
+    return C.find_collisions(cm, samples, names,
+                             C.allowed_contacts(cm, samples, C.phase_seams(motion)))
+
+
+def test_held_part_driven_into_a_resting_part_is_a_collision():
+    """part0, held during above_slot0, pushed 30 mm along +x into part1 resting next to it."""
+    found = [c for c in _pick_with("part0", "above_slot0", [0.05, 0.0, 0.0])
+             if set(c["bodies"]) == {"part0", "part1"}]
+    assert found and found[0]["phase"] == "above_slot0" and found[0]["depth_mm"] > 20.0
+
+
+def test_held_part_set_down_into_the_tray_floor_is_a_collision():
+    """Set-down may touch the tray up to 1 mm: part0 put in its slot 0.5 mm deep while it is
+    lowered is a set-down contact; 10 mm into the tray floor at release is a collision."""
+    from sim.simulation import collisions as C
+    from sim.simulation.compile import build
+    from sim.simulation.motion import build_motion
+
+    sc = load_scenario("lrmate200ic_pick_place")
+    built = build(sc)
+    motion = build_motion(sc, built.context)
+    samples = C.samples_from_motion(built, motion, 0.005)
+    names = [pm.name for pm in motion.phases]
+    adr = built.part_qpos[0]
+    slot = np.asarray(built.cell.slots[0])
+    for phase, sink in (("down_slot0", 0.0005), ("release0", 0.010)):
+        sel = samples.phase == names.index(phase)
+        samples.qpos[np.ix_(sel, adr[:3])] = slot - [0.0, 0.0, sink]
+        samples.qpos[np.ix_(sel, adr[3:7])] = [1.0, 0.0, 0.0, 0.0]
+    cm = C.CollisionModel(built)
+    found = C.find_collisions(cm, samples, names,
+                              C.allowed_contacts(cm, samples, C.phase_seams(motion)))
+    hits = [c for c in found if c["bodies"][0] == "part0"]
+    assert hits and {c["phase"] for c in hits} == {"release0"}, found
+    assert hits[0]["bodies"][1] == "tray_floor"
+    assert hits[0]["depth_mm"] == pytest.approx(10.0, abs=0.6)

@@ -410,6 +410,25 @@ _COLL_HEAD = ("phase", "t (s)", "kind", "bodies", "worst geoms", "depth (mm)")
 _CLEAR_HEAD = ("phase", "tool (mm)", "tool closest pair", "arm (mm)", "arm closest pair")
 
 
+def _run_verdict_html(summary: Mapping[str, Any]) -> list[str]:
+    """The run's verdict (every check: tracking, saturation, limits, sizing, collisions)."""
+    if "verdict" not in summary:
+        return []
+    checks = summary.get("checks", [])
+    failed = [c for c in checks if not c["pass"] and c.get("severity", "error") == "error"]
+    warned = [c for c in checks if not c["pass"] and c.get("severity") == "warning"]
+    cls = "verdict" if summary["verdict"] == "pass" else "verdict fail"
+    text = (f"Run verdict: {summary['verdict'].upper()}: {len(checks)} checks, "
+            f"{len(failed)} failed, {len(warned)} warning(s).")
+    out = [f'<h2>Run verdict</h2><p class="{cls}">{html.escape(text)}</p>']
+    if failed or warned:
+        out.append(_html_table(("check", "subject", "value", "limit", "unit", "severity"), [
+            (str(c["name"]), str(c.get("subject") or c.get("joint", "")), _f(float(c["value"])),
+             _f(float(c["limit"])), str(c["unit"]), str(c.get("severity", "error")))
+            for c in failed + warned]))
+    return out
+
+
 def _collision_html(summary: Mapping[str, Any]) -> list[str]:
     if "collisions" not in summary:
         return []
@@ -450,8 +469,9 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
     if video:
         out.append(f'<h2>Video</h2><video controls width="720" src="{esc(video)}"></video>'
                    f'<p><a href="{esc(video)}">{esc(video)}</a></p>')
+    out += _run_verdict_html(summary)
     cls = "verdict" if result.passed else "verdict fail"
-    out.append(f'<h2>Verdict</h2><p class="{cls}">{esc(result.verdict)}</p>')
+    out.append(f'<h2>Sizing verdict</h2><p class="{cls}">{esc(result.verdict)}</p>')
     out += _collision_html(summary)
     out.append("<h2>Per joint</h2>")
     out.append(_html_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))

@@ -31,7 +31,7 @@ from sim.simulation.compile import build
 from sim.simulation.motion import Motion, build_motion, limit_violations
 
 #: Sampling period of the reference motion, s (``cellsim run`` checks every recorded sample).
-CHECK_DT_S = 0.002
+CHECK_DT_S = 0.001
 #: A pass is singular where a factor of det J falls below its limit: ``wrist`` |sin theta5|
 #: (5 deg), ``elbow`` (dimensionless, about 1 deg of the elbow), ``shoulder`` (the wrist
 #: centre's distance from the J1 axis, m).

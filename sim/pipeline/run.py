@@ -177,15 +177,17 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
             write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
                         **video_args)
             summary["video"] = runfolder.VIDEO_MP4
-        sizing = None
-        if options.sizing:  # last: report.html links the video when there is one
-            sizing = _write_sizing(tmp, scenario, built, record, summary)
+        sizing = _size(scenario, built, record, summary) if options.sizing else None
         checks = run_checks(arrays, summary, scenario.robot,
                             scenario.simulation.tracking_tolerance_deg, sizing,
                             clearance_mm=scenario.simulation.clearance_mm)
         summary["checks"] = [c.to_dict() for c in checks]
         summary["verdict"] = verdict(checks)
         summary["warnings"] = warnings_count(checks)
+        if sizing is not None:  # last: report.html links the video and shows the verdict
+            from sim.analysis.report import write_sizing
+
+            write_sizing(tmp, sizing, summary=summary)
         runfolder.write_summary(tmp, summary)
         runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
     except BaseException:
@@ -233,9 +235,9 @@ def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:
     return args
 
 
-def _write_sizing(tmp: Path, scenario: Scenario, built: BuiltCell, record: runfolder.RunRecord,
-                  summary: dict[str, Any]) -> SizingResult:
-    from sim.analysis.report import write_sizing
+def _size(scenario: Scenario, built: BuiltCell, record: runfolder.RunRecord,
+          summary: dict[str, Any]) -> SizingResult:
+    """Size the run's drives; the summary gets the ``sizing`` headline."""
     from sim.analysis.sizing import (
         apply_overrides,
         joint_armature,
@@ -247,7 +249,6 @@ def _write_sizing(tmp: Path, scenario: Scenario, built: BuiltCell, record: runfo
     result = size_record(record, scenario.robot, drives,
                          joint_forcerange(built.model, built.joint_ids),
                          armature=joint_armature(built.model, built.joint_ids))
-    write_sizing(tmp, result, summary=summary)
     summary["sizing"] = {"hardest_joint": result.hardest_joint,
                          "hardest_margin_pct": result.hardest_margin_pct,
                          "pass": bool(result.all_pass),

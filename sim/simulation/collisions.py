@@ -11,28 +11,39 @@ What is checked (:class:`CollisionModel`):
 * **geoms**: the robot links' collision geoms (group 3), every geom of the tool, every static
   cell geom that collides in the physics model (fixtures, workpieces, the floor; markers such as
   the seam lines and slots do not) and the parts;
-* **pairs**: robot link with robot link (MuJoCo's parent-child filter and the robot's declared
-  ``<exclude>`` pairs apply: adjacent links meet at their joint), tool with robot link (not the
-  flange link it is mounted on), robot or tool with any cell object or part, part with cell
-  object or part.
+* **pairs**: robot link with robot link but each link with its parent (they meet at their
+  joint; the robot's own ``<exclude>`` pairs apply too), tool with robot link (every link but
+  the one it is mounted on), robot or tool with any cell object or part, part with cell object
+  or part.
 
 Allowed contacts are declared (:func:`allowed_contacts`), not guessed:
 
 * the tool's *work geoms* (:attr:`sim.cells.tools.ToolSpec.work_geoms`): the welding wire with
   the workpieces of the seam the phase welds (:attr:`sim.cells.Cell.seam_objects`) while the
-  arc is on; the cup lip with the part it picks, from the start of the phase before suction
-  comes on (the descent) to the end of the phase after it goes off (the retract);
-* a part with the cell or another part while it is not held (it rests), and while held in the
-  phase where suction comes on and the next one (lift-off from where it rested) and in the phase
-  where suction goes off and the one before (set-down in its slot);
-* everything else (nozzle, torch body, arm, a held part in transfer) never.
+  arc is on, up to its radius plus :data:`WIRE_ARC_DEPTH_M` deep (the tip in the pool), and with
+  any workpiece up to its radius with the arc off (touch sensing, the tip in a fillet's
+  corner); the cup lip with the part it picks (the nearest part holding the tool point when
+  suction comes on), from the start of the phase before suction comes on (the descent) to the
+  end of the phase after it goes off (the retract);
+* a part with the cell while it is not held (it rests), with another part while neither is
+  held, and while held in the phase where suction comes on and the next one (lift-off) and in
+  the phase where suction goes off and the one before (set-down); parts and the lip up to
+  :data:`PART_CONTACT_DEPTH_M` deep;
+* everything else (nozzle, contact tip, torch body, arm, a held part in transfer) never.
 
 A contact is a collision when its penetration exceeds :data:`PENETRATION_TOLERANCE_M` (0.1 mm,
 below the soft-contact sinkage of a resting part and the wire's touch at a seam start).
-Collisions are reported as intervals (:func:`find_collisions`): ``t0``, ``t1`` (s), the phase
-at ``t0``, the two ``bodies`` (robot body, tool body, cell object or part), the worst geom pair
-(``geoms``), every geom involved (``all_geoms``, for the video) and the worst penetration
-``depth_mm`` at ``t_worst``.
+Every sample that can hold a collision is checked: a coarse scan every
+:data:`CLEARANCE_STRIDE_S` measures the distances of the pairs closer than
+:data:`CLEARANCE_RANGE_M`, and an interval between two coarse samples is checked sample by
+sample unless no pair there can get deeper than it may: the pair's distance at the interval's
+ends less how much closer its two geoms can get inside it (:func:`motion_bound`: joint travel
+times each joint's reach, part travel) stays above the tolerance, or above the depth an allowed
+contact may reach where that declaration holds all through. Collisions are reported as
+intervals (:func:`find_collisions`): ``t0``, ``t1`` (s), the ``phase`` at ``t0`` and every
+phase the interval spans (``phases``), the two ``bodies`` (robot body, tool body, cell object
+or part), the worst geom pair (``geoms``), every geom involved (``all_geoms``, for the video)
+and the worst penetration ``depth_mm`` at ``t_worst``.
 
 Clearance (:func:`clearance`): per phase, the smallest distance from the tool (its geoms but the
 work geoms: nozzle and torch body) and from the arm (the links but the fixed base) to any cell
@@ -52,15 +63,25 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.errors import InternalError
+from sim.errors import InternalError, SimulationError
 from sim.simulation.compile import BuiltCell
 
 #: Penetration a contact may have without being a collision, m.
 PENETRATION_TOLERANCE_M = 1e-4
 #: Distances are measured up to this range, m (the check model's geom margin).
 CLEARANCE_RANGE_M = 0.1
-#: Period of the clearance scan before refinement, s.
+#: Period of the coarse scan (clearance, and the intervals a collision may hide in), s.
 CLEARANCE_STRIDE_S = 0.01
+#: Depth the welding wire may reach beyond its radius in the seam's workpiece while the arc is
+#: on (the tip in the weld pool, tracking included), m; the contact tip and nozzle never touch.
+WIRE_ARC_DEPTH_M = 1e-3
+#: Depth a part may sink into what it rests on, is lifted off or set down on, or into the cup's
+#: lip, m: the soft contacts of the simulation sink by a fraction of this.
+PART_CONTACT_DEPTH_M = 1e-3
+#: Dips of the coarse clearance refined per phase and group (tool, arm), the deepest first.
+MAX_DIPS = 50
+#: Suction picks the part whose bounding sphere holds the tool point, with this to spare, m.
+PICK_REACH_M = 0.005
 
 #: Roles of the checked geoms.
 LINK, TOOL, CELL, PART = "link", "tool", "cell", "part"
@@ -196,8 +217,15 @@ class CollisionModel:
                                          base=bool(src.body_weldid[body] == 0))
             elif bname in parts:
                 geoms[g] = CheckGeom(g, gname, PART, bname)
-            elif src.body_weldid[body] == 0 and (src.geom_contype[g] | src.geom_conaffinity[g]):
+            elif src.geom_contype[g] | src.geom_conaffinity[g]:
+                if src.body_weldid[body] != 0:
+                    raise InternalError(f"cell body {bname!r} moves but is neither the robot nor "
+                                        "a part: collision checks do not cover it")
                 geoms[g] = CheckGeom(g, gname, CELL, object_of.get(gname, gname))
+        missing = work - {cg.name for cg in geoms.values() if cg.work}
+        if missing:
+            raise InternalError(f"tool {cell.tool.name!r} declares work geoms it does not have: "
+                                f"{', '.join(sorted(missing))}")
         self.geoms = geoms
         self.model = self._masked(src, 0.0)
         self.range_model = self._masked(src, CLEARANCE_RANGE_M)
@@ -217,10 +245,13 @@ class CollisionModel:
 
         The masks are set before compiling, not on a compiled copy: MuJoCo's compiler leaves
         geoms that collide with nothing out of their body's bounding-volume tree, so a geom
-        enabled after compiling would be skipped by the broad phase.
+        enabled after compiling would be skipped by the broad phase. MuJoCo's parent filter is
+        replaced by explicit exclusions of each robot link with its parent: the filter works on
+        bodies welded together, so it would also skip the tool (welded to the last link) against
+        the link before it.
         """
         mujoco = _mujoco()
-        spec = mujoco.MjSpec.from_string(self.built.xml)
+        spec = mujoco.MjSpec.from_string(self.built.xml, assets=self.built.cell.mjcf.get_assets())
         geoms = spec.geoms
         if len(geoms) != src.ngeom or any(
                 g.name != src.geom(i).name for i, g in enumerate(geoms) if g.name):
@@ -231,12 +262,37 @@ class CollisionModel:
             g.conaffinity = _AFFINITY[cg.role] if cg else 0
             g.margin = margin if cg and cg.role in (CELL, PART) else 0.0
             g.gap = 0.0
+        spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
+        for body in spec.bodies:
+            if body.name.startswith("robot/") and body.joints and body.parent is not None:
+                ex = spec.add_exclude()
+                ex.bodyname1, ex.bodyname2 = body.parent.name, body.name
         try:
             m = spec.compile()
         except ValueError as exc:
             raise InternalError(f"the check model does not compile: {exc}") from exc
         m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         return m
+
+    def reach_from_joint(self, joint: int) -> float:
+        """Upper bound of the distance from a joint's anchor to any point of a checked geom it
+        moves, whatever the configuration, m: the chain of body offsets from the anchor to the
+        geom's body, the geom's offset and its bounding radius."""
+        m = self.built.model
+        jbody = int(m.jnt_bodyid[joint])
+        best = 0.0
+        for g in self.geoms:
+            b = int(m.geom_bodyid[g])
+            chain = 0.0
+            while b != jbody and b != 0:
+                chain += float(np.linalg.norm(m.body_pos[b]))
+                b = int(m.body_parentid[b])
+            if b != jbody:
+                continue  # not moved by this joint
+            r = (float(np.linalg.norm(m.jnt_pos[joint])) + chain
+                 + float(np.linalg.norm(m.geom_pos[g])) + float(m.geom_rbound[g]))
+            best = max(best, r)
+        return best
 
     def ids(self, role: str | None = None, owner: str | None = None) -> frozenset[int]:
         """Ids of the checked geoms with that role and/or owner."""
@@ -275,6 +331,22 @@ class CollisionModel:
         return Contacts(s[first], g1[first], g2[first], dist[first])
 
 
+def coarse_scan(cm: CollisionModel, qpos: NDArray[np.float64], samples: NDArray[np.int64]
+                ) -> Contacts:
+    """Every pair closer than :data:`CLEARANCE_RANGE_M` at the given samples, with exact
+    penetration depths: a geom margin makes MuJoCo's distances exact when positive but its
+    penetration depths approximate, so pairs in contact are measured again without margin
+    (a contact within the tolerance counts as touching, distance 0)."""
+    ranged = cm.scan(qpos, samples, ranged=True)
+    exact = cm.scan(qpos, samples)
+    n = max(1, cm.model.ngeom)
+    key = lambda c: (c.s.astype(np.int64) * n + c.g1) * n + c.g2  # noqa: E731
+    keep = ranged.dist >= 0.0
+    touching = ~keep & ~np.isin(key(ranged), key(exact))
+    ranged.dist[touching] = 0.0
+    return Contacts.concat([ranged.select(keep | touching), exact])
+
+
 def _mujoco() -> Any:
     import mujoco
 
@@ -306,26 +378,25 @@ def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
     n = samples.t.size
     out: list[AllowedContact] = []
     work = frozenset(g for g, cg in cm.geoms.items() if cg.work)
-    # the welding wire with the seam's workpieces while the arc is on
-    if work and samples.arc_on.any():
+    torch = cell.tool is not None and cell.tool.kind == "torch"
+    if work and torch and cell.seam_objects:
         all_work = frozenset().union(*(cm.ids(CELL, obj) for objs in cell.seam_objects.values()
-                                       for obj in objs)) if cell.seam_objects else frozenset()
+                                       for obj in objs))
+        radius = max(float(built.model.geom_size[g, 0]) for g in work)
+        # the wire in the weld pool of the seam it welds, while the arc is on
         for k, seam in enumerate(phase_seams):
             when = samples.arc_on & (samples.phase == k)
             if not when.any():
                 continue
             objs = cell.seam_objects.get(seam, ()) if seam is not None else ()
             pieces = (frozenset().union(*(cm.ids(CELL, o) for o in objs)) if objs else all_work)
-            if pieces:
-                out.append(AllowedContact(work, pieces, when,
-                                          f"wire on the workpiece of seam {seam!r}, arc on"))
+            out.append(AllowedContact(
+                work, pieces, when, f"wire on the workpiece of seam {seam!r}, arc on (up to "
+                f"{(radius + WIRE_ARC_DEPTH_M) * 1e3:.1f} mm)",
+                max_depth_m=radius + WIRE_ARC_DEPTH_M))
         # the wire touching a workpiece with the arc off: touch sensing, or its tip in the
         # corner of a fillet at a seam's start or end (a wire of radius r whose tip centre is in
         # a 90 deg corner overlaps both plates by r / sqrt(2)); deeper is a collision
-    if work and cell.seam_objects and cell.tool is not None and cell.tool.kind == "torch":
-        all_work = frozenset().union(*(cm.ids(CELL, obj) for objs in cell.seam_objects.values()
-                                       for obj in objs))
-        radius = max(float(built.model.geom_size[g, 0]) for g in work)
         out.append(AllowedContact(work, all_work, np.ones(n, bool),
                                   f"wire touching a workpiece (up to its radius, "
                                   f"{radius * 1e3:.1f} mm)", max_depth_m=radius))
@@ -333,7 +404,8 @@ def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
     part_ids = {p: cm.ids(PART, p) for p in cell.parts}
     if not part_ids:
         return out
-    others = cm.ids(CELL) | frozenset().union(*part_ids.values())
+    cell_ids = cm.ids(CELL)
+    depth = PART_CONTACT_DEPTH_M
     held = {p: np.zeros(n, bool) for p in part_ids}
     for i_on, stop in _runs(samples.suction):
         p = _picked_part(cm, samples, i_on)
@@ -345,17 +417,26 @@ def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
             k_off = int(samples.phase[stop])
         window = (samples.phase >= k_on - 1) & (samples.phase <= k_off + 1)
         if work:
-            out.append(AllowedContact(work, part_ids[p], window, f"cup lip on {p}, picking it"))
-        settle = held[p] & (np.isin(samples.phase, (k_on, k_on + 1, k_off - 1, k_off)))
-        out.append(AllowedContact(part_ids[p], others - part_ids[p], settle,
-                                  f"{p} lifted off or set down"))
-    for p, ids in part_ids.items():
-        out.append(AllowedContact(ids, others - ids, ~held[p], f"{p} at rest"))
+            out.append(AllowedContact(work, part_ids[p], window,
+                                      f"cup lip on {p}, picking it", max_depth_m=depth))
+        settle = held[p] & np.isin(samples.phase, (k_on, k_on + 1, k_off - 1, k_off))
+        rest = frozenset().union(*(ids for q, ids in part_ids.items() if q != p))
+        out.append(AllowedContact(part_ids[p], cell_ids | rest, settle,
+                                  f"{p} lifted off or set down", max_depth_m=depth))
+    names = list(part_ids)
+    for i, p in enumerate(names):
+        out.append(AllowedContact(part_ids[p], cell_ids, ~held[p], f"{p} at rest",
+                                  max_depth_m=depth))
+        for q in names[i + 1:]:
+            out.append(AllowedContact(part_ids[p], part_ids[q], ~held[p] & ~held[q],
+                                      f"{p} and {q} at rest", max_depth_m=depth))
     return out
 
 
 def _picked_part(cm: CollisionModel, samples: MotionSamples, i: int) -> str | None:
-    """The part nearest to the tool point when suction comes on at sample ``i``."""
+    """The part the cup's lip is on when suction comes on at sample ``i``: the nearest part
+    whose bounding sphere holds the tool point (with :data:`PICK_REACH_M` to spare); None when
+    suction comes on with no part at the cup."""
     mujoco = _mujoco()
     built = cm.built
     m, d = cm.model, cm._data
@@ -364,8 +445,11 @@ def _picked_part(cm: CollisionModel, samples: MotionSamples, i: int) -> str | No
     tcp = d.site_xpos[built.tcp_site]
     best, best_d = None, np.inf
     for p in built.cell.parts:
-        dist = float(np.linalg.norm(d.xpos[m.body(p).id] - tcp))
-        if dist < best_d:
+        body = m.body(p).id
+        geoms = np.flatnonzero(m.geom_bodyid == body)
+        reach = float(np.max(np.linalg.norm(m.geom_pos[geoms], axis=1) + m.geom_rbound[geoms]))
+        dist = float(np.linalg.norm(d.xpos[body] - tcp))
+        if dist <= reach + PICK_REACH_M and dist < best_d:
             best, best_d = p, dist
     return best
 
@@ -381,6 +465,43 @@ def _allowed_mask(c: Contacts, allowed: Sequence[AllowedContact]) -> NDArray[np.
 # --------------------------------------------------------------------------------------------
 # Reports
 # --------------------------------------------------------------------------------------------
+
+
+def _intervals_to_check(cm: CollisionModel, samples: MotionSamples, coarse: NDArray[np.int64],
+                        scan: Contacts, allowed: Sequence[AllowedContact]
+                        ) -> list[tuple[int, int]]:
+    """Coarse intervals ``(first, last sample)`` in which a collision cannot be ruled out.
+
+    A pair at distance ``d`` at an end of interval ``k`` gets at most the sum of its geoms'
+    bounds closer inside it (:func:`motion_bound`): it cannot collide there when that stays
+    above the penetration tolerance, or above the depth an allowed contact may reach when that
+    declaration holds all through the interval.
+    """
+    if len(coarse) < 2:
+        return [(int(coarse[0]), int(coarse[0]))] if len(coarse) else []
+    starts = coarse[:-1]
+    bounds = motion_bound(cm, samples, coarse)
+    # too fast for the coarse distances to tell
+    need = (bounds[LINK] + np.maximum(bounds[LINK], bounds[PART])) >= CLEARANCE_RANGE_M
+    through = [(rule, np.logical_and.reduceat(rule.when, starts) & rule.when[coarse[1:]])
+               for rule in allowed]
+    pos = np.searchsorted(coarse, scan.s)
+    for side in (0, -1):  # a coarse sample starts interval pos and ends interval pos - 1
+        k = pos + side
+        ok = (k >= 0) & (k < len(starts))
+        rows, k = np.flatnonzero(ok), k[ok]
+        # the deepest the pair can be inside the interval
+        worst = scan.dist[rows] - _pair_reach(cm, bounds, scan.g1[rows], scan.g2[rows], k)
+        risky = worst < -PENETRATION_TOLERANCE_M
+        rows, k, worst = rows[risky], k[risky], worst[risky]
+        safe = np.zeros(rows.size, bool)
+        g1, g2 = scan.g1[rows], scan.g2[rows]
+        for rule, all_when in through:
+            a, b = np.fromiter(rule.a, int), np.fromiter(rule.b, int)
+            pair = (np.isin(g1, a) & np.isin(g2, b)) | (np.isin(g1, b) & np.isin(g2, a))
+            safe |= pair & all_when[k] & (worst >= -rule.max_depth_m)
+        need[k[~safe]] = True
+    return [(int(coarse[k]), int(coarse[k + 1])) for k in np.flatnonzero(need)]
 
 
 def _kind(cm: CollisionModel, g1: int, g2: int) -> str:
@@ -401,10 +522,86 @@ def _ordered(cm: CollisionModel, g1: int, g2: int) -> tuple[int, int]:
     return (g1, g2) if order[a.role] <= order[b.role] else (g2, g1)
 
 
+def coarse_samples(samples: MotionSamples) -> NDArray[np.int64]:
+    """The samples of the coarse scan: every :data:`CLEARANCE_STRIDE_S`, each phase's first and
+    last sample, and the last sample."""
+    n = samples.t.size
+    stride = max(1, int(round(CLEARANCE_STRIDE_S / max(samples.dt, 1e-12))))
+    return np.unique(np.concatenate([np.arange(0, n, stride), _phase_ends(samples), [n - 1]])
+                     ).astype(int)
+
+
+def motion_bound(cm: CollisionModel, samples: MotionSamples, coarse: NDArray[np.int64]
+                 ) -> dict[str, NDArray[np.float64]]:
+    """Upper bounds of how far a checked geom of each role moves within each coarse interval
+    (between any two of its samples), m, by role (``link`` and ``tool``: the robot's bound;
+    ``part``; ``cell``: 0).
+
+    Interval ``k`` runs from sample ``coarse[k]`` to ``coarse[k + 1]``. A robot joint turning
+    by ``dq`` moves a point at most ``dq`` times its distance from the joint's axis, bounded
+    (whatever the configuration) by the chain of body offsets from the joint's anchor to the
+    geom plus the geom's bounding radius: ``R_j``. A part moves by its translation plus its
+    bounding radius times its rotation angle. So ``bound_k = sum_j range_k(q_j) R_j`` plus
+    the largest part motion. Two geoms come closer by at most the sum of their bounds: a pair
+    farther apart than that at an interval's ends cannot touch inside it
+    (:func:`find_collisions`).
+    """
+    m = cm.built.model
+    qpos = samples.qpos
+    ends = coarse[1:]
+    starts = coarse[:-1]
+    idx = np.arange(qpos.shape[0])
+    # the interval each sample belongs to (an interval's end sample also ends it)
+    k_of = np.clip(np.searchsorted(coarse, idx, side="right") - 1, 0, len(starts) - 1)
+
+    def span(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """max - min of x (N,) over each interval, end samples included."""
+        hi = np.maximum.reduceat(x, starts)
+        lo = np.minimum.reduceat(x, starts)
+        return np.maximum(hi, x[ends]) - np.minimum(lo, x[ends])
+
+    robot = np.zeros(len(starts))
+    for j, adr in zip(cm.built.joint_ids, cm.built.robot_qpos, strict=True):
+        robot += span(qpos[:, adr]) * cm.reach_from_joint(int(j))
+    part = np.zeros(len(starts))
+    for adr in cm.built.part_qpos:
+        body = int(m.jnt_bodyid[np.flatnonzero(m.jnt_qposadr == adr[0])[0]])
+        geoms = np.flatnonzero(m.geom_bodyid == body)
+        r = float(np.max(np.linalg.norm(m.geom_pos[geoms], axis=1) + m.geom_rbound[geoms]))
+        move = np.sqrt(sum(span(qpos[:, a]) ** 2 for a in adr[:3]))
+        quat = qpos[:, adr[3:7]]
+        ref = quat[coarse[k_of]]
+        ang = 2.0 * np.arccos(np.clip(np.abs(np.sum(quat * ref, axis=1)), 0.0, 1.0))
+        turn = np.maximum.reduceat(ang, starts)
+        turn = np.maximum(turn, ang[ends])
+        part = np.maximum(part, move + r * 2.0 * turn)  # any two samples: twice from the start
+    return {LINK: robot, TOOL: robot, PART: part, CELL: np.zeros(len(starts))}
+
+
+def _pair_reach(cm: CollisionModel, bounds: dict[str, NDArray[np.float64]],
+                g1: NDArray[np.int64], g2: NDArray[np.int64], k: NDArray[np.int64]
+                ) -> NDArray[np.float64]:
+    """How much closer each pair (geoms g1, g2) can get within interval k, m."""
+    table = np.stack([bounds[LINK], bounds[TOOL], bounds[CELL], bounds[PART]])  # by role code
+    return table[cm.role[g1], k] + table[cm.role[g2], k]
+
+
 def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
-                    allowed: Sequence[AllowedContact]) -> list[dict[str, Any]]:
-    """Collision intervals along the motion, every sample checked (module docstring)."""
-    c = cm.scan(samples.qpos, np.arange(samples.t.size))
+                    allowed: Sequence[AllowedContact], scanned: Contacts | None = None
+                    ) -> list[dict[str, Any]]:
+    """Collision intervals along the motion (module docstring).
+
+    Every sample that can hold a collision is checked: the coarse scan
+    (:func:`coarse_samples`, :func:`coarse_scan`) rules an interval out when no pair can get
+    deeper inside it than it may (:func:`_intervals_to_check`); every other interval is
+    checked at every sample.
+    """
+    coarse = coarse_samples(samples)
+    if scanned is None:
+        scanned = coarse_scan(cm, samples.qpos, coarse)
+    fine = np.concatenate([np.arange(a, b + 1) for a, b in _intervals_to_check(
+        cm, samples, coarse, scanned, allowed)] or [np.zeros(0, int)])
+    c = cm.scan(samples.qpos, np.unique(fine).astype(int))
     c = c.select(~_allowed_mask(c, allowed))
     groups: dict[tuple[str, str], list[int]] = {}
     for r in range(c.s.size):
@@ -427,6 +624,7 @@ def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Seq
             out.append({
                 "t0": float(samples.t[lo]), "t1": float(samples.t[hi]),
                 "phase": phase_names[int(samples.phase[lo])],
+                "phases": [phase_names[int(k)] for k in dict.fromkeys(samples.phase[lo:hi + 1])],
                 "kind": _kind(cm, a, b),
                 "bodies": [oa, ob],
                 "geoms": [cm.geoms[a].name, cm.geoms[b].name],
@@ -438,37 +636,54 @@ def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Seq
 
 
 def clearance(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
-              allowed: Sequence[AllowedContact]) -> list[dict[str, Any]]:
+              allowed: Sequence[AllowedContact], scanned: Contacts | None = None
+              ) -> list[dict[str, Any]]:
     """Per phase: the tool's and the arm's smallest distance to the cell (module docstring).
 
     Each entry: ``phase``, ``tool_mm`` and ``arm_mm`` (null beyond :data:`CLEARANCE_RANGE_M`),
     with the ``tool_pair``/``arm_pair`` (geom names) and ``tool_t``/``arm_t`` where they occur.
     Allowed contacts (and the tool near the part it picks, in the same windows) are left out.
+    The coarse scan is refined at every sample around each dip of the distance (a coarse sample
+    closer than both neighbours, plateaus counted once) that could hide a value below the
+    phase's coarse minimum (:func:`motion_bound`), the :data:`MAX_DIPS` deepest per phase.
     """
-    n = samples.t.size
-    stride = max(1, int(round(CLEARANCE_STRIDE_S / max(samples.dt, 1e-12))))
-    coarse = np.unique(np.concatenate([np.arange(0, n, stride), _phase_ends(samples)]))
-    c = cm.scan(samples.qpos, coarse, ranged=True)
-    c = _clearance_rows(cm, c, allowed)
-    groups = ("tool", "arm")
-    best: dict[tuple[int, str], tuple[float, int]] = {}
-    for k in range(len(phase_names)):
-        for grp, rows in _group_rows(cm, c).items():
-            sel = rows & (samples.phase[c.s] == k)
-            if sel.any():
-                r = np.flatnonzero(sel)[int(np.argmin(c.dist[sel]))]
-                best[(k, grp)] = (float(c.dist[r]), int(c.s[r]))
-    # refine at every sample around each phase's closest coarse sample
-    refine = sorted({i for (_, _), (_, s0) in best.items()
-                     for i in range(max(0, s0 - stride), min(n, s0 + stride + 1))})
-    fine = _clearance_rows(cm, cm.scan(samples.qpos, np.array(refine, int), ranged=True),
-                           allowed) if refine else Contacts()
+    coarse = coarse_samples(samples)
+    if scanned is None:
+        scanned = coarse_scan(cm, samples.qpos, coarse)
+    bounds = motion_bound(cm, samples, coarse) if len(coarse) > 1 else None
+    # robot against cell or part: how much closer within each interval
+    bound = (bounds[LINK] + bounds[PART]) if bounds is not None else np.zeros(0)
+    c = _clearance_rows(cm, scanned, allowed)
+    pos_of = {int(i): k for k, i in enumerate(coarse)}
+    refine: set[int] = set()
+    for grp, rows in _group_rows(cm, c).items():
+        # the group's smallest distance at each coarse sample (the range where none is closer)
+        d = np.full(len(coarse), CLEARANCE_RANGE_M)
+        np.minimum.at(d, [pos_of[int(i)] for i in c.s[rows]], c.dist[rows])
+        ph = samples.phase[coarse]
+        for k in range(len(phase_names)):
+            idx = np.flatnonzero(ph == k)
+            if idx.size == 0 or np.min(d[idx]) >= CLEARANCE_RANGE_M:
+                continue
+            best = float(np.min(d[idx]))
+            left = np.concatenate([[np.inf], d[idx][:-1]])
+            right = np.concatenate([d[idx][1:], [np.inf]])
+            dips = idx[(d[idx] < left) & (d[idx] <= right)]
+            slack = np.array([max(bound[j - 1] if j > 0 else 0.0,
+                                  bound[j] if j < len(bound) else 0.0) for j in dips])
+            dips = dips[d[dips] - slack < best]
+            for j in dips[np.argsort(d[dips])][:MAX_DIPS]:
+                lo = int(coarse[max(j - 1, 0)])
+                hi = int(coarse[min(j + 1, len(coarse) - 1)])
+                refine.update(range(lo, hi + 1))
+    fine = (_clearance_rows(cm, cm.scan(samples.qpos, np.array(sorted(refine), int),
+                                        ranged=True), allowed) if refine else Contacts())
     both = Contacts.concat([c, fine])
     rows_by = _group_rows(cm, both)
     out = []
     for k, name in enumerate(phase_names):
         entry: dict[str, Any] = {"phase": name}
-        for grp in groups:
+        for grp in ("tool", "arm"):
             sel = rows_by[grp] & (samples.phase[both.s] == k)
             if sel.any():
                 r = np.flatnonzero(sel)[int(np.argmin(both.dist[sel]))]
@@ -531,10 +746,15 @@ def check_motion(built: BuiltCell, samples: MotionSamples, phase_names: Sequence
                  phase_seams: Sequence[str | None], *, with_clearance: bool = True
                  ) -> CollisionReport:
     """Check a sampled motion for collisions (and clearance) on the cell's check model."""
+    if not np.all(np.isfinite(samples.qpos)):
+        i = int(np.flatnonzero(~np.all(np.isfinite(samples.qpos), axis=1))[0])
+        raise SimulationError(f"the motion has non-finite positions at t = {samples.t[i]:.6g} s: "
+                              "no collision check is possible")
     cm = CollisionModel(built)
     allowed = allowed_contacts(cm, samples, phase_seams)
-    collisions = find_collisions(cm, samples, phase_names, allowed)
-    clear = clearance(cm, samples, phase_names, allowed) if with_clearance else []
+    scanned = coarse_scan(cm, samples.qpos, coarse_samples(samples))
+    collisions = find_collisions(cm, samples, phase_names, allowed, scanned)
+    clear = clearance(cm, samples, phase_names, allowed, scanned) if with_clearance else []
     return CollisionReport(collisions, clear, sorted({a.reason for a in allowed}))
 
 
