@@ -55,6 +55,11 @@ class RunFolderError(CellsimError):
     """A run folder is missing, incomplete or inconsistent; names the folder and the file/field."""
 
 
+class CatalogError(CellsimError):
+    """A motor or reducer catalogue is missing or malformed; the message names the file, the
+    entry and the key."""
+
+
 class SweepError(CellsimError):
     """Bad sweep input (payloads, speed scales, workers) or failed variants; one line."""
 

@@ -23,6 +23,7 @@ from sim.scenario import (
     LinearPhaseSpec,
     ScenarioSpec,
     SimulationSpec,
+    SizingSpec,
     VideoSpec,
     load_scenario,
     parse_scenario,
@@ -248,7 +249,7 @@ def test_format_reference_documents_every_key():
     doc = DOC.read_text()
     documented = set(re.findall(r"`([a-z][a-z0-9_]*)`", doc))
     models = (ScenarioSpec, JointPhaseSpec, LinearPhaseSpec, CircularPhaseSpec, HoldPhaseSpec,
-              ActionSpec, SimulationSpec, VideoSpec, DriveOverrideSpec)
+              ActionSpec, SimulationSpec, VideoSpec, DriveOverrideSpec, SizingSpec)
     declared = set()
     for model in models:
         for key in model.model_fields:

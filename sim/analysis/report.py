@@ -410,6 +410,58 @@ _COLL_HEAD = ("phase", "t (s)", "kind", "bodies", "worst geoms", "depth (mm)")
 _CLEAR_HEAD = ("phase", "tool (mm)", "tool closest pair", "arm (mm)", "arm closest pair")
 
 
+def selection_html(sel: Any) -> list[str]:
+    """The "Actuator selection" section: the choice per joint, its checks and the ranking."""
+    from sim.analysis.catalog import describe_entry
+    from sim.analysis.selection import REPORT_TOP
+
+    esc = html.escape
+    o = sel.options
+    out = ["<h2>Actuator selection</h2>",
+           f"<p>Catalogue {esc(o.catalog.name)}: {len(o.catalog.motors)} motors x "
+           f"{len(o.catalog.reducers)} reducers per joint; duty cycle {sel.cycle_s:.4g} s "
+           f"cycle + {o.dwell_s:g} s dwell; reducer life target {o.life_h:g} h; ranked by "
+           f"{esc(o.rank)}; each check on the worse of the inverse dynamics and the simulated "
+           "torque.</p>"]
+    if any(e.illustrative for e in (*o.catalog.motors, *o.catalog.reducers)):
+        out.append('<p class="small">Entries marked [illustrative] hold numbers not verified '
+                   "against their datasheet: verify before ordering.</p>")
+    rows = []
+    for j in sel.joints:
+        if j.chosen is None:
+            rows.append((j.joint, "NONE", "", "", "", esc(j.reason), "", f"0 / {j.n_pairs}"))
+            continue
+        c, h = j.chosen, j.chosen.hardest
+        runner = (f"{j.runner_up.motor.id} + {j.runner_up.reducer.id}" if j.runner_up else "-")
+        rows.append((j.joint, describe_entry(c.motor), describe_entry(c.reducer),
+                     f"{c.reducer.spec.ratio:g}", _f(c.mass_kg, 3), f"{h.name} {_pct(h.margin_pct)}",
+                     runner, f"{len(j.passing)} / {j.n_pairs}"))
+    cls = "verdict" if sel.all_served else "verdict fail"
+    out.append(f'<p class="{cls}">' + ("Every joint has a pair that passes every check."
+                                       if sel.all_served else
+                                       "Some joint has no pair that passes: see below.") + "</p>")
+    out.append(_html_table(("joint", "motor", "reducer", "ratio", "mass (kg)", "hardest check",
+                            "runner-up", "pairs passing"), rows))
+    for j in sel.joints:
+        pair = j.chosen or j.closest
+        if pair is None:
+            continue
+        title = "chosen" if j.chosen else "closest (fails)"
+        out.append(f"<details><summary>{esc(j.joint)}: {title} {esc(pair.motor.id)} + "
+                   f"{esc(pair.reducer.id)}</summary>")
+        out.append(_html_table(("check", "value", "limit", "unit", "margin", "source",
+                                "severity"),
+                               [(c.name, _f(c.value), _f(c.limit), c.unit, _pct(c.margin_pct),
+                                 c.source, c.severity) for c in pair.checks]))
+        if j.passing:
+            out.append(_html_table(("rank", "motor", "reducer", "mass (kg)", "min margin"),
+                                   [(str(i + 1), p.motor.id, p.reducer.id, _f(p.mass_kg, 3),
+                                     _pct(p.min_margin_pct))
+                                    for i, p in enumerate(j.passing[:REPORT_TOP])]))
+        out.append("</details>")
+    return out
+
+
 def _run_verdict_html(summary: Mapping[str, Any]) -> list[str]:
     """The run's verdict (every check: tracking, saturation, limits, sizing, collisions)."""
     if "verdict" not in summary:
@@ -445,7 +497,7 @@ def _collision_html(summary: Mapping[str, Any]) -> list[str]:
 
 
 def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapping[str, Any],
-                video: str | None = None) -> str:
+                video: str | None = None, selection: Any = None) -> str:
     """Text of the self-contained ``report.html`` (charts as base64 data URIs)."""
     esc = html.escape
     title = f"cellsim report: {result.scenario or 'run'}"
@@ -473,6 +525,8 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
     cls = "verdict" if result.passed else "verdict fail"
     out.append(f'<h2>Sizing verdict</h2><p class="{cls}">{esc(result.verdict)}</p>')
     out += _collision_html(summary)
+    if selection is not None:
+        out += selection_html(selection)
     out.append("<h2>Per joint</h2>")
     out.append(_html_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
     out.append("<h2>Checks</h2>")
@@ -494,7 +548,8 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
 # --------------------------------------------------------------------------------------------
 
 def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = True,
-                 summary: Mapping[str, Any] | None = None) -> dict[str, Path]:
+                 summary: Mapping[str, Any] | None = None,
+                 selection: Any = None) -> dict[str, Path]:
     """Write the sizing files of a run into ``run_dir``.
 
     ``summary`` is the run's summary in memory (the runner's); without it the folder's
@@ -526,5 +581,5 @@ def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = Tr
     else:  # the runner's summary in memory names the video when it wrote one
         video = summary.get("video")
     written["html"] = write_atomic(run_dir / REPORT_HTML,
-                                   sizing_html(result, pngs, summary, video))
+                                   sizing_html(result, pngs, summary, video, selection))
     return written

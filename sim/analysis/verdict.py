@@ -17,7 +17,9 @@ is per joint:
   names the phase and the two bodies), the penetration in mm against 0; one passed check with
   value 0 when there is none;
 * ``clearance`` (a *warning*): per phase, the smaller of the tool's and the arm's clearance to
-  the cell, mm, against the scenario's ``simulation.clearance_mm``.
+  the cell, mm, against the scenario's ``simulation.clearance_mm``;
+* ``selection`` (when actuators were chosen from a catalogue, :mod:`sim.analysis.selection`):
+  per joint, the chosen pair's smallest margin, %; fails when no pair serves the joint.
 
 ``summary.json`` holds ``"checks"`` (each ``name``, ``joint`` ("" when the check is not a
 joint's), ``subject``, ``value``, ``limit``, ``unit``, ``pass``, ``severity``) and
@@ -59,8 +61,9 @@ class RunCheck:
 
 def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], spec: RobotSpec,
                tracking_tolerance_deg: float, sizing: SizingResult | None = None,
-               clearance_mm: float = 5.0) -> list[RunCheck]:
-    """Every check of a run (module docstring): joint by joint, then collisions, clearance."""
+               clearance_mm: float = 5.0, selection: Any = None) -> list[RunCheck]:
+    """Every check of a run (module docstring): joint by joint, then collisions, clearance and
+    the actuator selection when one was made."""
     checks: list[RunCheck] = []
     track = np.degrees(np.max(np.abs(np.asarray(arrays["q"]) - arrays["q_ref"]), axis=0))
     speed = np.degrees(np.max(np.abs(np.asarray(arrays["qd"])), axis=0))
@@ -88,6 +91,14 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                 checks.append(RunCheck(c.key, j.joint, float(c.used), float(c.limit), c.unit,
                                        bool(c.passed)))
     checks += motion_checks(summary, clearance_mm)
+    if selection is not None:
+        for j in selection.joints:
+            pair = j.chosen or j.closest
+            margin = pair.min_margin_pct if pair is not None else -100.0
+            subject = (f"{j.joint}: {j.chosen.motor.id} + {j.chosen.reducer.id}" if j.chosen
+                       else f"{j.joint}: {j.reason}")
+            checks.append(RunCheck("selection", j.joint, float(margin), 0.0, "% margin",
+                                   j.chosen is not None, subject=subject))
     return checks
 
 

@@ -48,6 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="exit with 1 when the run's verdict is fail (a collision, a saturated "
                         "drive, a joint over its speed or acceleration limit, tracking worse "
                         "than the tolerance, a sizing limit exceeded)")
+    from sim.cli.size import add_selection_args
+
+    add_selection_args(p)
     p.set_defaults(func=run)
 
 
@@ -56,10 +59,17 @@ def run(args: argparse.Namespace) -> int:
         from sim.render.gl import configure_gl
 
         configure_gl(args.gl)
+    from sim.cli.size import selection_overrides
     from sim.pipeline.run import RunOptions, default_out_dir, run_scenario
     from sim.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
+    select = selection_overrides(args)
+    selection = None
+    if select is not None or scenario.sizing.select:
+        from sim.pipeline.run import selection_options
+
+        selection = selection_options(scenario, **(select or {}))
     options = RunOptions(
         out_dir=args.out,
         video=not args.no_video,
@@ -68,6 +78,7 @@ def run(args: argparse.Namespace) -> int:
         video_args={"width": args.width, "height": args.height, "fps": args.fps,
                     "cameras": tuple(args.camera) if args.camera else None, "gl": args.gl},
         progress=not args.quiet,
+        selection=selection,
     )
     summary = run_scenario(scenario, options)
     out = (args.out or default_out_dir(scenario))
@@ -94,6 +105,10 @@ def run(args: argparse.Namespace) -> int:
         s = summary["sizing"]
         print(f"  sizing: hardest joint {s['hardest_joint']} (margin {s['hardest_margin_pct']:.1f} %),"
               f" {'all pass' if s['pass'] else 'FAIL'}")
+    if "selection" in summary:
+        for joint, j in summary["selection"]["joints"].items():
+            print(f"  selection {joint}: " + (f"{j['motor']} + {j['reducer']}" if j["motor"]
+                                               else "NO PAIR passes (see selection.json)"))
     checks = summary.get("checks", [])
     failed = [c for c in checks if not c["pass"] and c.get("severity", "error") == "error"]
     warned = [c for c in checks if not c["pass"] and c.get("severity") == "warning"]

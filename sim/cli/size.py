@@ -12,6 +12,7 @@ when it could evaluate every variant.
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 from pathlib import Path
 
@@ -40,10 +41,42 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, default=None,
                    help="parallel processes (default: the number of cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_selection_args(p)
     p.set_defaults(func=run)
 
 
-def run_variant(variant: Variant) -> Path:
+def add_selection_args(p: argparse.ArgumentParser) -> None:
+    """The actuator-selection flags (shared by ``cellsim size`` and ``cellsim run``)."""
+    g = p.add_argument_group(
+        "actuator selection", "choose a motor and a reducer per joint from a catalogue over "
+        "the duty cycle (selection.json, selection.csv, a report section); defaults from the "
+        "scenario's [sizing] table")
+    g.add_argument("--select", action="store_true",
+                   help="choose motors and reducers (also on when the scenario says "
+                        "[sizing] select = true)")
+    g.add_argument("--catalog", type=Path, metavar="FILE",
+                   help="catalogue TOML (default: the scenario's [sizing] catalog, else the "
+                        "shipped models/catalog/starter.toml)")
+    g.add_argument("--life-h", type=float, metavar="H", help="reducer L10 life target, h "
+                   "(default 20000)")
+    g.add_argument("--dwell-s", type=float, metavar="S",
+                   help="standstill after each cycle, s (default 0)")
+    g.add_argument("--rank", choices=("mass", "inertia", "margin"),
+                   help="rank passing pairs by mass (default), rotor inertia or margin")
+    g.add_argument("--inertia-ratio-max", type=float, metavar="X",
+                   help="load/rotor inertia ratio above which a pair gets a warning (default 10)")
+
+
+def selection_overrides(args: argparse.Namespace) -> dict | None:
+    """The selection flags given, or None when no selection was asked for."""
+    if not getattr(args, "select", False):
+        return None
+    return {"catalog": None if args.catalog is None else str(args.catalog),
+            "life_h": args.life_h, "dwell_s": args.dwell_s, "rank": args.rank,
+            "inertia_ratio_max": args.inertia_ratio_max}
+
+
+def run_variant(variant: Variant, select: dict | None = None) -> Path:
     """Run one sweep variant (module level, so worker processes can import it).
 
     A variant faster or heavier than the robot allows is still simulated (speed and
@@ -58,8 +91,13 @@ def run_variant(variant: Variant) -> Path:
     scenario = load_scenario(variant.scenario).scaled(variant.speed_scale, variant.payload_kg)
     scenario = dataclasses.replace(scenario, simulation=scenario.simulation.model_copy(
         update={"enforce_speed_limits": False, "enforce_accel_limits": False}))
+    selection = None
+    if select is not None or scenario.sizing.select:
+        from sim.pipeline.run import selection_options
+
+        selection = selection_options(scenario, **(select or {}))
     run_scenario(scenario, RunOptions(out_dir=variant.run_dir, video=False, plots=False,
-                                      progress=False))
+                                      progress=False, selection=selection))
     return Path(variant.run_dir)
 
 
@@ -83,9 +121,41 @@ def run(args: argparse.Namespace) -> int:
         raise CellsimError(f"--workers must be at least 1, got {args.workers}")
     out = args.out or Path("runs") / f"{scenario.name}_sweep"
     workers = args.workers or os.cpu_count() or 1
-    result = run_sweep(str(scenario.source), payloads, scales, run_variant,
+    select = selection_overrides(args)
+    if select is not None or scenario.sizing.select:  # a bad catalogue fails before any run
+        from sim.pipeline.run import selection_options
+
+        selection_options(scenario, **(select or {}))
+    result = run_sweep(str(scenario.source), payloads, scales,
+                       functools.partial(run_variant, select=select),
                        workers=min(workers, len(payloads) * len(scales)), out_dir=out,
                        progress=not args.quiet)
     print(f"{len(result.outcomes)} variants in {result.wall_s:.1f} s on {result.workers} "
           f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.png)")
+    if select is not None or scenario.sizing.select:
+        _print_selections(result)
     return 0
+
+
+def _print_selections(result) -> None:
+    """Each variant's choice per joint (from its selection.json)."""
+    import json
+
+    for outcome in result.outcomes:
+        if outcome.run_dir is None:
+            continue
+        path = Path(outcome.run_dir) / "selection.json"
+        if not path.is_file():
+            continue
+        doc = json.loads(path.read_text())
+        print(f"selection, {outcome.variant.label}:")
+        for joint, j in doc["joints"].items():
+            if j["motor"] is None:
+                print(f"  {joint}: NO PAIR: {j['reason']}")
+                continue
+            hard = min((c for c in j["checks"] if c["severity"] == "error"),
+                       key=lambda c: c["margin_pct"] if c["margin_pct"] is not None else 1e300)
+            margin = hard["margin_pct"]
+            print(f"  {joint}: {j['motor']} + {j['reducer']} (hardest {hard['name']}, "
+                  f"margin {'inf' if margin is None else f'{margin:.0f}'} %; "
+                  f"{j['pairs_passing']} of {j['pairs_checked']} pairs pass)")

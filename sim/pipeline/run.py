@@ -55,6 +55,9 @@ class RunOptions:
         plots: Write ``plots/*.png``.
         sizing: Write the actuator-sizing report.
         progress: Show progress bars (they are silent anyway when stderr is not a terminal).
+        selection: Choose a motor and a reducer per joint from a catalogue
+            (:mod:`sim.analysis.selection`; ``selection.json``/``.csv``, a report section and a
+            ``selection`` check per joint), or None.
     """
 
     out_dir: Path | None = None
@@ -64,6 +67,7 @@ class RunOptions:
     plots: bool = True
     sizing: bool = True
     progress: bool = True
+    selection: Any = None
 
 
 # --------------------------------------------------------------------------------------------
@@ -178,16 +182,31 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
                         **video_args)
             summary["video"] = runfolder.VIDEO_MP4
         sizing = _size(scenario, built, record, summary) if options.sizing else None
+        selected = None
+        if options.selection is not None:
+            from sim.analysis.selection import select_actuators, write_selection
+            from sim.analysis.sizing import joint_armature
+
+            selected = select_actuators(record, built.joint_ids,
+                                        joint_armature(built.model, built.joint_ids),
+                                        options.selection)
+            write_selection(tmp, selected)
+            summary["selection"] = {
+                "catalog": list(options.selection.catalog.sources),
+                "all_joints_served": selected.all_served,
+                "joints": {j.joint: {"motor": j.chosen.motor.id if j.chosen else None,
+                                     "reducer": j.chosen.reducer.id if j.chosen else None}
+                           for j in selected.joints}}
         checks = run_checks(arrays, summary, scenario.robot,
                             scenario.simulation.tracking_tolerance_deg, sizing,
-                            clearance_mm=scenario.simulation.clearance_mm)
+                            clearance_mm=scenario.simulation.clearance_mm, selection=selected)
         summary["checks"] = [c.to_dict() for c in checks]
         summary["verdict"] = verdict(checks)
         summary["warnings"] = warnings_count(checks)
         if sizing is not None:  # last: report.html links the video and shows the verdict
             from sim.analysis.report import write_sizing
 
-            write_sizing(tmp, sizing, summary=summary)
+            write_sizing(tmp, sizing, summary=summary, selection=selected)
         runfolder.write_summary(tmp, summary)
         runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
     except BaseException:
@@ -221,6 +240,45 @@ def add_collisions(summary: dict[str, Any], built: BuiltCell, motion: Any,
     summary["clearance"] = report.clearance
     summary["allowed_contacts"] = report.allowed
     summary["collision_check_s"] = time.perf_counter() - start
+
+
+def selection_options(scenario: Scenario, *, catalog: str | Path | None = None,
+                      life_h: float | None = None, dwell_s: float | None = None,
+                      rank: str | None = None, inertia_ratio_max: float | None = None) -> Any:
+    """The selection settings of a run: the scenario's ``[sizing]`` keys, overridden by the
+    given values (command-line flags). The catalogue is loaded here (the scenario's
+    ``catalog`` is relative to the scenario file; the default is the shipped starter).
+
+    Raises:
+        CatalogError: The catalogue is missing or malformed.
+        ScenarioError: A bad override (negative life, unknown rank, ...).
+    """
+    from sim.analysis.catalog import load_catalog, starter_catalog
+    from sim.analysis.selection import RANKS, SelectionOptions
+    from sim.errors import ScenarioError
+
+    spec = scenario.sizing
+    if catalog is not None:
+        path = Path(catalog)
+    elif spec.catalog is not None:
+        path = Path(spec.catalog)
+        if not path.is_absolute():
+            path = scenario.source.parent / path
+    else:
+        path = starter_catalog()
+    values = {"life_h": spec.life_h if life_h is None else life_h,
+              "dwell_s": spec.dwell_s if dwell_s is None else dwell_s,
+              "inertia_ratio_max": (spec.inertia_ratio_max if inertia_ratio_max is None
+                                    else inertia_ratio_max)}
+    for key, value in values.items():
+        low = 0.0 if key == "dwell_s" else None
+        if not np.isfinite(value) or (value < 0 if low == 0.0 else value <= 0):
+            raise ScenarioError(f"--{key.replace('_', '-')}: must be a finite number "
+                                f"{'>= 0' if low == 0.0 else '> 0'}, got {value!r}")
+    rank = spec.rank if rank is None else rank
+    if rank not in RANKS:
+        raise ScenarioError(f"--rank: must be one of {', '.join(RANKS)}, got {rank!r}")
+    return SelectionOptions(load_catalog(path), rank=rank, **values)
 
 
 def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:

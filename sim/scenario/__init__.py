@@ -34,12 +34,13 @@ from sim.scenario.schema import (
     LinearPhaseSpec,
     ScenarioSpec,
     SimulationSpec,
+    SizingSpec,
     VideoSpec,
 )
 
 __all__ = [
     "Action", "ActionSpec", "CartesianPhase", "CircularPhaseSpec", "DriveOverrideSpec",
     "HoldPhase", "HoldPhaseSpec", "JointPhase", "JointPhaseSpec", "LinearPhaseSpec", "Phase",
-    "PlannedPhase", "PoseTarget", "Scenario", "ScenarioSpec", "SimulationSpec", "VideoSpec",
+    "PlannedPhase", "PoseTarget", "Scenario", "ScenarioSpec", "SimulationSpec", "SizingSpec", "VideoSpec",
     "load_scenario", "parse_scenario", "plan_phase", "plan_scenario", "resolve_scenario",
 ]

@@ -186,6 +186,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         video=spec.video,
         drives=drives,
         actions=tuple(actions),
+        sizing=spec.sizing,
     )
 
 

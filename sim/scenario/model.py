@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 
 from sim.errors import ScenarioError, UsageError
 from sim.robots.registry import RobotSpec
-from sim.scenario.schema import SimulationSpec, VideoSpec
+from sim.scenario.schema import SimulationSpec, SizingSpec, VideoSpec
 
 if TYPE_CHECKING:
     from sim.cells import CellSpec
@@ -172,6 +172,7 @@ class Scenario:
         mount, payload_kg: Robot mount (``"floor"``/``"ceiling"``) and lumped payload, kg.
         simulation, video: Settings tables (pydantic models, defaults filled in).
         drives: Drive-train overrides by joint name: {field: value}, SI units.
+        sizing: Actuator-selection settings (``[sizing]``; ``catalog`` relative to ``source``).
         actions: Tool actions in file order.
     """
 
@@ -189,6 +190,7 @@ class Scenario:
     video: VideoSpec = VideoSpec()
     drives: dict[str, dict[str, float]] = field(default_factory=dict)
     actions: tuple[Action, ...] = ()
+    sizing: SizingSpec = SizingSpec()
 
     @property
     def sha256(self) -> str:

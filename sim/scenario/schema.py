@@ -170,6 +170,18 @@ class DriveOverrideSpec(_Strict):
     max_speed_rpm: float | None = Field(None, gt=0)
 
 
+class SizingSpec(_Strict):
+    """Actuator selection from catalogues (``cellsim size --select``, ``cellsim run --select``)."""
+
+    select: bool = Field(False, description="choose motors and reducers on every run")
+    catalog: str | None = Field(None, description="catalogue file, relative to the scenario "
+                                                 "file (default: the shipped starter)")
+    life_h: float = Field(20000.0, gt=0, description="reducer L10 life target, h")
+    dwell_s: float = Field(0.0, ge=0, le=1e6, description="standstill after each cycle, s")
+    rank: Literal["mass", "inertia", "margin"] = "mass"
+    inertia_ratio_max: float = Field(10.0, gt=0, description="load/rotor inertia warning limit")
+
+
 class ScenarioSpec(_Strict):
     """Top level of a scenario file."""
 
@@ -184,5 +196,6 @@ class ScenarioSpec(_Strict):
     simulation: SimulationSpec = SimulationSpec()
     video: VideoSpec = VideoSpec()
     drives: dict[str, DriveOverrideSpec] = {}
+    sizing: SizingSpec = SizingSpec()
     actions: list[ActionSpec] = []
     phases: list[PhaseSpec] = Field(min_length=1, description="the work cycle, in order")

@@ -14,7 +14,9 @@ A run folder DIR holds (``FILES`` lists them):
 * ``trajectory.npz``: the recorded arrays (``ARRAYS`` gives each one's shape and unit);
   ``trajectory.csv``: the main ones as columns;
 * ``video.mp4``, ``plots/*.png``, the sizing report (``sizing.md``, ``sizing.csv``,
-  ``sizing.json``, ``report.html``, ``sizing/*.png``).
+  ``sizing.json``, ``report.html``, ``sizing/*.png``);
+* with an actuator selection, ``selection.json`` and ``selection.csv``
+  (:mod:`sim.analysis.selection`).
 
 A run that fails mid-simulation keeps what it recorded in ``DIR.failed/`` with ``error.txt``.
 """
@@ -46,6 +48,8 @@ SIZING_MD = "sizing.md"
 SIZING_CSV = "sizing.csv"
 SIZING_JSON = "sizing.json"
 REPORT_HTML = "report.html"
+SELECTION_JSON = "selection.json"
+SELECTION_CSV = "selection.csv"
 SIZING_CHARTS_DIR = "sizing"
 #: Suffix of the folder a failed run leaves next to the one it would have written.
 FAILED_SUFFIX = ".failed"
@@ -55,7 +59,7 @@ MARKER = ".cellsim-run"
 
 #: Every file (or folder) a complete run folder may hold, in the order a person reads them.
 FILES: tuple[str, ...] = (SUMMARY_JSON, REPORT_HTML, SIZING_MD, SIZING_CSV, SIZING_JSON,
-                          SIZING_CHARTS_DIR, VIDEO_MP4, PLOTS_DIR, TRAJECTORY_NPZ,
+                          SELECTION_JSON, SELECTION_CSV, SIZING_CHARTS_DIR, VIDEO_MP4, PLOTS_DIR, TRAJECTORY_NPZ,
                           TRAJECTORY_CSV, MODEL_XML, SCENARIO_TOML, MANIFEST_JSON)
 
 
