@@ -321,3 +321,24 @@ def test_starter_catalogue_cites_sources_and_has_plausible_units():
     for e in (*cat.motors, *cat.reducers):
         if e.spec.illustrative:
             assert "memory" in e.spec.source or "not" in e.spec.source.lower(), e.id
+
+
+@pytest.mark.parametrize("shape", ["full", "never_brakes", "only_torque", "at_rest"])
+def test_peak_from_the_hull_equals_the_peak_over_every_sample(shape):
+    """``max |c . p|`` over the hull points equals the maximum over every sample, for any
+    ``c``, also for flat sets (a joint that never brakes, never accelerates, or rests)."""
+    from sim.analysis.selection import _hull_points
+
+    rng = np.random.default_rng(3)
+    p = rng.normal(size=(5000, 3))
+    if shape == "never_brakes":
+        p[:, 1] = 0.0
+    elif shape == "only_torque":
+        p[:, 1:] = 0.0
+    elif shape == "at_rest":
+        p[:] = 0.0
+    hull = _hull_points(p)
+    assert len(hull) <= max(2, len(p))
+    for c in rng.normal(size=(200, 3)):
+        assert np.max(np.abs(hull @ c)) == pytest.approx(np.max(np.abs(p @ c)), rel=1e-12,
+                                                          abs=1e-15)

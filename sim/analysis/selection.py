@@ -267,14 +267,23 @@ def _weights(t: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _hull_points(p: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Vertices of the convex hull of ``+-p`` (all of them when the set is flat)."""
-    pts = np.vstack([p, -p])
-    try:
-        from scipy.spatial import ConvexHull
+    """Points of ``+-p`` among which ``max |c . p|`` is reached for every ``c``: the vertices of
+    their convex hull, computed in the subspace the points span (a joint that never brakes,
+    or never accelerates, gives a flat set)."""
+    from scipy.spatial import ConvexHull, QhullError
 
-        return pts[ConvexHull(pts).vertices]
-    except Exception:  # flat or degenerate sets (a joint at rest): every point
-        return np.unique(pts, axis=0)
+    pts = np.vstack([p, -p])
+    vals, vecs = np.linalg.eigh(pts.T @ pts)
+    basis = vecs[:, vals > 1e-12 * max(float(vals.max()), 1e-300)]
+    if basis.shape[1] == 0:
+        return pts[:1]
+    proj = pts @ basis
+    if basis.shape[1] == 1:
+        return pts[[int(np.argmin(proj[:, 0])), int(np.argmax(proj[:, 0]))]]
+    try:
+        return pts[ConvexHull(proj).vertices]
+    except QhullError:  # nearly flat within the basis: every point (rare and exact)
+        return pts
 
 
 def _source(name: str, t: NDArray[np.float64], tau: NDArray[np.float64],
