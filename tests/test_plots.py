@@ -58,42 +58,56 @@ def test_write_plots_one_png_per_kind_of_the_expected_size(run_dir: Path) -> Non
         assert image[..., :3].std() > 10  # something is drawn
 
 
-def test_joint_figure_shows_q_qd_qdd_qddd_and_knots(run_dir: Path) -> None:
+def _knot_ticks(ax) -> np.ndarray:
+    """x of the knot ticks: the one LineCollection of short verticals on the time axis."""
+    (ticks,) = [c for c in ax.collections if c.__class__.__name__ == "LineCollection"]
+    segs = ticks.get_segments()
+    assert all(seg[0, 0] == seg[1, 0] and seg[1, 1] - seg[0, 1] < 0.05 for seg in segs)
+    return np.sort([seg[0, 0] for seg in segs])
+
+
+def test_joint_figure_shows_q_qd_qdd_qddd_in_degrees_with_knot_ticks(run_dir: Path) -> None:
+    """Position to jerk in the scenario's unit (deg); knots as short ticks on the time axis,
+    none closer than 1/80 of the axis, every knot within that of a tick; no markers on the
+    curves."""
     record = load_run(run_dir)
     t = record.t
-    knots = record.get("knot_t")
+    knots = np.sort(record.get("knot_t"))
     for j in range(len(JOINTS)):
         fig = joint_figure(record, j)
         axes = fig.get_axes()
         assert len(axes) == 4
-        for ax, key in zip(axes, ("q_ref", "qd_ref", "qdd_ref", "qddd_ref")):
+        for ax, key, unit in zip(axes, ("q_ref", "qd_ref", "qdd_ref", "qddd_ref"),
+                                 ("[deg]", "[deg/s]", "[deg/s²]", "[deg/s³]")):
             ref, *rest = ax.get_lines()
             np.testing.assert_array_equal(ref.get_xdata(), t)
-            np.testing.assert_array_equal(ref.get_ydata(), record.get(key)[:, j])
-            marker = next(line for line in rest if line.get_label() == "knots")
-            np.testing.assert_allclose(marker.get_xdata(), knots)
-            expected = np.interp(knots, t, record.get(key)[:, j])
-            np.testing.assert_allclose(marker.get_ydata(), expected)
-            # knot lines: one vertical segment per knot (a single LineCollection)
-            (knot_lines,) = [c for c in ax.collections
-                             if c.__class__.__name__ == "LineCollection"]
-            xs = sorted(seg[0, 0] for seg in knot_lines.get_segments())
-            assert all(seg[0, 0] == seg[1, 0] for seg in knot_lines.get_segments())
-            np.testing.assert_allclose(xs, np.sort(knots))
+            np.testing.assert_allclose(ref.get_ydata(), np.degrees(record.get(key)[:, j]))
+            assert unit in ax.get_ylabel()
+            assert not [line for line in rest if line.get_marker() not in ("None", None, "")]
+            ticks = _knot_ticks(ax)
+            span = np.subtract(*ax.get_xlim()[::-1])
+            assert np.all(np.diff(ticks) >= span / 80 - 1e-9)
+            assert np.all(np.min(np.abs(knots[:, None] - ticks[None, :]), axis=1)
+                          < span / 80 + 1e-9)
         simulated = [line for line in axes[0].get_lines() if line.get_label() == "simulated"]
-        np.testing.assert_array_equal(simulated[0].get_ydata(), record.get("q")[:, j])
+        np.testing.assert_allclose(simulated[0].get_ydata(), np.degrees(record.get("q")[:, j]))
 
 
-def test_tool_path_figure_draws_reference_actual_seam_and_error(run_dir: Path) -> None:
+def test_tool_path_figure_in_mm_with_equal_axes(run_dir: Path) -> None:
     record = load_run(run_dir)
     fig = tool_path_figure(record)
     ax3d, ax2d = fig.get_axes()
     lines = {line.get_label(): line for line in ax3d.get_lines()}
     ref_x, ref_y, ref_z = lines["reference"].get_data_3d()
-    np.testing.assert_allclose(np.stack([ref_x, ref_y, ref_z], 1), record.get("tcp_pos_ref"))
+    np.testing.assert_allclose(np.stack([ref_x, ref_y, ref_z], 1),
+                               1000.0 * record.get("tcp_pos_ref"))
     seam = lines["seam (arc on)"].get_data_3d()
     arc = record.get("arc_on")
-    np.testing.assert_allclose(np.stack(seam, 1), record.get("tcp_pos")[arc])
+    np.testing.assert_allclose(np.stack(seam, 1), 1000.0 * record.get("tcp_pos")[arc])
+    spans = [np.subtract(*lim[::-1]) for lim in (ax3d.get_xlim(), ax3d.get_ylim(),
+                                                 ax3d.get_zlim())]
+    assert max(spans) == pytest.approx(min(spans))  # one scale on every axis
+    assert "[mm]" in ax3d.get_xlabel()
     (err,) = ax2d.get_lines()
     expected = 1000.0 * np.linalg.norm(record.get("tcp_pos") - record.get("tcp_pos_ref"), axis=1)
     np.testing.assert_allclose(err.get_ydata(), expected)
@@ -106,12 +120,40 @@ def test_tracking_error_and_torque_figures(run_dir: Path) -> None:
     trq_axes = [ax for ax in torque_figure(record).get_axes() if ax.get_visible()]
     assert len(err_axes) == len(trq_axes) == len(JOINTS)
     for j, (ea, ta) in enumerate(zip(err_axes, trq_axes)):
-        mrad = ea.get_lines()[0].get_ydata()
-        np.testing.assert_allclose(mrad / 1000.0, record.get("q")[:, j] - record.get("q_ref")[:, j])
-        assert JOINTS[j] in ea.get_ylabel() and "mrad" in ea.get_ylabel()
+        deg = ea.get_lines()[0].get_ydata()
+        np.testing.assert_allclose(np.radians(deg),
+                                   record.get("q")[:, j] - record.get("q_ref")[:, j])
+        assert JOINTS[j] in ea.get_ylabel() and "[deg]" in ea.get_ylabel()
         id_line, sim_line = ta.get_lines()[:2]
         np.testing.assert_array_equal(id_line.get_ydata(), record.get("tau_id")[:, j])
         np.testing.assert_array_equal(sim_line.get_ydata(), record.get("tau")[:, j])
+
+
+@pytest.mark.parametrize("durations", [
+    [1.0, 1.0, 1.0], [10.0, 0.05, 0.05, 0.05, 0.05, 10.0], [0.2] * 40,
+    [30.0, 0.3, 0.2, 1.5, 0.4, 0.1, 54.0, 1.2, 2.5]])
+def test_phase_labels_never_overlap(durations) -> None:
+    """However short the phases, no two phase labels overlap once drawn."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from sim.analysis.plots import shade_phases
+
+    t = np.concatenate([[0.0], np.cumsum(durations)])
+    phases = [{"name": f"phase_{k}_name", "t0": t[k], "t1": t[k + 1]}
+              for k in range(len(durations))]
+    fig = Figure(figsize=(10, 3), dpi=100, layout="constrained")
+    ax = fig.subplots()
+    ax.plot(t, t)
+    texts = shade_phases(ax, phases, label=True)
+    FigureCanvasAgg(fig).draw()
+    boxes = [tx.get_window_extent() for tx in texts]
+    assert texts  # at least the long phases are named
+    for a in range(len(boxes)):
+        for b in range(a + 1, len(boxes)):
+            assert not boxes[a].overlaps(boxes[b]), (texts[a].get_text(), texts[b].get_text())
+        inside = ax.get_window_extent()
+        assert inside.x0 - 1 <= boxes[a].x0 and boxes[a].x1 <= inside.x1 + 1
 
 
 def test_plots_need_their_arrays(run_dir: Path, tmp_path: Path) -> None:

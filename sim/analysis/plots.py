@@ -3,18 +3,18 @@
 :func:`write_plots` writes into ``DIR/plots/``:
 
 * ``joint_<name>.png`` for every joint: position, velocity, acceleration and jerk against
-  time (reference solid; simulated position and velocity dashed), knots marked (dotted
-  verticals and dots on the reference), phases shaded and named; the layout of seed 001,
-  figures 5-9, with the jerk added;
-* ``tool_path.png``: the tool point's path in 3D, reference vs actual, with the seam
-  (samples where ``arc_on``) drawn thick and the knots as dots, and the tool point's position
-  error ``|tcp_pos - tcp_pos_ref|`` (mm) against time;
-* ``tracking_error.png``: ``q - q_ref`` per joint (mrad) against time;
+  time in degrees (reference solid; simulated position and velocity dashed), knots as ticks on
+  the time axis, phases shaded and named without overlap (:func:`shade_phases`); the layout
+  of seed 001, figures 5-9, with the jerk added;
+* ``tool_path.png``: the tool point's path in 3D in mm with equal axes, reference vs actual,
+  with the seam (samples where ``arc_on``) drawn thick, and the tool point's position error
+  ``|tcp_pos - tcp_pos_ref|`` (mm) against time;
+* ``tracking_error.png``: ``q - q_ref`` per joint (deg) against time;
 * ``torques.png``: simulated actuator torque ``tau`` vs inverse dynamics of the reference
   ``tau_id`` per joint (N m) against time.
 
-Units: SI, except where the axis label says otherwise (mrad, mm). Every figure has a fixed
-pixel size (:data:`FIGURE_SIZES` x :data:`DPI`).
+Units: the scenario's (deg, mm), as every axis label says; torques in N m. Every figure has a
+fixed pixel size (:data:`FIGURE_SIZES` x :data:`DPI`).
 """
 
 from __future__ import annotations
@@ -58,19 +58,78 @@ def _figure(kind: str) -> Any:
     return Figure(figsize=FIGURE_SIZES[kind], dpi=DPI, layout="constrained")
 
 
-def _shade_phases(ax: Any, record: RunRecord, label: bool) -> None:
-    for k, phase in enumerate(record.phases):
+#: Font size of the phase labels, pt, and how many rows they may stack in.
+PHASE_LABEL_PT = 7.5
+PHASE_LABEL_ROWS = 3
+
+
+def shade_phases(ax: Any, phases: Any, label: bool) -> list[Any]:
+    """Shade every other phase of ``phases`` (objects or dicts with ``name``, ``t0``, ``t1``)
+    and, when ``label``, name them at the top of the axes without overlap.
+
+    A label goes on the first of :data:`PHASE_LABEL_ROWS` rows where it clears the labels
+    already there (text widths estimated from the font size and the axes' width in pixels);
+    a phase too short for its name on any row gets its number (its position in the cycle,
+    from 1) where that fits, else no label. Returns the label texts.
+    """
+    spans = []
+    for k, p in enumerate(phases):
+        name, t0, t1 = ((p["name"], p["t0"], p["t1"]) if isinstance(p, dict)
+                        else (p.name, p.t0, p.t1))
+        spans.append((k, str(name), float(t0), float(t1)))
         if k % 2:
-            ax.axvspan(phase.t0, phase.t1, color="0.92", zorder=0, lw=0)
-        if label:
-            ax.text(
-                0.5 * (phase.t0 + phase.t1), 1.0, phase.name, transform=ax.get_xaxis_transform(),
-                ha="center", va="bottom", fontsize=8, color="0.3",
-            )
+            ax.axvspan(float(t0), float(t1), color="0.92", zorder=0, lw=0)
+    if not label or not spans:
+        return []
+    lo, hi = spans[0][2], spans[-1][3]
+    ax.set_xlim(lo, hi)
+    fig = ax.get_figure()
+    spec = ax.get_subplotspec()
+    ncols = spec.get_gridspec().ncols if spec is not None else 1
+    width_px = fig.get_size_inches()[0] * fig.dpi * 0.86 / ncols
+    px_per_s = width_px / max(hi - lo, 1e-12)
+    char_px = 0.58 * PHASE_LABEL_PT * fig.dpi / 72.0
+    rows_end = [-np.inf] * PHASE_LABEL_ROWS
+    texts = []
+    for k, name, t0, t1 in spans:
+        centre = 0.5 * (t0 + t1) * px_per_s
+        for text in (name, str(k + 1)):
+            half = 0.5 * len(text) * char_px + 3.0
+            row = next((r for r in range(PHASE_LABEL_ROWS)
+                        if centre - half >= rows_end[r]
+                        and lo * px_per_s <= centre - half + 3 and
+                        centre + half - 3 <= hi * px_per_s), None)
+            if row is None:
+                continue
+            rows_end[row] = centre + half
+            texts.append(ax.text(0.5 * (t0 + t1), 0.985 - 0.075 * row, text,
+                                 transform=ax.get_xaxis_transform(), ha="center", va="top",
+                                 fontsize=PHASE_LABEL_PT, color="0.25", gid="phase-label",
+                                 zorder=5, bbox={"boxstyle": "round,pad=0.15", "fc": "white",
+                                                 "ec": "none", "alpha": 0.75}))
+            break
+    return texts
 
 
-#: Above this many knots (dense Cartesian via points) knots are dots only, no vertical lines.
-MAX_KNOT_LINES = 60
+#: Knot ticks closer than this fraction of the time axis to the previous tick are left out
+#: (Cartesian phases have a via point every sampling period: a band, not ticks).
+KNOT_MIN_SPACING = 1.0 / 80.0
+
+
+def mark_knots(ax: Any, knots: Any) -> None:
+    """Knot times as short ticks on the time axis (not markers on the curves), thinned to at
+    most one per :data:`KNOT_MIN_SPACING` of the axis."""
+    knots = np.sort(np.asarray(knots, dtype=float))
+    if not knots.size:
+        return
+    lo, hi = ax.get_xlim()
+    gap = KNOT_MIN_SPACING * (hi - lo)
+    kept = [knots[0]]
+    for k in knots[1:]:
+        if k - kept[-1] >= gap:
+            kept.append(k)
+    ax.vlines(kept, 0.0, 0.035, transform=ax.get_xaxis_transform(), colors="0.2", lw=0.8,
+              zorder=4)
 
 
 def _knots(record: RunRecord) -> np.ndarray:
@@ -106,29 +165,24 @@ def joint_figure(record: RunRecord, joint: int) -> Any:
     fig = _figure("joint")
     axes = fig.subplots(4, 1, sharex=True)
     rows = (
-        ("q_ref", "q", "position [rad]"),
-        ("qd_ref", "qd", "velocity [rad/s]"),
-        ("qdd_ref", None, "acceleration [rad/s²]"),
-        ("qddd_ref", None, "jerk [rad/s³]"),
+        ("q_ref", "q", "position [deg]"),
+        ("qd_ref", "qd", "velocity [deg/s]"),
+        ("qdd_ref", None, "acceleration [deg/s²]"),
+        ("qddd_ref", None, "jerk [deg/s³]"),
     )
     knots = _knots(record)
     for k, (ax, (ref_key, act_key, label)) in enumerate(zip(axes, rows)):
-        _shade_phases(ax, record, label=k == 0)
-        ref = record.get(ref_key)[:, joint]
+        ref = np.degrees(record.get(ref_key)[:, joint])
         ax.plot(t, ref, color=_REF, lw=1.6, label="reference")
         if act_key and record.has(act_key):
-            ax.plot(t, record.get(act_key)[:, joint], color=_ACT, lw=1.0, ls="--",
+            ax.plot(t, np.degrees(record.get(act_key)[:, joint]), color=_ACT, lw=1.0, ls="--",
                     label="simulated")
-        if 0 < knots.size <= MAX_KNOT_LINES:
-            ax.vlines(knots, 0, 1, transform=ax.get_xaxis_transform(), colors="0.45", lw=0.7,
-                      linestyles=":", zorder=1)
-        if knots.size:
-            ms = 4 if knots.size <= MAX_KNOT_LINES else 1.5
-            ax.plot(knots, np.interp(knots, t, ref), "o", color="k", ms=ms, label="knots")
+        shade_phases(ax, record.phases, label=k == 0)
+        mark_knots(ax, knots)
         ax.set_ylabel(label)
         ax.grid(True, lw=0.3)
-    axes[0].legend(loc="upper right", fontsize=8)
-    axes[-1].set_xlabel("time [s]")
+    axes[1].legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("time [s] (ticks at the bottom: knots)")
     title = record.summary.get("scenario", "")
     fig.suptitle(f"joint {name}" + (f" ({title})" if title else ""))
     return fig
@@ -145,8 +199,8 @@ def tool_path_figure(record: RunRecord) -> Any:
         axes of the error in mm.
     """
     t = record.t
-    ref = record.get("tcp_pos_ref")
-    act = record.get("tcp_pos")
+    ref = 1000.0 * record.get("tcp_pos_ref")
+    act = 1000.0 * record.get("tcp_pos")
     fig = _figure("tool_path")
     ax = fig.add_subplot(1, 2, 1, projection="3d")
     ax.plot(*ref.T, color=_REF, lw=1.6, label="reference")
@@ -158,24 +212,21 @@ def tool_path_figure(record: RunRecord) -> Any:
             ax.plot(*act[a:b].T, color=_BEAD, lw=4.0, alpha=0.8,
                     label="seam (arc on)" if first else None)
             first = False
-    knots = _knots(record)
-    if knots.size:
-        kp = np.stack([np.interp(knots, t, ref[:, i]) for i in range(3)], axis=1)
-        ax.scatter(*kp.T, color="k", s=12, label="knots", depthshade=False)
     lo, hi = np.minimum(ref.min(0), act.min(0)), np.maximum(ref.max(0), act.max(0))
-    centre, half = 0.5 * (lo + hi), max(0.5 * float(np.max(hi - lo)), 1e-3)
+    centre, half = 0.5 * (lo + hi), max(0.5 * float(np.max(hi - lo)), 1.0)
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
     ax.set_zlim(centre[2] - half, centre[2] + half)
     ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_zlabel("z [mm]")
     ax.legend(loc="upper left", fontsize=8)
     ax.set_title("tool point path (world frame)")
     ax2 = fig.add_subplot(1, 2, 2)
-    _shade_phases(ax2, record, label=True)
-    ax2.plot(t, 1000.0 * np.linalg.norm(act - ref, axis=1), color=_ACT, lw=1.2)
+    ax2.plot(t, np.linalg.norm(act - ref, axis=1), color=_ACT, lw=1.2)
+    shade_phases(ax2, record.phases, label=True)
+    mark_knots(ax2, _knots(record))
     ax2.set_xlabel("time [s]")
     ax2.set_ylabel("|tcp - tcp_ref| [mm]")
     ax2.grid(True, lw=0.3)
@@ -184,15 +235,15 @@ def tool_path_figure(record: RunRecord) -> Any:
 
 
 def tracking_error_figure(record: RunRecord) -> Any:
-    """Joint tracking error ``q - q_ref`` (mrad) against time, one axes per joint."""
+    """Joint tracking error ``q - q_ref`` (deg) against time, one axes per joint."""
     t = record.t
-    err = 1000.0 * (record.get("q") - record.get("q_ref"))
+    err = np.degrees(record.get("q") - record.get("q_ref"))
     fig = _figure("tracking_error")
     for j, ax in enumerate(_grid(fig, len(record.joints))):
-        _shade_phases(ax, record, label=j == 0)
         ax.plot(t, err[:, j], color=_ACT, lw=1.0)
+        shade_phases(ax, record.phases, label=j == 0)
         ax.axhline(0.0, color="0.5", lw=0.5)
-        ax.set_ylabel(f"{record.joints[j]} error [mrad]")
+        ax.set_ylabel(f"{record.joints[j]} error [deg]")
         ax.grid(True, lw=0.3)
         if ax.get_subplotspec().is_last_row():
             ax.set_xlabel("time [s]")
@@ -206,9 +257,9 @@ def torque_figure(record: RunRecord) -> Any:
     tau, tau_id = record.get("tau"), record.get("tau_id")
     fig = _figure("torques")
     for j, ax in enumerate(_grid(fig, len(record.joints))):
-        _shade_phases(ax, record, label=j == 0)
         ax.plot(t, tau_id[:, j], color=_ID, lw=1.6, label="inverse dynamics (reference)")
         ax.plot(t, tau[:, j], color=_ACT, lw=0.9, ls="--", label="simulated")
+        shade_phases(ax, record.phases, label=j == 0)
         ax.set_ylabel(f"{record.joints[j]} torque [N m]")
         ax.grid(True, lw=0.3)
         if ax.get_subplotspec().is_last_row():

@@ -197,34 +197,42 @@ _COLORS = {"id": "#1f77b4", "sim": "#d62728"}
 
 
 def chart_torques(result: SizingResult) -> bytes:
-    """PNG: joint torque against time, inverse dynamics and simulation, phases shaded."""
+    """PNG: joint torque against time, inverse dynamics and simulation, phases shaded; each
+    axis scaled to its data, the force range drawn as lines where it is in view and named at
+    the edge where it is not."""
     from matplotlib.figure import Figure
+
+    from sim.analysis.plots import shade_phases
 
     s = result.series
     n = len(result.joints)
     fig = Figure(figsize=(9, 1.9 * n + 0.8), layout="constrained")
     axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
+    phases = [p for p in result.phases if "t0" in p and "t1" in p]
     for k, (ax, j) in enumerate(zip(axes, result.joints)):
-        for i, p in enumerate(result.phases):
-            if "t0" in p and "t1" in p:
-                ax.axvspan(float(p["t0"]), float(p["t1"]), color="0.92" if i % 2 else "0.97", lw=0)
         ax.plot(s["t"], s["tau_id"][:, k], color=_COLORS["id"], lw=1.2, label="inverse dynamics")
         ax.plot(s["t"], s["tau"][:, k], color=_COLORS["sim"], lw=0.8, alpha=0.8, label="simulated")
-        lo, hi = j.torque_range
-        for v in (lo, hi):
-            if np.isfinite(v):
+        data = np.concatenate([s["tau_id"][:, k], s["tau"][:, k]])
+        lo_d, hi_d = float(np.min(data)), float(np.max(data))
+        pad = 0.12 * max(hi_d - lo_d, 1e-3 * max(abs(lo_d), abs(hi_d), 1.0))
+        ax.set_ylim(lo_d - pad, hi_d + pad)
+        y0, y1 = ax.get_ylim()
+        off = []
+        for v in j.torque_range:
+            if not np.isfinite(v):
+                continue
+            if y0 <= v <= y1:
                 ax.axhline(v, color="k", ls="--", lw=0.8)
-        ax.set_ylabel(f"{j.joint} (N m)")
+            else:
+                off.append(f"{v:+.4g}")
+        shade_phases(ax, phases, label=k == 0)
+        ax.set_ylabel(f"{j.joint} (N m)" + (f"\nlimits {' / '.join(off)}\n(off scale)"
+                                            if off else ""), fontsize=9)
         ax.grid(alpha=0.3)
-    if result.phases:
-        for p in result.phases:
-            if "t0" in p and "t1" in p:
-                axes[0].annotate(str(p.get("name", "")),
-                                 ((float(p["t0"]) + float(p["t1"])) / 2, 1.02),
-                                 xycoords=("data", "axes fraction"), ha="center", fontsize=8)
-    axes[0].legend(loc="upper right", fontsize=8)
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=2,
+               fontsize=8)
     axes[-1].set_xlabel("time (s)")
-    fig.suptitle("Joint torques (dashed: force range)", fontsize=10)
+    fig.suptitle("Joint torques (dashed: force range, where in view)", fontsize=10)
     return figure_png(fig)
 
 
@@ -268,10 +276,34 @@ def chart_torque_speed(j: JointSizing, knee_fraction: float = PEAK_KNEE_FRACTION
         ax.set_xlabel("joint speed |qd| (rad/s)")
         ax.set_ylabel("joint torque |tau| (N m)")
         ax.set_title(f"{j.joint}: joint side (no drive data)", fontsize=10)
-    ax.set_xlim(left=0)
-    ax.set_ylim(bottom=0)
+    if j.drive is not None and j.points:  # the operating cloud in view, envelopes clipped
+        speeds = np.concatenate([np.abs(v[0]) for v in j.points.values()])
+        torques = np.concatenate([np.abs(v[1]) for v in j.points.values()]
+                                 + [[j.motor[s].rms_torque for s in j.points]])
+        n_top = 1.15 * max(float(np.max(speeds)), 1.0)
+        t_top = 1.25 * max(float(np.max(torques)), 1e-6)
+        # the envelope's levels come into view when they are near the cloud; farther ones
+        # are named at the edge instead of squashing the cloud into a corner
+        off = []
+        for level, name in ((d.rated_torque, "rated"), (d.peak_torque, "peak")):
+            if level <= 3.0 * t_top / 1.25:
+                t_top = max(t_top, 1.08 * level)
+            else:
+                off.append(f"{name} {level:.3g} N m")
+        if d.max_speed_rpm <= 3.0 * n_top / 1.15:
+            n_top = max(n_top, 1.05 * d.max_speed_rpm)
+        else:
+            off.append(f"max speed {d.max_speed_rpm:.4g} rpm")
+        ax.set_xlim(0, n_top)
+        ax.set_ylim(0, t_top)
+        if off:
+            ax.annotate("off scale: " + ", ".join(off), (0.99, 0.98), xycoords="axes fraction",
+                        ha="right", va="top", fontsize=7, color="0.3")
+    else:
+        ax.set_xlim(left=0)
+        ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+    fig.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="outside lower center", ncol=2)
     return figure_png(fig)
 
 
@@ -373,12 +405,17 @@ def _html_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     for r in rows:
         cls = ' class="fail"' if r[-1] == "FAIL" else ""
         body.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(x)}</td>" for x in r) + "</tr>")
-    return f"<table><thead><tr>{h}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+    return (f'<div class="scroll"><table><thead><tr>{h}</tr></thead>'
+            f"<tbody>{''.join(body)}</tbody></table></div>")
 
 
 _CSS = """
-body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:2em;max-width:1200px;color:#222}
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:2em auto;padding:0 1em;max-width:1200px;color:#222}
+.scroll{overflow-x:auto;-webkit-overflow-scrolling:touch}
 table{border-collapse:collapse;margin:1em 0;font-size:0.85em}
+details{margin:0.4em 0}summary{cursor:pointer;font-weight:600}
+video{max-width:100%;height:auto}
+@media (max-width:700px){body{margin:0.5em auto;font-size:15px}table{font-size:0.78em}th,td{padding:2px 4px}h1{font-size:1.3em}}
 th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}
 th{background:#f0f0f0}td:first-child,th:first-child{text-align:left}
 tr.fail td{background:#fde2e2}
@@ -462,6 +499,48 @@ def selection_html(sel: Any) -> list[str]:
     return out
 
 
+def _value(v: Any) -> str:
+    """A summary value as a person reads it: floats to 4 significant digits."""
+    if isinstance(v, bool) or not isinstance(v, float):
+        return str(v)
+    return _f(v)
+
+
+def summary_html(summary: Mapping[str, Any], result: SizingResult) -> list[str]:
+    """The report's first table: the verdict, then per joint the hardest check and its margin
+    (of every check of the run on that joint: tracking, saturation, limits, sizing)."""
+    esc = html.escape
+    verdict = str(summary.get("verdict", "pass" if result.passed else "fail"))
+    checks = summary.get("checks", [])
+    failed = [c for c in checks if not c["pass"] and c.get("severity", "error") == "error"]
+    warned = [c for c in checks if not c["pass"] and c.get("severity") == "warning"]
+    cls = "verdict" if verdict == "pass" else "verdict fail"
+    head = (f"{verdict.upper()}: {len(checks)} checks, {len(failed)} failed, "
+            f"{len(warned)} warning(s); collisions: {len(summary.get('collisions', []))}; "
+            f"cycle {result.duration:.4g} s")
+    out = ["<h2>Summary</h2>", f'<p class="{cls}">{esc(head)}</p>']
+    rows = []
+    for j in result.joints:
+        mine = [c for c in checks if c.get("joint") == j.joint and c.get("limit")
+                and np.isfinite(c["limit"]) and c["limit"] != 0
+                and c.get("severity", "error") == "error"]
+        if not mine:
+            continue
+
+        def margin(c: Mapping[str, Any]) -> float:
+            lim, val = float(c["limit"]), float(c["value"])
+            return (lim - val) / abs(lim) * 100.0
+
+        hard = min(mine, key=margin)
+        rows.append((j.joint, str(hard["name"]), f"{_f(float(hard['value']), 3)} {hard['unit']}",
+                     f"{_f(float(hard['limit']), 3)} {hard['unit']}", _pct(margin(hard)),
+                     "PASS" if all(c["pass"] for c in mine) else "FAIL"))
+    if rows:
+        out.append(_html_table(("joint", "hardest check", "value", "limit", "margin %",
+                                "verdict"), rows))
+    return out
+
+
 def _run_verdict_html(summary: Mapping[str, Any]) -> list[str]:
     """The run's verdict (every check: tracking, saturation, limits, sizing, collisions)."""
     if "verdict" not in summary:
@@ -502,24 +581,12 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
     esc = html.escape
     title = f"cellsim report: {result.scenario or 'run'}"
     out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+           '<meta name="viewport" content="width=device-width, initial-scale=1">',
            f"<title>{esc(title)}</title><style>{_CSS}</style></head><body>",
            f"<h1>{esc(title)}</h1>"]
-    # Run summary: scalar fields of summary.json.
-    scalars = [(k, v) for k, v in summary.items() if isinstance(v, (str, int, float, bool))]
-    if result.robot and "robot" not in summary:
-        scalars.insert(0, ("robot", result.robot))
-    scalars.append(("cycle duration (s)", f"{result.duration:.4g}"))
-    out.append("<h2>Run</h2>")
-    out.append(_html_table(("field", "value"), [(str(k), str(v)) for k, v in scalars]))
-    if summary.get("joints"):
-        out.append(f"<p>Joints: {esc(', '.join(map(str, summary['joints'])))}</p>")
-    if result.phases:
-        out.append(_html_table(("phase", "kind", "t0 (s)", "t1 (s)"),
-                               [(str(p.get("name", "")), str(p.get("kind", "")),
-                                 _f(float(p.get("t0", np.nan))), _f(float(p.get("t1", np.nan))))
-                                for p in result.phases]))
+    out += summary_html(summary, result)
     if video:
-        out.append(f'<h2>Video</h2><video controls width="720" src="{esc(video)}"></video>'
+        out.append(f'<h2>Video</h2><video controls src="{esc(video)}"></video>'
                    f'<p><a href="{esc(video)}">{esc(video)}</a></p>')
     out += _run_verdict_html(summary)
     cls = "verdict" if result.passed else "verdict fail"
@@ -529,13 +596,30 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
         out += selection_html(selection)
     out.append("<h2>Per joint</h2>")
     out.append(_html_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
-    out.append("<h2>Checks</h2>")
-    out.append(_html_table(_CHECK_HEAD, [r for j in result.joints for r in _checks_cells(j)]))
+    out.append("<h2>Checks, per joint</h2>")
+    for j in result.joints:
+        rows = _checks_cells(j)
+        failed = sum(r[-1] == "FAIL" for r in rows)
+        out.append(f"<details{' open' if failed else ''}><summary>{esc(j.joint)}: "
+                   f"{len(rows)} checks, {failed} failed</summary>")
+        out.append(_html_table(_CHECK_HEAD, rows))
+        out.append("</details>")
     out.append("<h2>Charts</h2>")
     for name, png in charts.items():
         b64 = base64.b64encode(png).decode("ascii")
         out.append(f'<figure><img alt="{esc(name)}" src="data:image/png;base64,{b64}">'
                    f"<figcaption class=\"small\">{esc(name)}</figcaption></figure>")
+    out.append("<h2>Run details</h2>")
+    scalars = [(k, v) for k, v in summary.items() if isinstance(v, (str, int, float, bool))]
+    if result.robot and "robot" not in summary:
+        scalars.insert(0, ("robot", result.robot))
+    scalars.append(("cycle duration (s)", result.duration))
+    out.append(_html_table(("field", "value"), [(str(k), _value(v)) for k, v in scalars]))
+    if result.phases:
+        out.append(_html_table(("phase", "kind", "t0 (s)", "t1 (s)"),
+                               [(str(p.get("name", "")), str(p.get("kind", "")),
+                                 _f(float(p.get("t0", np.nan))), _f(float(p.get("t1", np.nan))))
+                                for p in result.phases]))
     out.append(f'<h2>Conventions</h2><p class="small">{esc(_CONVENTIONS)}</p>')
     srcs = "; ".join(f"{k}: {v}" for k, v in SOURCE_TITLES.items())
     out.append(f'<p class="small">Sources: {esc(srcs)}.</p>')

@@ -128,5 +128,9 @@ def run(args: argparse.Namespace) -> int:
                   f"{c['unit']} against the limit {c['limit']:.4g} {c['unit']}")
     else:
         print(f"  verdict: pass ({len(checks)} checks, {len(warned)} warning(s))")
+    timings = summary.get("timings_s", {})
+    if timings:
+        parts = ", ".join(f"{k} {v:.2g}" if v < 10 else f"{k} {v:.0f}" for k, v in timings.items())
+        print(f"  wall {summary.get('total_wall_s', sum(timings.values())):.1f} s ({parts})")
     print(f"  results in {out}/")
     return 1 if args.strict and summary.get("verdict") == "fail" else 0

@@ -10,9 +10,16 @@
    tracks the reference with the inverse-dynamics feed-forward through the same actuator
    (:mod:`sim.simulation.simulate`);
 4. record the tool-point path and the continuous-time joint torques, compute the summary
-   metrics and the drives' saturation intervals, write the run folder atomically through
-   :mod:`sim.simulation.runfolder` with plots, video and the sizing report, and judge the run
-   (:mod:`sim.analysis.verdict`: ``"checks"`` and ``"verdict"`` in ``summary.json``).
+   metrics, the drives' saturation intervals, collisions and clearance
+   (:mod:`sim.simulation.collisions`);
+5. size the drives (and choose actuators from a catalogue when asked), judge the run
+   (:mod:`sim.analysis.verdict`: ``"checks"`` and ``"verdict"`` in ``summary.json``), draw the
+   plots and the video, and write the run folder atomically through
+   :mod:`sim.simulation.runfolder`.
+
+Each stage is timed and reported (:mod:`sim.pipeline.stages`): a status line on a terminal, one
+line per stage on standard error otherwise; ``summary.json`` holds ``"timings_s"`` per stage and
+``"total_wall_s"``.
 """
 
 from __future__ import annotations
@@ -34,6 +41,7 @@ from sim import __version__
 from sim.analysis.sizing import SizingResult, apply_overrides
 from sim.analysis.verdict import run_checks, verdict, warnings_count
 from sim.errors import InternalError
+from sim.pipeline.stages import Stages
 from sim.scenario import Scenario
 from sim.simulation import runfolder
 from sim.simulation.compile import BuiltCell, build
@@ -117,22 +125,25 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
                                       else default_out_dir(scenario))
     feedforward = (scenario.simulation.feedforward if options.feedforward is None
                    else options.feedforward)
+    stages = Stages(enabled=options.progress)
 
-    built = build(scenario)
-    _check_tcp_consistency(built, scenario)
-    video_args = _video_args(scenario, options)
-    if options.video:  # refuse bad video settings before simulating, not after
-        from sim.render.frames import resolve_cameras, validate_size
+    with stages.stage("build"):
+        built = build(scenario)
+        _check_tcp_consistency(built, scenario)
+        video_args = _video_args(scenario, options)
+        if options.video:  # refuse bad video settings before simulating, not after
+            from sim.render.frames import resolve_cameras, validate_size
 
-        resolve_cameras(built.model, video_args.get("cameras", ("overview",)))
-        validate_size(video_args.get("width", 640), video_args.get("height", 480))
-        fps = video_args.get("fps", 30.0)
-        if not (np.isfinite(fps) and fps > 0):
-            from sim.errors import RenderError
+            resolve_cameras(built.model, video_args.get("cameras", ("overview",)))
+            validate_size(video_args.get("width", 640), video_args.get("height", 480))
+            fps = video_args.get("fps", 30.0)
+            if not (np.isfinite(fps) and fps > 0):
+                from sim.errors import RenderError
 
-            raise RenderError(f"--fps must be a positive number, got {fps!r}")
-    motion = build_motion(scenario, built.context)
-    check_motion_limits(scenario, motion)
+                raise RenderError(f"--fps must be a positive number, got {fps!r}")
+    with stages.stage("plan"):
+        motion = build_motion(scenario, built.context)
+        check_motion_limits(scenario, motion)
 
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
@@ -154,59 +165,69 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
                 failed.rmdir()
             os.replace(tmp, failed)
 
-        drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
-        rec = simulate(built, motion, feedforward=feedforward,
-                       settle_s=scenario.simulation.settle_s, progress=options.progress,
-                       on_failure=keep_failed,
-                       drives=drives if scenario.simulation.motor_speed_limits and drives
-                       else None)
+        with stages.stage("simulate"):
+            drives = apply_overrides(scenario.robot.drives, scenario.drives,
+                                     scenario.robot.joints)
+            rec = simulate(built, motion, feedforward=feedforward,
+                           settle_s=scenario.simulation.settle_s, progress=options.progress,
+                           on_failure=keep_failed,
+                           drives=drives if scenario.simulation.motor_speed_limits and drives
+                           else None)
         arrays = rec.arrays
-        runfolder.write_trajectory(tmp, arrays)
-        runfolder.write_csv(tmp, arrays, scenario.robot.joints)
 
-        summary = make_summary(scenario, built, motion, rec, feedforward)
-        add_collisions(summary, built, motion, arrays)
-        # post-processing reads the record in memory, never the files just written; the
-        # folder only becomes visible (moved into place) once everything succeeded
+        with stages.stage("checks"):
+            summary = make_summary(scenario, built, motion, rec, feedforward)
+            add_collisions(summary, built, motion, arrays)
+        # post-processing reads the record in memory, never the files it writes; the folder
+        # only becomes visible (moved into place) once everything succeeded
         record = runfolder.RunRecord.from_arrays(
             arrays, joints=list(summary["joints"]), phases=summary["phases"],
             model_path=tmp / runfolder.MODEL_XML, summary=summary)
+        with stages.stage("sizing"):
+            sizing = _size(scenario, built, record, summary) if options.sizing else None
+            selected = None
+            if options.selection is not None:
+                from sim.analysis.selection import select_actuators, write_selection
+                from sim.analysis.sizing import joint_armature
+
+                selected = select_actuators(record, built.joint_ids,
+                                            joint_armature(built.model, built.joint_ids),
+                                            options.selection)
+                write_selection(tmp, selected)
+                summary["selection"] = {
+                    "catalog": list(options.selection.catalog.sources),
+                    "all_joints_served": selected.all_served,
+                    "joints": {j.joint: {"motor": j.chosen.motor.id if j.chosen else None,
+                                         "reducer": j.chosen.reducer.id if j.chosen else None}
+                               for j in selected.joints}}
+            checks = run_checks(arrays, summary, scenario.robot,
+                                scenario.simulation.tracking_tolerance_deg, sizing,
+                                clearance_mm=scenario.simulation.clearance_mm,
+                                selection=selected)
+            summary["checks"] = [c.to_dict() for c in checks]
+            summary["verdict"] = verdict(checks)
+            summary["warnings"] = warnings_count(checks)
         if options.plots:
-            from sim.analysis.plots import write_plots
+            with stages.stage("plots"):
+                from sim.analysis.plots import write_plots
 
-            write_plots(record, tmp / runfolder.PLOTS_DIR)
+                write_plots(record, tmp / runfolder.PLOTS_DIR)
         if options.video:
-            from sim.render.video import write_video
+            with stages.stage("video"):
+                from sim.render.video import write_video
 
-            write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
-                        **video_args)
-            summary["video"] = runfolder.VIDEO_MP4
-        sizing = _size(scenario, built, record, summary) if options.sizing else None
-        selected = None
-        if options.selection is not None:
-            from sim.analysis.selection import select_actuators, write_selection
-            from sim.analysis.sizing import joint_armature
+                write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
+                            **video_args)
+                summary["video"] = runfolder.VIDEO_MP4
+        with stages.stage("write"):
+            runfolder.write_trajectory(tmp, arrays)
+            runfolder.write_csv(tmp, arrays, scenario.robot.joints)
+            if sizing is not None:  # last: report.html links the video, shows the verdict
+                from sim.analysis.report import write_sizing
 
-            selected = select_actuators(record, built.joint_ids,
-                                        joint_armature(built.model, built.joint_ids),
-                                        options.selection)
-            write_selection(tmp, selected)
-            summary["selection"] = {
-                "catalog": list(options.selection.catalog.sources),
-                "all_joints_served": selected.all_served,
-                "joints": {j.joint: {"motor": j.chosen.motor.id if j.chosen else None,
-                                     "reducer": j.chosen.reducer.id if j.chosen else None}
-                           for j in selected.joints}}
-        checks = run_checks(arrays, summary, scenario.robot,
-                            scenario.simulation.tracking_tolerance_deg, sizing,
-                            clearance_mm=scenario.simulation.clearance_mm, selection=selected)
-        summary["checks"] = [c.to_dict() for c in checks]
-        summary["verdict"] = verdict(checks)
-        summary["warnings"] = warnings_count(checks)
-        if sizing is not None:  # last: report.html links the video and shows the verdict
-            from sim.analysis.report import write_sizing
-
-            write_sizing(tmp, sizing, summary=summary, selection=selected)
+                write_sizing(tmp, sizing, summary=summary, selection=selected)
+        summary["timings_s"] = dict(stages.timings)
+        summary["total_wall_s"] = stages.total_s
         runfolder.write_summary(tmp, summary)
         runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
     except BaseException:
