@@ -12,6 +12,9 @@ from __future__ import annotations
 import json
 import re
 
+import numpy as np
+import pytest
+
 from sim.cli import main
 from sim.pipeline.stages import STAGES
 
@@ -55,3 +58,48 @@ def test_report_opens_with_the_summary_and_folds_the_checks(tmp_path, capsys):
     cells = re.findall(r"<td>(-?\d+\.\d+)</td>", text)
     assert cells and all(len(c.replace("-", "").replace(".", "").lstrip("0")) <= 4
                          for c in cells), [c for c in cells if len(c) > 8][:5]
+
+
+SHIPPED = sorted(__import__("sim.core.resources", fromlist=["x"]).shipped_scenarios())
+
+
+@pytest.mark.render
+@pytest.mark.parametrize("name", SHIPPED)
+def test_overview_frames_show_the_whole_robot(name, scenario_run):
+    """The first and middle frames of the overview: no pixel of the robot (or its tool) on
+    the image border, and the robot is in the picture."""
+    from sim.render.frames import FrameRenderer
+
+    run_dir, _ = scenario_run(name)
+    with FrameRenderer(run_dir, cameras=("overview",), width=320, height=240,
+                       overlay=False, caption=False) as fr:
+        model = fr.model
+        robot = np.array([model.body(int(b)).name.startswith("robot/")
+                          for b in model.geom_bodyid])
+        for time in (fr.record.t0, fr.record.t0 + 0.5 * fr.record.duration):
+            seg = fr.segment(time)
+            mask = np.zeros(seg.shape, bool)
+            hit = seg >= 0
+            mask[hit] = robot[seg[hit]]
+            assert mask.sum() > 200, (name, time)  # the robot is in the picture
+            border = np.concatenate([mask[0], mask[-1], mask[:, 0], mask[:, -1]])
+            assert not border.any(), (name, time, int(border.sum()))
+
+
+@pytest.mark.render
+@pytest.mark.parametrize("name", ["bugnar_5r_weld_cycle", "lrmate200ic_weld_plate"])
+def test_tool_camera_follows_the_torch(name, scenario_run):
+    """The tool camera keeps the torch's tip in the middle of its image all along the cycle."""
+    from sim.render.frames import FrameRenderer
+
+    run_dir, _ = scenario_run(name)
+    with FrameRenderer(run_dir, cameras=("tool",), width=320, height=240, overlay=False,
+                       caption=False) as fr:
+        model = fr.model
+        tool = np.array([model.body(int(b)).name.startswith("robot/tool/")
+                         for b in model.geom_bodyid])
+        for frac in (0.0, 0.3, 0.6, 0.9):
+            seg = fr.segment(fr.record.t0 + frac * fr.record.duration)
+            centre = seg[100:140, 140:180]
+            hit = centre >= 0
+            assert hit.any() and tool[centre[hit]].any(), (name, frac)

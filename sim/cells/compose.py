@@ -336,6 +336,9 @@ def new_world(name: str, center=(0.0, 0.0, 0.8), extent: float = 3.0) -> mjcf.Ro
     w.visual.headlight.specular = (0.0, 0.0, 0.0)
     w.visual.map.znear = 0.005
     w.visual.map.zfar = 50.0
+    # the haze where the floor meets the sky: the sky's colour at the horizon, not MuJoCo's
+    # default white (a bright line across every frame)
+    w.visual.rgba.haze = (0.25, 0.34, 0.435, 1.0)
     w.statistic.center = center
     w.statistic.extent = extent
     w.asset.add("texture", name="sky", type="skybox", builtin="gradient",

@@ -161,6 +161,11 @@ def build(rig: RobotRig, mount: str) -> Layout:
     cam_az = az - np.deg2rad(35.0)
     tool_cam = [(R + 1.0) * np.cos(cam_az), (R + 1.0) * np.sin(cam_az), zs + 0.45]
     ov_pos = [3.2 + R, -(2.6 + R), zs + 2.2]
+    if mount == "floor":
+        # the arm reaches down behind its column to the far side of the ring: look down at
+        # 55 deg so that it stays in view all round (the video frames the distance itself)
+        horizontal = float(np.hypot(ov_pos[0], ov_pos[1]))
+        ov_pos[2] = zs + 0.3 + horizontal * np.tan(np.deg2rad(55.0))
     cameras = add_cameras(world, rig, ov_pos, [0.0, 0.0, zs + 0.3], tool_cam, tool_fovy=35.0)
     dims = {
         "seam_radius": R, "seam_height": zs, "shell_outer_radius": R + SHELL_WALL,

@@ -138,6 +138,7 @@ class FrameRenderer:
             )
         model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), int(width))
         model.vis.global_.offheight = max(int(model.vis.global_.offheight), int(height))
+        self.views = self._views(model, qpos, width / height)
         self.model = model
         self.data = mujoco.MjData(model)
         self.width, self.height = int(width), int(height)
@@ -156,6 +157,26 @@ class FrameRenderer:
         self.painter = CollisionPainter(model, self.record.summary.get("collisions", ())
                                         if self.record.summary else ())
         self._tiles = [np.empty((self.height, self.width, 3), np.uint8) for _ in self.camera_ids]
+
+    def _views(self, model: Any, qpos: np.ndarray, aspect: float) -> list[Any]:
+        """Per tile: a framed free camera (``overview``, ``tool``: :mod:`sim.render.framing`)
+        or None for a model camera rendered as it is."""
+        import mujoco
+
+        from sim.render.framing import FOVY_DEG, overview_view, tool_view
+
+        views: list[Any] = []
+        tcp = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "robot/tcp")
+        for name, cid in zip(self.cameras, self.camera_ids):
+            if name == "overview":
+                views.append(overview_view(model, qpos, cid, aspect))
+            elif name == "tool" and tcp >= 0:
+                views.append(tool_view(model, qpos, cid, tcp))
+            else:
+                views.append(None)
+        if any(v is not None for v in views):
+            model.vis.global_.fovy = FOVY_DEG
+        return views
 
     # -- life cycle ---------------------------------------------------------------------
     def close(self) -> None:
@@ -213,6 +234,28 @@ class FrameRenderer:
         """Caption text of the frame at ``time`` (see :func:`~sim.render.overlay.caption_text`)."""
         return caption_text(self.record, time)
 
+    def segment(self, time: float, tile: int = 0) -> np.ndarray:
+        """Geom id seen at every pixel of one tile at ``time`` (-1: nothing), (H, W): the
+        same view as :meth:`render`, without overlays (tests check what the frame shows)."""
+        if self._renderer is None:
+            raise RenderError("segment() called after close()")
+        self.set_state(time)
+        r = self._renderer
+        view = self.views[tile]
+        if view is None:
+            r.update_scene(self.data, self.camera_ids[tile])
+        else:
+            if view.track_site is not None:
+                view.lookat = self.data.site_xpos[view.track_site].copy()
+            r.update_scene(self.data, view.camera())
+        r.enable_segmentation_rendering()
+        try:
+            seg = r.render()
+        finally:
+            r.disable_segmentation_rendering()
+        ids, types = seg[..., 0], seg[..., 1]
+        return np.where(types == self._mj.mjtObj.mjOBJ_GEOM, ids, -1)
+
     def render(
         self, time: float, out: np.ndarray | None = None, *, caption: bool | None = None
     ) -> np.ndarray:
@@ -235,7 +278,13 @@ class FrameRenderer:
         r = self._renderer
         single = len(self.camera_ids) == 1
         for k, cid in enumerate(self.camera_ids):
-            r.update_scene(self.data, cid)
+            view = self.views[k]
+            if view is None:
+                r.update_scene(self.data, cid)
+            else:
+                if view.track_site is not None:
+                    view.lookat = self.data.site_xpos[view.track_site].copy()
+                r.update_scene(self.data, view.camera())
             self.painter.paint(r.scene, time)
             if self.overlay is not None:
                 self.overlay.add_to_scene(r.scene, time, self.height, self._geoms)
