@@ -435,16 +435,18 @@ def collision_rows(summary: Mapping[str, Any]) -> tuple[list[list[str]], list[li
     def mm(v: Any) -> str:
         return f"> {CLEARANCE_RANGE_MM:g}" if v is None else f"{v:.1f}"
 
-    clear = [[str(c["phase"]), mm(c.get("tool_mm")),
-              " / ".join(c.get("tool_pair", ())) or "-", mm(c.get("arm_mm")),
-              " / ".join(c.get("arm_pair", ())) or "-"] for c in summary.get("clearance", ())]
+    def pair(c: Mapping[str, Any], grp: str) -> str:
+        return " / ".join(c.get(f"{grp}_bodies", c.get(f"{grp}_pair", ()))) or "-"
+
+    clear = [[str(c["phase"]), mm(c.get("tool_mm")), pair(c, "tool"), mm(c.get("arm_mm")),
+              pair(c, "arm")] for c in summary.get("clearance", ())]
     return coll, clear
 
 
 #: Clearance is measured up to this distance, mm.
 CLEARANCE_RANGE_MM = 1e3 * CLEARANCE_RANGE_M
 _COLL_HEAD = ("phase", "t (s)", "kind", "bodies", "worst geoms", "depth (mm)")
-_CLEAR_HEAD = ("phase", "tool (mm)", "tool closest pair", "arm (mm)", "arm closest pair")
+_CLEAR_HEAD = ("phase", "tool (mm)", "tool closest to", "arm (mm)", "arm closest to")
 
 
 def selection_html(sel: Any) -> list[str]:

@@ -662,7 +662,8 @@ def clearance(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[
     """Per phase: the tool's and the arm's smallest distance to the cell (module docstring).
 
     Each entry: ``phase``, ``tool_mm`` and ``arm_mm`` (null beyond :data:`CLEARANCE_RANGE_M`),
-    with the ``tool_pair``/``arm_pair`` (geom names) and ``tool_t``/``arm_t`` where they occur.
+    with the ``tool_pair``/``arm_pair`` (geom names), ``tool_bodies``/``arm_bodies`` (the robot
+    body, tool body, cell object or part of each) and ``tool_t``/``arm_t`` where they occur.
     Allowed contacts (and the tool near the part it picks, in the same windows) are left out.
     The coarse scan is refined at every sample around each dip of the distance (a coarse sample
     closer than both neighbours, plateaus counted once) that could hide a value below the
@@ -711,6 +712,7 @@ def clearance(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[
                 a, b = _ordered(cm, int(both.g1[r]), int(both.g2[r]))
                 entry[f"{grp}_mm"] = max(0.0, float(both.dist[r] * 1e3))
                 entry[f"{grp}_pair"] = [cm.geoms[a].name, cm.geoms[b].name]
+                entry[f"{grp}_bodies"] = [cm.geoms[a].owner, cm.geoms[b].owner]
                 entry[f"{grp}_t"] = float(samples.t[both.s[r]])
             else:
                 entry[f"{grp}_mm"] = None
