@@ -18,6 +18,8 @@ is per joint:
   value 0 when there is none;
 * ``clearance`` (a *warning*): per phase, the smaller of the tool's and the arm's clearance to
   the cell, mm, against the scenario's ``simulation.clearance_mm``;
+* ``cartesian_speed``: per Cartesian phase, how far the reference tool point's cruise speed is
+  from the set speed, %, against 1 % (a phase sampled too coarsely for its move misses it);
 * ``selection`` (when actuators were chosen from a catalogue, :mod:`sim.analysis.selection`):
   per joint, the chosen pair's smallest margin, %; fails when no pair serves the joint.
 
@@ -91,6 +93,11 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                 checks.append(RunCheck(c.key, j.joint, float(c.used), float(c.limit), c.unit,
                                        bool(c.passed)))
     checks += motion_checks(summary, clearance_mm)
+    for c in summary.get("cartesian_speed", ()):
+        dev = abs(float(c["deviation_pct"]))
+        checks.append(RunCheck("cartesian_speed", "", dev, 1.0, "% off the set speed",
+                               dev <= 1.0, subject=f"{c['phase']}: {c['cruise_mm_s']:.4g} mm/s "
+                               f"for {c['set_mm_s']:.4g} mm/s"))
     if selection is not None:
         for j in selection.joints:
             pair = j.chosen or j.closest

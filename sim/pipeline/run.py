@@ -40,13 +40,13 @@ from numpy.typing import NDArray
 from sim import __version__
 from sim.analysis.sizing import SizingResult, apply_overrides
 from sim.analysis.verdict import run_checks, verdict, warnings_count
-from sim.errors import InternalError
+from sim.errors import InternalError, RunFolderError
 from sim.pipeline.stages import Stages
 from sim.scenario import Scenario
 from sim.simulation import runfolder
 from sim.simulation.compile import BuiltCell, build
 from sim.simulation.metrics import make_summary
-from sim.simulation.motion import build_motion, check_motion_limits
+from sim.simulation.motion import build_motion, check_motion_limits, check_size
 from sim.simulation.simulate import simulate
 
 
@@ -144,104 +144,114 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
     with stages.stage("plan"):
         motion = build_motion(scenario, built.context)
         check_motion_limits(scenario, motion)
+        check_size(scenario, motion, float(built.model.opt.timestep))
 
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
     try:
-        runfolder.write_marker(tmp)
-        runfolder.write_text(tmp, runfolder.MODEL_XML, built.xml)
-        runfolder.write_text(tmp, runfolder.SCENARIO_TOML, scenario.text)
-        runfolder.write_text(tmp, runfolder.MANIFEST_JSON,
-                             json.dumps(manifest(scenario), indent=1) + "\n")
+        out_dir.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise RunFolderError(f"{out_dir.parent}: cannot create the run folder's parent: "
+                             f"{exc.strerror or exc}") from None
+    # one writer per place: a second run into it refuses; what a killed run left goes
+    with runfolder.RunLock(out_dir):
+        runfolder.remove_stale(out_dir)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+        try:
+            runfolder.write_marker(tmp, state="writing")
+            runfolder.write_text(tmp, runfolder.MODEL_XML, built.xml)
+            runfolder.write_text(tmp, runfolder.SCENARIO_TOML, scenario.text)
+            runfolder.write_text(tmp, runfolder.MANIFEST_JSON,
+                                 json.dumps(manifest(scenario), indent=1) + "\n")
 
-        def keep_failed(partial: dict[str, NDArray[Any]], message: str) -> None:
-            runfolder.write_trajectory(tmp, partial)
-            runfolder.write_text(tmp, runfolder.ERROR_TXT, message + "\n")
-            failed = runfolder.failed_folder(out_dir)
-            if runfolder.is_run_folder(failed):
-                shutil.rmtree(failed)
-            elif failed.exists() or failed.is_symlink():  # not ours: never replaced
-                failed = Path(tempfile.mkdtemp(prefix=failed.name + "-", dir=out_dir.parent))
-                failed.rmdir()
-            os.replace(tmp, failed)
+            def keep_failed(partial: dict[str, NDArray[Any]], message: str) -> None:
+                runfolder.write_marker(tmp, state="failed")
+                runfolder.write_trajectory(tmp, partial)
+                runfolder.write_text(tmp, runfolder.ERROR_TXT, message + "\n")
+                failed = runfolder.failed_folder(out_dir)
+                if runfolder.is_run_folder(failed):
+                    shutil.rmtree(failed)
+                elif failed.exists() or failed.is_symlink():  # not ours: never replaced
+                    failed = Path(tempfile.mkdtemp(prefix=failed.name + "-", dir=out_dir.parent))
+                    failed.rmdir()
+                os.replace(tmp, failed)
 
-        with stages.stage("simulate"):
-            drives = apply_overrides(scenario.robot.drives, scenario.drives,
-                                     scenario.robot.joints)
-            rec = simulate(built, motion, feedforward=feedforward,
-                           settle_s=scenario.simulation.settle_s, progress=options.progress,
-                           on_failure=keep_failed,
-                           drives=drives if scenario.simulation.motor_speed_limits and drives
-                           else None)
-        arrays = rec.arrays
+            with stages.stage("simulate"):
+                drives = apply_overrides(scenario.robot.drives, scenario.drives,
+                                         scenario.robot.joints)
+                rec = simulate(built, motion, feedforward=feedforward,
+                               settle_s=scenario.simulation.settle_s, progress=options.progress,
+                               on_failure=keep_failed,
+                               drives=drives if scenario.simulation.motor_speed_limits and drives
+                               else None)
+            arrays = rec.arrays
 
-        with stages.stage("checks"):
-            summary = make_summary(scenario, built, motion, rec, feedforward)
-            add_collisions(summary, built, motion, arrays)
-        # post-processing reads the record in memory, never the files it writes; the folder
-        # only becomes visible (moved into place) once everything succeeded
-        record = runfolder.RunRecord.from_arrays(
-            arrays, joints=list(summary["joints"]), phases=summary["phases"],
-            model_path=tmp / runfolder.MODEL_XML, summary=summary)
-        with stages.stage("sizing"):
-            sizing = _size(scenario, built, record, summary) if options.sizing else None
-            selected = None
-            if options.selection is not None:
-                from sim.analysis.selection import select_actuators, write_selection
-                from sim.analysis.sizing import joint_armature
+            with stages.stage("checks"):
+                summary = make_summary(scenario, built, motion, rec, feedforward)
+                add_collisions(summary, built, motion, arrays)
+            # post-processing reads the record in memory, never the files it writes; the folder
+            # only becomes visible (moved into place) once everything succeeded
+            record = runfolder.RunRecord.from_arrays(
+                arrays, joints=list(summary["joints"]), phases=summary["phases"],
+                model_path=tmp / runfolder.MODEL_XML, summary=summary)
+            with stages.stage("sizing"):
+                sizing = _size(scenario, built, record, summary) if options.sizing else None
+                selected = None
+                if options.selection is not None:
+                    from sim.analysis.selection import select_actuators, write_selection
+                    from sim.analysis.sizing import joint_armature
 
-                selected = select_actuators(record, built.joint_ids,
-                                            joint_armature(built.model, built.joint_ids),
-                                            options.selection)
-                write_selection(tmp, selected)
-                summary["selection"] = {
-                    "catalog": list(options.selection.catalog.sources),
-                    "all_joints_served": selected.all_served,
-                    "joints": {j.joint: {"motor": j.chosen.motor.id if j.chosen else None,
-                                         "reducer": j.chosen.reducer.id if j.chosen else None}
-                               for j in selected.joints}}
-            checks = run_checks(arrays, summary, scenario.robot,
-                                scenario.simulation.tracking_tolerance_deg, sizing,
-                                clearance_mm=scenario.simulation.clearance_mm,
-                                selection=selected)
-            summary["checks"] = [c.to_dict() for c in checks]
-            summary["verdict"] = verdict(checks)
-            summary["warnings"] = warnings_count(checks)
-        if options.plots:
-            with stages.stage("plots"):
-                from sim.analysis.plots import write_plots
+                    selected = select_actuators(record, built.joint_ids,
+                                                joint_armature(built.model, built.joint_ids),
+                                                options.selection)
+                    write_selection(tmp, selected)
+                    summary["selection"] = {
+                        "catalog": list(options.selection.catalog.sources),
+                        "all_joints_served": selected.all_served,
+                        "joints": {j.joint: {"motor": j.chosen.motor.id if j.chosen else None,
+                                             "reducer": j.chosen.reducer.id if j.chosen else None}
+                                   for j in selected.joints}}
+                checks = run_checks(arrays, summary, scenario.robot,
+                                    scenario.simulation.tracking_tolerance_deg, sizing,
+                                    clearance_mm=scenario.simulation.clearance_mm,
+                                    selection=selected)
+                summary["checks"] = [c.to_dict() for c in checks]
+                summary["verdict"] = verdict(checks)
+                summary["warnings"] = warnings_count(checks)
+            if options.plots:
+                with stages.stage("plots"):
+                    from sim.analysis.plots import write_plots
 
-                write_plots(record, tmp / runfolder.PLOTS_DIR)
-        if options.video:
-            with stages.stage("video"):
-                from sim.render.video import write_video
+                    write_plots(record, tmp / runfolder.PLOTS_DIR)
+            if options.video:
+                with stages.stage("video"):
+                    from sim.render.video import write_video
 
-                write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
-                            **video_args)
-                summary["video"] = runfolder.VIDEO_MP4
-        with stages.stage("write"):
-            runfolder.write_trajectory(tmp, arrays)
-            runfolder.write_csv(tmp, arrays, scenario.robot.joints)
-            if sizing is not None:  # last: report.html links the video, shows the verdict
-                from sim.analysis.report import write_sizing
+                    write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
+                                **video_args)
+                    summary["video"] = runfolder.VIDEO_MP4
+            with stages.stage("write"):
+                runfolder.write_trajectory(tmp, arrays)
+                runfolder.write_csv(tmp, arrays, scenario.robot.joints)
+                if sizing is not None:  # last: report.html links the video, shows the verdict
+                    from sim.analysis.report import write_sizing
 
-                write_sizing(tmp, sizing, summary=summary, selection=selected)
-        summary["timings_s"] = dict(stages.timings)
-        summary["total_wall_s"] = stages.total_s
-        runfolder.write_summary(tmp, summary)
-        runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
-    except BaseException:
-        if tmp.exists():
-            shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    if out_dir.exists():
-        trash = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.", dir=out_dir.parent))
-        os.replace(out_dir, trash / "old")
-        shutil.rmtree(trash, ignore_errors=True)
-    os.replace(tmp, out_dir)
-    stale = runfolder.failed_folder(out_dir)
-    if runfolder.is_run_folder(stale):
-        shutil.rmtree(stale, ignore_errors=True)
+                    write_sizing(tmp, sizing, summary=summary, selection=selected)
+            summary["timings_s"] = dict(stages.timings)
+            summary["total_wall_s"] = stages.total_s
+            runfolder.write_summary(tmp, summary)
+            runfolder.write_marker(tmp, state="complete")
+            runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
+        except BaseException:
+            if tmp.exists():
+                shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        if out_dir.exists():
+            trash = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.", dir=out_dir.parent))
+            os.replace(out_dir, trash / "old")
+            shutil.rmtree(trash, ignore_errors=True)
+        os.replace(tmp, out_dir)
+        stale = runfolder.failed_folder(out_dir)
+        if runfolder.is_run_folder(stale):
+            shutil.rmtree(stale, ignore_errors=True)
     return summary
 
 

@@ -67,6 +67,11 @@ def _number(token: str, field: str) -> float:
     return value
 
 
+#: Most values one sweep option may list, and most variants of a sweep.
+MAX_SWEEP_VALUES = 10_000
+MAX_SWEEP_VARIANTS = 10_000
+
+
 def parse_float_list(text: str, field: str = "value") -> list[float]:
     """Numbers from a command-line list: ``"0,2.5,5"`` or an inclusive range ``"0:10:2.5"``
     (items may mix: ``"0,1:3:1"``). Duplicates are dropped, the order kept.
@@ -97,9 +102,12 @@ def parse_float_list(text: str, field: str = "value") -> list[float]:
                 raise SweepError(f"{field}: range {item!r} needs a positive step")
             if b < a:
                 raise SweepError(f"{field}: range {item!r} has stop < start")
-            count = int(math.floor((b - a) / step + 1e-9)) + 1
-            if count > 10_000:
-                raise SweepError(f"{field}: range {item!r} has {count} values (at most 10000)")
+            span = (b - a) / step  # inf for a huge range or a tiny step: refused, not allocated
+            if not math.isfinite(span) or span + 1 > MAX_SWEEP_VALUES:
+                shown = "more than 1e308" if not math.isfinite(span) else f"{int(span) + 1}"
+                raise SweepError(f"{field}: range {item!r} has {shown} values (at most "
+                                 f"{MAX_SWEEP_VALUES})")
+            count = int(math.floor(span + 1e-9)) + 1
             out.extend(round(a + k * step, 12) for k in range(count))
         else:
             out.append(_number(item, field))

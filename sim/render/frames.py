@@ -215,7 +215,11 @@ class FrameRenderer:
         """
         if not np.isfinite(fps) or fps <= 0:
             raise RenderError(f"fps must be a positive number, got {fps!r}")
-        n = int(np.floor(self.record.duration * fps + 1e-9)) + 1
+        count = self.record.duration * fps
+        if not np.isfinite(count) or count + 1 > MAX_FRAMES:
+            raise RenderError(f"--fps {fps:g} over the run's {self.record.duration:.4g} s gives "
+                              f"{count + 1:.3g} frames, more than {MAX_FRAMES:,}: lower --fps")
+        n = int(np.floor(count + 1e-9)) + 1
         return self.record.t0 + np.arange(n) / float(fps)
 
     def set_state(self, time: float) -> None:
@@ -297,6 +301,9 @@ class FrameRenderer:
             draw_caption(out, self.caption_at(time))
         return out
 
+
+#: Most frames of one video (an hour at 30 fps).
+MAX_FRAMES = 108_000
 
 #: Colour of the geoms that collide, while they touch (RGBA).
 COLLISION_RGBA = (1.0, 0.08, 0.05, 1.0)

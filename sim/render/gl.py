@@ -114,7 +114,7 @@ def probe_backend(name: str) -> ProbeResult:
     env["PYOPENGL_PLATFORM"] = key
     try:
         proc = subprocess.run(
-            [sys.executable, "-c", _PROBE_CODE],
+            [sys.executable, "-I", "-c", _PROBE_CODE],  # isolated: no planted modules
             env=env,
             capture_output=True,
             text=True,

@@ -244,6 +244,39 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     return motion
 
 
+#: Most inverse-kinematics samples of one Cartesian phase.
+MAX_PHASE_SAMPLES = 1_000_000
+#: Most physics steps of one run (about 1 KB recorded per step: 2 GB).
+MAX_STEPS = 2_000_000
+
+
+def check_size(scenario: Scenario, motion: Motion, timestep: float) -> int:
+    """The number of physics steps a run of ``motion`` takes, if it is within
+    :data:`MAX_STEPS` and no phase is shorter than one timestep.
+
+    Raises:
+        ScenarioError: A phase shorter than the timestep; or the count (cycle plus
+            ``simulation.settle_s`` over the timestep) and the limit, naming the keys that set
+            it.
+    """
+    for k, pm in enumerate(motion.phases):
+        if pm.t1 - pm.t0 < timestep:
+            raise ScenarioError(f"{scenario.source.name}: phases[{k}] ({pm.name}) lasts "
+                                f"{pm.t1 - pm.t0:.3g} s, shorter than one timestep "
+                                f"({timestep:g} s, simulation.timestep_s): the drives could not "
+                                "follow it; make it longer or drop it")
+    total = motion.duration + scenario.simulation.settle_s
+    steps = total / timestep if timestep > 0 else float("inf")
+    if not np.isfinite(steps) or steps > MAX_STEPS:
+        raise ScenarioError(
+            f"{scenario.source.name}: the cycle lasts {motion.duration:.4g} s plus "
+            f"simulation.settle_s {scenario.simulation.settle_s:g} s; at a timestep of "
+            f"{timestep:g} s (simulation.timestep_s) that is {steps:.3g} steps, more than "
+            f"{MAX_STEPS:,}: shorten the phases (durations_s, time_s, speed_mm_s) or the "
+            "settling, or raise the timestep")
+    return int(np.ceil(steps))
+
+
 def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
                      accel: bool = True) -> list[str]:
     """One line per joint limit the reference motion exceeds (position range from the MJCF,
@@ -424,7 +457,14 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     except PlannerError as exc:
         raise ScenarioError(f"{label}: {exc}") from None
 
-    n = max(2, int(np.ceil(cart.duration / phase.sample_period - 1e-9)))
+    count = cart.duration / phase.sample_period
+    if not np.isfinite(count) or count > MAX_PHASE_SAMPLES:
+        raise ScenarioError(
+            f"{label}: the move lasts {cart.duration:.4g} s; sampled every "
+            f"{phase.sample_period:.4g} s (sample_period_s) that is "
+            f"{count:.3g} inverse-kinematics samples, more than {MAX_PHASE_SAMPLES:,} "
+            "(raise speed_mm_s or sample_period_s)")
+    n = max(2, int(np.ceil(count - 1e-9)))
     ts = np.linspace(0.0, cart.duration, n + 1)
     st = cart.at(ts)
     poses = np.zeros((n + 1, 4, 4))

@@ -350,6 +350,10 @@ def load_run(run_dir: str | Path) -> RunRecord:
         raise RunFolderError(
             f"{where} does not exist or is not a folder (give the folder `cellsim run` wrote)"
         )
+    if marker_state(folder) == "writing":
+        raise RunFolderError(f"{where} is a run that was still being written (a killed or "
+                             "running `cellsim run`), not a result; the next run into that "
+                             "place removes it")
     missing = [n for n in (MODEL_XML, TRAJECTORY_NPZ) if not (folder / n).is_file()]
     if missing:
         raise RunFolderError(
@@ -413,12 +417,105 @@ def is_run_folder(path: str | Path) -> bool:
     return isinstance(manifest, dict) and {"cellsim", "scenario_sha256"} <= manifest.keys()
 
 
-def write_marker(folder: str | Path) -> Path:
-    """Write the :data:`MARKER` file that makes ``folder`` cellsim's."""
+def write_marker(folder: str | Path, state: str = "complete") -> Path:
+    """Write the :data:`MARKER` file that makes ``folder`` cellsim's.
+
+    ``state`` is ``"writing"`` while the runner fills its hidden temporary folder and
+    ``"complete"`` once it is whole (just before it is moved into place): a folder left
+    ``"writing"`` by a killed run is never read as a result (:func:`load_run`) and is removed
+    by the next run into the same place (:func:`remove_stale`).
+    """
+    import os
+
     from sim import __version__
 
     return write_text(folder, MARKER, json.dumps({"written_by": "cellsim",
-                                                  "cellsim": __version__}) + "\n")
+                                                  "cellsim": __version__, "state": state,
+                                                  "pid": os.getpid()}) + "\n")
+
+
+def marker_state(folder: str | Path) -> str | None:
+    """The marker's ``state`` (``"writing"``, ``"complete"``), None without a marker; a marker
+    of cellsim 0.2 without a state counts as complete."""
+    try:
+        doc = json.loads((Path(folder) / MARKER).read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return None
+    return str(doc.get("state", "complete")) if isinstance(doc, dict) else None
+
+
+class RunLock:
+    """An exclusive lock on a run folder's place: ``.<name>.lock`` next to it, holding the
+    writer's pid, taken with ``flock`` (released by the kernel when the process dies, so a
+    killed run never leaves the place locked).
+
+    Raises:
+        RunFolderError: Another process holds it; the message names its pid.
+    """
+
+    def __init__(self, out_dir: Path) -> None:
+        self.path = out_dir.with_name(f".{out_dir.name}.lock")
+        self.out_dir = out_dir
+        self._fd: int | None = None
+
+    def __enter__(self) -> RunLock:
+        import fcntl
+        import os
+
+        try:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
+        except OSError as exc:
+            raise RunFolderError(f"{self.path}: cannot create the run's lock file: "
+                                 f"{exc.strerror or exc}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            try:
+                other = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
+            finally:
+                os.close(fd)
+            raise RunFolderError(f"run folder {str(self.out_dir)!r} is being written by another "
+                                 f"cellsim run (pid {other}); wait for it or choose another "
+                                 "--out") from None
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        self._fd = fd
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        import os
+
+        if self._fd is not None:
+            try:
+                self.path.unlink(missing_ok=True)
+            except OSError:
+                pass
+            os.close(self._fd)
+            self._fd = None
+
+
+def remove_stale(out_dir: Path) -> list[Path]:
+    """Remove what killed runs into ``out_dir`` left next to it: hidden temporary folders
+    (``.<name>.XXXX``) and trash folders (``.<name>.old.XXXX``) that cellsim wrote. Call it
+    holding the place's :class:`RunLock`: no live run can own them then. Returns what went."""
+    import re
+    import shutil
+
+    gone = []
+    parent = out_dir.parent
+    if not parent.is_dir():
+        return gone
+    # tempfile.mkdtemp's names: the prefix and 8 characters of [a-z0-9_]
+    pattern = re.compile(rf"^\.{re.escape(out_dir.name)}\.(old\.)?[a-z0-9_]{{8}}$")
+    for entry in parent.iterdir():
+        m = pattern.match(entry.name)
+        if not m or entry.is_symlink() or not entry.is_dir():
+            continue
+        if (m.group(1) is None and is_run_folder(entry)) or (
+                m.group(1) is not None and all(is_run_folder(c) for c in entry.iterdir())):
+            shutil.rmtree(entry, ignore_errors=True)
+            gone.append(entry)
+    return gone
 
 
 def check_out_dir(requested: str | Path) -> Path:
@@ -435,6 +532,22 @@ def check_out_dir(requested: str | Path) -> Path:
     if raw.name in ("", ".", ".."):
         raise RunFolderError(f"run folder {str(requested)!r}: give a folder name, not "
                              f"{str(requested)!r} (cellsim replaces the whole folder)")
+    if len(raw.name.encode()) > MAX_NAME_BYTES:
+        raise RunFolderError(f"run folder {str(requested)[:60]!r}...: the name is too long "
+                             f"({len(raw.name.encode())} bytes; at most {MAX_NAME_BYTES}, room "
+                             "for the hidden temporary folder next to it)")
+    try:
+        return _check_out_dir(raw)
+    except OSError as exc:
+        raise RunFolderError(f"run folder {str(raw)!r}: {exc.strerror or exc}") from None
+
+
+#: Longest run-folder name, bytes: file systems allow 255, and the runner's hidden temporary
+#: folder ``.<name>.old.XXXXXXXX`` next to it needs 14 more.
+MAX_NAME_BYTES = 240
+
+
+def _check_out_dir(raw: Path) -> Path:
     if raw.is_symlink():
         raise RunFolderError(f"run folder {str(raw)!r} is a symbolic link; cellsim writes only "
                              "into a real folder (choose another --out)")

@@ -1,0 +1,238 @@
+"""Faults (issue 18): a killed run, two runs into one folder, a parent that is a file, a name
+too long. Nothing is lost, nothing half-written is taken for a result, every refusal is one
+line with exit 2.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from sim.cli import main
+from sim.errors import RunFolderError
+from sim.simulation.runfolder import MARKER, is_run_folder, load_run, marker_state
+
+SLOW = "bugnar_5r_weld_cycle"  # ~15 s without video or plots: time to interrupt it
+QUICK = "bugnar_5r_phase1"
+
+
+def _start(out: Path, scenario: str = SLOW) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-I", "-m", "sim", "run", scenario, "--out",
+                             str(out), "--no-video", "--no-plots", "--quiet"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            cwd=Path(__file__).resolve().parents[1])
+
+
+def _hidden(out: Path) -> list[Path]:
+    return sorted(p for p in out.parent.iterdir() if p.name.startswith(f".{out.name}."))
+
+
+def _wait_for(cond, timeout: float = 60.0) -> None:
+    end = time.monotonic() + timeout
+    while not cond():
+        if time.monotonic() > end:
+            raise AssertionError("timed out")
+        time.sleep(0.05)
+
+
+@pytest.mark.slow
+def test_sigkill_mid_run_leaves_nothing_taken_for_a_result(tmp_path, capsys):
+    out = tmp_path / "run"
+    proc = _start(out)
+    # the hidden temporary folder appears with the model: the simulation is under way
+    _wait_for(lambda: any((p / "model.xml").is_file() for p in _hidden(out) if p.is_dir()))
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=30)
+    left = [p for p in _hidden(out) if p.is_dir()]
+    assert left and all(marker_state(p) == "writing" for p in left)
+    assert not out.exists()
+    for p in left:  # a killed run's folder is never read as a result
+        with pytest.raises(RunFolderError, match="still being written"):
+            load_run(p)
+    # the next run into the same place removes the leftovers and writes a complete result
+    assert main(["run", QUICK, "--out", str(out), "--no-video", "--no-plots", "--quiet"]) == 0
+    assert _hidden(out) == []
+    assert is_run_folder(out) and marker_state(out) == "complete"
+    assert load_run(out).t.size > 0
+
+
+@pytest.mark.slow
+def test_a_second_run_into_a_busy_folder_refuses_cleanly(tmp_path, capsys):
+    out = tmp_path / "run"
+    first = _start(out)
+    lock = out.with_name(f".{out.name}.lock")
+    _wait_for(lambda: lock.is_file() and lock.read_text().strip() == str(first.pid))
+    rc = main(["run", QUICK, "--out", str(out), "--no-video", "--no-plots", "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert f"being written by another cellsim run (pid {first.pid})" in err
+    assert err.count("\n") == 1
+    assert first.wait(timeout=300) == 0  # the first run is untouched and completes
+    summary = load_run(out).summary
+    assert summary["scenario"] == SLOW
+    assert _hidden(out) == []  # its lock is gone too
+
+
+def test_parent_that_is_a_file_and_a_name_too_long_are_one_line(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("mine")
+    assert main(["run", QUICK, "--out", str(blocker / "run"), "--no-video", "--no-plots",
+                 "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(blocker) in err
+    assert blocker.read_text() == "mine"
+    long = tmp_path / ("x" * 300)
+    assert main(["run", QUICK, "--out", str(long), "--no-video", "--no-plots", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "too long" in err.lower(), err
+    assert not any(p.name.startswith(".x") for p in tmp_path.iterdir())
+
+
+def test_marker_says_complete_only_at_the_end(tmp_path):
+    out = tmp_path / "run"
+    assert main(["run", QUICK, "--out", str(out), "--no-video", "--no-plots", "--quiet"]) == 0
+    assert (out / MARKER).is_file() and marker_state(out) == "complete"
+    assert not out.with_name(f".{out.name}.lock").exists()
+
+
+def test_remove_stale_leaves_other_folders_alone(tmp_path):
+    """Only this place's leftovers go: not another run's (``a.b`` next to ``a``), not a user's
+    hidden folder that looks alike but was not written by cellsim."""
+    from sim.simulation.runfolder import remove_stale, write_marker
+
+    mine = tmp_path / ".a.abcd1234"
+    mine.mkdir()
+    write_marker(mine, state="writing")
+    other = tmp_path / ".a.b.abcd1234"
+    other.mkdir()
+    write_marker(other, state="writing")
+    user = tmp_path / ".a.zzzz9999"
+    user.mkdir()
+    (user / "notes.txt").write_text("mine")
+    gone = remove_stale(tmp_path / "a")
+    assert gone == [mine] and other.is_dir() and (user / "notes.txt").is_file()
+
+
+
+def test_a_planted_mujoco_py_in_the_working_directory_is_never_run(tmp_path, monkeypatch):
+    """The OpenGL probe's helper process runs isolated (``python -I``): a ``mujoco.py`` in the
+    working directory is not imported by it."""
+    import sim.render.gl as gl
+
+    flag = tmp_path / "planted-ran"
+    (tmp_path / "mujoco.py").write_text(f"open({str(flag)!r}, 'w').write('x')\n"
+                                        "raise SystemExit(3)\n")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(gl, "_probe_cache", {})
+    for backend in ("egl", "osmesa"):
+        gl.probe_backend(backend)
+    assert not flag.exists()
+
+
+@pytest.mark.parametrize("edit, words", [
+    (("speed_mm_s = 8.0", "speed_mm_s = 1e-9", 1), ["inverse-kinematics samples", "1,000,000"]),
+    (("[video]", "[simulation]\ntimestep_s = 1e-9\n\n[video]", 1), ["steps", "2,000,000",
+                                                                    "simulation.timestep_s"]),
+    (("[video]", "[simulation]\nsettle_s = 1e9\n\n[video]", 1), ["settle_s", "2,000,000"]),
+])
+def test_sizes_are_bounded_before_anything_is_allocated(tmp_path, capsys, edit, words):
+    """A speed of 1e-9 mm/s, a 1e-9 s timestep or 1e9 s of settling: one line naming the key,
+    the count it would give and the limit, exit 2, in well under a second of work."""
+    from sim.core.resources import shipped_scenarios
+
+    text = Path(shipped_scenarios()["lrmate200ic_weld_plate"]).read_text()
+    old, new, n = edit
+    assert old in text
+    path = tmp_path / "s.toml"
+    path.write_text(text.replace(old, new, n))
+    start = time.monotonic()
+    rc = main(["run", str(path), "--out", str(tmp_path / "run"), "--no-video", "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1, err
+    assert all(w in err for w in words), err
+    assert time.monotonic() - start < 20.0
+    assert not (tmp_path / "run").exists()
+
+
+def test_sweep_ranges_are_bounded(capsys):
+    rc = main(["size", "lrmate200ic_pick_place", "--payload", "0:1e308:1e-300", "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--payload" in err and "at most 10000" in err and err.count("\n") == 1
+
+
+@pytest.mark.render
+def test_frame_counts_are_bounded(tmp_path, capsys):
+    """`cellsim render --fps 1e7`: one line naming --fps, the count and the limit; no hang."""
+    import sim.render.gl as gl
+    from sim.render.synthetic import write_synthetic_run
+
+    gl.configure_gl()
+    run = write_synthetic_run(tmp_path / "run", duration=2.0)
+    start = time.monotonic()
+    rc = main(["render", str(run), "--fps", "1e7", "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--fps" in err and "108,000" in err and err.count("\n") == 1, err
+    assert time.monotonic() - start < 20.0
+
+
+COARSE = """name = "coarse"
+description = "a linear move sampled too coarsely for its length"
+robot = "lrmate200ic5l"
+cell = "weld_table"
+tool = "mig_torch"
+
+[[phases]]
+name = "start"
+planner = "434"
+time_s = [0.0, 0.5, 1.0]
+joints_deg = [[0, 0, 0, 0, -90, 0], [0, 0, 0, 0, -90, 0], [0, 0, 0, 0, -90, 0]]
+
+[[phases]]
+name = "above"
+planner = "434"
+durations_s = [1.5]
+to_mm = [330.0, 120.0, -60.0]
+euler_zyx_deg = [0.0, 0.0, 180.0]
+
+[[phases]]
+name = "across"
+kind = "linear"
+to_mm = [330.0, 220.0, -60.0]
+speed_mm_s = 100.0
+sample_period_s = {period}
+"""
+
+
+@pytest.mark.parametrize("period, passes", [(0.4, False), (0.01, True)])
+def test_a_cartesian_phase_that_misses_its_speed_fails_the_verdict(tmp_path, period, passes):
+    """100 mm at 100 mm/s sampled every 0.4 s: the joint interpolation between so few samples
+    runs the tool 7.8 % fast, a failed check; sampled every 10 ms it keeps the speed."""
+    from sim.pipeline.run import RunOptions, run_scenario
+    from sim.scenario import load_scenario
+
+    path = tmp_path / "coarse.toml"
+    path.write_text(COARSE.format(period=period))
+    summary = run_scenario(load_scenario(path), RunOptions(
+        out_dir=tmp_path / "run", video=False, plots=False, sizing=False, progress=False))
+    (check,) = [c for c in summary["checks"] if c["name"] == "cartesian_speed"]
+    assert check["pass"] is passes and (check["value"] > 1.0) is not passes
+    assert (summary["verdict"] == "pass") is passes
+
+
+def test_a_phase_shorter_than_the_timestep_is_a_user_error(tmp_path, capsys):
+    path = tmp_path / "short.toml"
+    path.write_text(COARSE.format(period=0.01) + """
+[[phases]]
+name = "blink"
+kind = "hold"
+duration_s = 0.0004
+""")
+    rc = main(["run", str(path), "--out", str(tmp_path / "run"), "--no-video", "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "phases[3] (blink)" in err and "shorter than one timestep" in err
