@@ -236,3 +236,77 @@ duration_s = 0.0004
     rc = main(["run", str(path), "--out", str(tmp_path / "run"), "--no-video", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and "phases[3] (blink)" in err and "shorter than one timestep" in err
+
+
+def test_a_full_disk_is_one_line_and_the_previous_result_stays(tmp_path, capsys, monkeypatch):
+    """ENOSPC while the run writes its files (simulated where the run writes trajectory.npz):
+    one line with the path, exit 2, the previous result in the folder untouched and no hidden
+    leftovers."""
+    import errno
+
+    import sim.simulation.runfolder as rf
+
+    out = tmp_path / "run"
+    assert main(["run", QUICK, "--out", str(out), "--no-video", "--no-plots", "--quiet"]) == 0
+    before = (out / "summary.json").read_bytes()
+
+    def full(folder, arrays):
+        raise OSError(errno.ENOSPC, "No space left on device", str(Path(folder) / "trajectory.npz"))
+
+    monkeypatch.setattr(rf, "write_trajectory", full)
+    rc = main(["run", QUICK, "--out", str(out), "--no-video", "--no-plots", "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and "No space left on device" in err
+    assert "trajectory.npz" in err
+    assert (out / "summary.json").read_bytes() == before
+    assert _hidden(out) == []
+
+
+def _finished_run(tmp_path) -> Path:
+    out = tmp_path / "run"
+    assert main(["run", QUICK, "--out", str(out), "--no-video", "--no-plots", "--quiet"]) == 0
+    return out
+
+
+@pytest.mark.parametrize("attack, words", [
+    ("include", "includes"),
+    ("mesh", "outside the run folder"),
+    ("meshdir", "outside the run folder"),
+])
+def test_render_loads_only_files_inside_the_folder(tmp_path, capsys, attack, words):
+    """A model.xml that would read a file elsewhere on disk is refused before MuJoCo opens
+    anything."""
+    out = _finished_run(tmp_path)
+    xml = (out / "model.xml").read_text()
+    secret = tmp_path / "secret.stl"
+    secret.write_bytes(b"solid x\nendsolid x\n")
+    if attack == "include":
+        xml = xml.replace("<worldbody>", f'<include file="{tmp_path / "other.xml"}"/>\n'
+                          "<worldbody>", 1)
+    elif attack == "mesh":
+        xml = xml.replace("<asset>", f'<asset>\n<mesh name="evil" file="{secret}"/>', 1)
+    else:
+        xml = xml.replace("<compiler", '<compiler meshdir="../.."', 1)
+    (out / "model.xml").write_text(xml)
+    rc = main(["render", str(out), "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and words in err and err.count("\n") == 1, err
+
+
+def test_render_refuses_nan_arrays_and_a_plots_symlink(tmp_path, capsys):
+    import numpy as np
+
+    out = _finished_run(tmp_path)
+    arrays = dict(np.load(out / "trajectory.npz"))
+    arrays["qpos"][5, 0] = np.nan
+    np.savez(out / "trajectory.npz", **arrays)
+    rc = main(["render", str(out), "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "'qpos' holds NaN or inf" in err
+    out2 = _finished_run(tmp_path / "b")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (out2 / "plots").symlink_to(elsewhere)
+    rc = main(["render", str(out2), "--plots", "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "symbolic link" in err and list(elsewhere.iterdir()) == []

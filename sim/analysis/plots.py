@@ -294,6 +294,11 @@ def write_plots(run: str | Path | RunRecord, out_dir: str | Path | None = None) 
             raise UsageError("out_dir is required for a run that was not read from a folder")
         out_dir = record.source / PLOTS_DIR
     out = Path(out_dir)
+    if out.is_symlink():
+        from sim.errors import RunFolderError
+
+        raise RunFolderError(f"{out}: is a symbolic link; cellsim writes plots only into a real "
+                             "folder (remove the link)")
     out.mkdir(parents=True, exist_ok=True)
     jobs: list[tuple[str, Any]] = [
         (f"joint_{re.sub(r'[^A-Za-z0-9_.-]', '_', name)}.png", lambda j=j: joint_figure(record, j))

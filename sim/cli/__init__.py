@@ -47,6 +47,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except CellsimError as exc:
         print(f"cellsim: error: {exc}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print("cellsim: error: out of memory (a size the input asks for is too large)",
+              file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("cellsim: interrupted", file=sys.stderr)
         return 130
@@ -55,6 +59,29 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as exc:
+        message = io_error(exc)
+        if message is None:
+            raise
+        print(f"cellsim: error: {message}", file=sys.stderr)
+        return 2
+
+
+#: Operating-system errors that are the place's, not cellsim's: reported as one line with the
+#: path (the run folder's previous result is left as it was: runs write to a hidden sibling).
+_IO_ERRNOS = ("ENOSPC", "EDQUOT", "EACCES", "EPERM", "EROFS", "ENAMETOOLONG", "ENOTDIR",
+              "EISDIR", "EMFILE", "EFBIG", "EIO")
+
+
+def io_error(exc: OSError) -> str | None:
+    """One line for a disk or permission error (``None`` for other OS errors)."""
+    import errno
+
+    codes = {getattr(errno, name) for name in _IO_ERRNOS if hasattr(errno, name)}
+    if exc.errno not in codes:
+        return None
+    where = exc.filename if exc.filename is not None else "(a file cellsim was writing)"
+    return f"{where}: {exc.strerror or exc}"
 
 
 if __name__ == "__main__":

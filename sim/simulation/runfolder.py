@@ -233,6 +233,7 @@ class RunRecord:
                 return mujoco.MjModel.from_xml_string(self.model_xml)
             if self.model_path is None:
                 raise RunFolderError(f"{self.where}: no model (model.xml) to render")
+            confine_model_files(self.model_path, self.where)
             return mujoco.MjModel.from_xml_path(str(self.model_path))
         except ValueError as exc:
             first = str(exc).strip().splitlines()[0] if str(exc).strip() else repr(exc)
@@ -293,6 +294,11 @@ class RunRecord:
             )
         n = t.size
         for name, value in self.arrays.items():
+            if value.dtype.kind not in "fiub":
+                raise RunFolderError(f"{self.where}: trajectory.npz {name!r} has dtype "
+                                     f"{value.dtype}, expected numbers")
+            if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+                raise RunFolderError(f"{self.where}: trajectory.npz {name!r} holds NaN or inf")
             if name in ("knot_t",):
                 continue
             if value.shape[:1] != (n,):
@@ -314,6 +320,43 @@ class RunRecord:
                     f"{self.where}: trajectory.npz {name!r} has shape {self.arrays[name].shape}, "
                     "expected (N, 3)"
                 )
+
+
+def confine_model_files(model_path: Path, where: str) -> None:
+    """Refuse a ``model.xml`` that would read files outside its folder: ``<include>``, an
+    absolute or ``..`` file name (meshes, textures, height fields, skins), or an asset
+    directory pointing elsewhere.
+
+    Raises:
+        RunFolderError: The first such reference, named.
+    """
+    import xml.etree.ElementTree as ET
+
+    folder = model_path.resolve().parent
+    try:
+        root = ET.parse(model_path).getroot()
+    except (ET.ParseError, OSError) as exc:
+        raise RunFolderError(f"{where}: model.xml is not valid XML ({exc})") from None
+    dirs = {"": folder}
+    for comp in root.iter("compiler"):
+        for key in ("assetdir", "meshdir", "texturedir"):
+            if key in comp.attrib:
+                dirs[key] = (folder / comp.attrib[key]).resolve()
+    for el in root.iter():
+        if el.tag == "include":
+            raise RunFolderError(f"{where}: model.xml includes {el.attrib.get('file', '?')!r}; "
+                                 "a run folder's model is self-contained")
+        for key in ("file", "fileright", "fileleft", "fileup", "filedown", "filefront",
+                    "fileback"):
+            if key in el.attrib:
+                base = dirs.get("meshdir" if el.tag == "mesh" else "texturedir", folder)
+                path = (base / el.attrib[key]).resolve()
+                if folder not in path.parents:
+                    raise RunFolderError(f"{where}: model.xml reads {el.attrib[key]!r}, outside "
+                                         "the run folder")
+    for key, d in dirs.items():
+        if key and d != folder and folder not in d.parents:
+            raise RunFolderError(f"{where}: model.xml's {key} points outside the run folder")
 
 
 def _phase(item: Phase | Mapping[str, Any], where: str) -> Phase:
