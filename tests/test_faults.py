@@ -310,3 +310,21 @@ def test_render_refuses_nan_arrays_and_a_plots_symlink(tmp_path, capsys):
     rc = main(["render", str(out2), "--plots", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and "symbolic link" in err and list(elsewhere.iterdir()) == []
+
+
+@pytest.mark.parametrize("time_s", [-1.0, 1e9])
+def test_actions_outside_the_cycle_are_refused(tmp_path, capsys, time_s):
+    path = tmp_path / "a.toml"
+    path.write_text(COARSE.format(period=0.01).replace(
+        'tool = "mig_torch"', f'tool = "mig_torch"\n\n[[actions]]\naction = "arc_on"\n'
+                              f"time_s = {time_s}", 1))
+    rc = main(["check", str(path)])
+    err = capsys.readouterr().err
+    assert rc == 2 and "actions[0].time_s" in err and "outside the cycle" in err, err
+
+
+def test_workspace_out_that_is_a_folder_is_one_line(tmp_path, capsys):
+    (tmp_path / "pic.png").mkdir()
+    rc = main(["workspace", "lrmate100ib", "--out", str(tmp_path / "pic.png")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "is a folder" in err and err.count("\n") == 1

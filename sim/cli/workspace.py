@@ -42,6 +42,9 @@ def run(args: argparse.Namespace) -> int:
         raise CellsimError(f"--out must name a .png file, got {str(out)!r}")
     if not out.parent.is_dir():
         raise CellsimError(f"--out: folder {str(out.parent)!r} does not exist")
+    if out.is_dir() or out.is_symlink():
+        raise CellsimError(f"--out: {str(out)!r} is a folder or a symbolic link; name a new "
+                           ".png file")
     model = kinematic_model(spec)
     reach = plot_workspace(model, out, title=f"{spec.title} ({spec.name}) workspace")
     ranges = "joint ranges from the model" if model.lower is not None else \

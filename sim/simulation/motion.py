@@ -338,9 +338,12 @@ def _check_phase_continuity(prev: PhaseMotion, pm: PhaseMotion, label: str,
 def _resolve_actions(scenario: Scenario, motion: Motion) -> list[tuple[float, str]]:
     by_name = {pm.name: pm for pm in motion.phases}
     out = []
-    for a in scenario.actions:
+    for k, a in enumerate(scenario.actions):
         if a.time is not None:
             time = a.time
+            if not (motion.t0 <= time <= motion.t1):
+                raise ScenarioError(f"{scenario.source.name}: actions[{k}].time_s: {time:g} s is "
+                                    f"outside the cycle ({motion.t0:g} to {motion.t1:.6g} s)")
         else:
             pm = by_name[a.phase]
             time = pm.t0 if a.at == "start" else pm.t1
