@@ -328,3 +328,46 @@ def test_workspace_out_that_is_a_folder_is_one_line(tmp_path, capsys):
     rc = main(["workspace", "lrmate100ib", "--out", str(tmp_path / "pic.png")])
     err = capsys.readouterr().err
     assert rc == 2 and "is a folder" in err and err.count("\n") == 1
+
+
+@pytest.mark.slow
+@pytest.mark.render
+def test_sigkill_mid_video_then_rerun(tmp_path, capsys):
+    """Killed while encoding the video (its stage lines on stderr say when): the next run
+    into the place completes, video included, with no leftovers."""
+    import select
+
+    out = tmp_path / "run"
+    proc = subprocess.Popen([sys.executable, "-I", "-m", "sim", "run", QUICK, "--out", str(out),
+                             "--no-plots", "--width", "160", "--height", "120"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=Path(__file__).resolve().parents[1])
+    seen = ""
+    end = time.monotonic() + 120
+    while "cellsim: sizing" not in seen:  # the next stage is the video
+        assert time.monotonic() < end and proc.poll() is None, seen
+        ready, _, _ = select.select([proc.stderr], [], [], 1.0)
+        if ready:
+            seen += proc.stderr.readline()
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=30)
+    assert not out.exists() and [p for p in _hidden(out) if p.is_dir()]
+    assert main(["run", QUICK, "--out", str(out), "--no-plots", "--quiet", "--width", "160",
+                 "--height", "120"]) == 0
+    assert (out / "video.mp4").stat().st_size > 0 and _hidden(out) == []
+
+
+@pytest.mark.parametrize("target", ["trajectory.npz", "summary.json", "model.xml"])
+def test_render_of_a_damaged_folder_is_one_line(tmp_path, capsys, target):
+    """Bytes overwritten in the middle of a run's file: `cellsim render` says which file is
+    damaged, exit 2, no traceback."""
+    out = _finished_run(tmp_path)
+    path = out / target
+    data = bytearray(path.read_bytes())
+    mid = len(data) // 2
+    data[mid:mid + 64] = b"\x00\xff" * 32
+    path.write_bytes(bytes(data))
+    rc = main(["render", str(out), "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "Traceback" not in err and err.count("\n") == 1, err
