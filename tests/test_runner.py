@@ -29,7 +29,7 @@ def _run(name_or_scenario, out: Path, **kw) -> dict:
 @pytest.fixture(scope="module")
 def kacso_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("runs") / "kacso"
-    return out, _run("kacso_lrmate100ib_sequence1", out)
+    return out, _run("kacso_lrmate100ib_sequence1", out, csv=True)
 
 
 def test_run_folder_contents(kacso_run):
@@ -263,3 +263,27 @@ joints_deg = [[0,10,-20,0,45,0],[0,20,-40,0,60,0]]
     sing = s["singularity"]
     assert sing["phase"] == "through" and sing["t"] == pytest.approx(0.5, abs=0.011)
     assert sing["min_abs_wrist"] < 1e-3 and sing["min_sigma"] < 1e-3
+
+
+def test_csv_only_when_asked_and_record_hz_thins_the_saved_arrays(tmp_path):
+    """Without ``csv`` no trajectory.csv; ``simulation.record_hz = 100`` keeps every 10th
+    step of the 1 kHz record (and the last), while the summary's figures come from every
+    step: the same as a full-rate run's."""
+    import dataclasses
+
+    from sim.scenario import load_scenario
+    from sim.simulation.runfolder import load_run
+
+    sc = load_scenario("bugnar_5r_phase1")
+    full = _run(sc, tmp_path / "full")
+    thin_sc = dataclasses.replace(sc, simulation=sc.simulation.model_copy(
+        update={"record_hz": 100.0}))
+    thin = _run(thin_sc, tmp_path / "thin")
+    assert not (tmp_path / "full" / "trajectory.csv").exists()
+    n_full = load_run(tmp_path / "full").t.size
+    rec = load_run(tmp_path / "thin")
+    assert rec.t.size == (n_full - 1) // 10 + 1 + (0 if (n_full - 1) % 10 == 0 else 1)
+    assert thin["record_hz"] == pytest.approx(100.0)
+    assert full["record_hz"] == pytest.approx(1000.0)
+    assert thin["max_tracking_error_deg"] == full["max_tracking_error_deg"]
+    assert thin["verdict"] == full["verdict"]

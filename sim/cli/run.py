@@ -1,7 +1,8 @@
 """``cellsim run SCENARIO``: simulate a scenario and write its run folder.
 
-The folder (default ``runs/<scenario name>/``) holds ``summary.json``, ``trajectory.npz`` and
-``trajectory.csv``, ``model.xml`` (the compiled cell exactly as simulated), ``scenario.toml``,
+The folder (default ``runs/<scenario name>/``) holds ``summary.json``, ``trajectory.npz`` (at
+``simulation.record_hz``, default every step; ``trajectory.csv`` too with ``--csv``),
+``model.xml`` (the compiled cell exactly as simulated), ``scenario.toml``,
 ``manifest.json``, the actuator-sizing report (``sizing.csv``/``.json``/``.md``,
 ``report.html``), ``plots/`` and ``video.mp4``. It is written atomically: a failed run leaves
 no ``summary.json``; a run that fails mid-simulation keeps what it recorded in
@@ -34,6 +35,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="run folder (default: runs/<scenario name>)")
     p.add_argument("--no-video", action="store_true", help="do not render video.mp4")
     p.add_argument("--no-plots", action="store_true", help="do not write plots/*.png")
+    p.add_argument("--csv", action="store_true",
+                   help="also write trajectory.csv (large: about 0.5 MB per second of cycle)")
     p.add_argument("--no-feedforward", action="store_true",
                    help="position actuators alone (no inverse-dynamics torque feed-forward)")
     p.add_argument("--gl", choices=("egl", "osmesa"),
@@ -79,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
                     "cameras": tuple(args.camera) if args.camera else None, "gl": args.gl},
         progress=not args.quiet,
         selection=selection,
+        csv=args.csv,
     )
     summary = run_scenario(scenario, options)
     out = (args.out or default_out_dir(scenario))

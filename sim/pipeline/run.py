@@ -63,6 +63,8 @@ class RunOptions:
         plots: Write ``plots/*.png``.
         sizing: Write the actuator-sizing report.
         progress: Show progress bars (they are silent anyway when stderr is not a terminal).
+        csv: Also write ``trajectory.csv`` (the main arrays as columns; large: about 0.5 MB
+            per second of cycle at 1 kHz).
         selection: Choose a motor and a reducer per joint from a catalogue
             (:mod:`sim.analysis.selection`; ``selection.json``/``.csv``, a report section and a
             ``selection`` check per joint), or None.
@@ -76,6 +78,7 @@ class RunOptions:
     sizing: bool = True
     progress: bool = True
     selection: Any = None
+    csv: bool = False
 
 
 # --------------------------------------------------------------------------------------------
@@ -229,8 +232,12 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
                                 **video_args)
                     summary["video"] = runfolder.VIDEO_MP4
             with stages.stage("write"):
-                runfolder.write_trajectory(tmp, arrays)
-                runfolder.write_csv(tmp, arrays, scenario.robot.joints)
+                saved = runfolder.decimate(arrays, built.model.opt.timestep,
+                                           scenario.simulation.record_hz)
+                summary["record_hz"] = runfolder.sample_rate(saved["t"])
+                runfolder.write_trajectory(tmp, saved)
+                if options.csv:
+                    runfolder.write_csv(tmp, saved, scenario.robot.joints)
                 if sizing is not None:  # last: report.html links the video, shows the verdict
                     from sim.analysis.report import write_sizing
 

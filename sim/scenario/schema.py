@@ -143,6 +143,7 @@ class SimulationSpec(_Strict):
     timestep_s: float | None = Field(None, gt=0, le=0.01)
     feedforward: bool = True
     settle_s: float = Field(0.0, ge=0)
+    record_hz: float | None = Field(None, gt=0, le=1e6)
     enforce_speed_limits: bool = True
     enforce_accel_limits: bool = True
     motor_speed_limits: bool = True

@@ -629,6 +629,32 @@ def write_trajectory(folder: str | Path, arrays: Mapping[str, np.ndarray]) -> Pa
     return path
 
 
+def decimate(arrays: Mapping[str, np.ndarray], timestep: float, record_hz: float | None
+             ) -> dict[str, np.ndarray]:
+    """The recorded arrays kept at ``record_hz`` (every k-th sample, k = round(1 / (timestep
+    record_hz)) >= 1, the last sample always kept); all of them when ``record_hz`` is None.
+    Checks, sizing, plots and video of a run use every sample; this is what ``trajectory.npz``
+    keeps."""
+    out = dict(arrays)
+    if record_hz is None:
+        return out
+    n = len(arrays["t"])
+    k = max(1, int(round(1.0 / (timestep * record_hz))))
+    if k == 1:
+        return out
+    keep = np.unique(np.append(np.arange(0, n, k), n - 1))
+    for name, value in arrays.items():
+        if name != "knot_t" and np.ndim(value) >= 1 and len(value) == n:
+            out[name] = np.asarray(value)[keep]
+    return out
+
+
+def sample_rate(t: np.ndarray) -> float:
+    """The median sampling rate of a time array, Hz."""
+    dt = np.diff(np.asarray(t, float))
+    return float(1.0 / np.median(dt)) if dt.size else 0.0
+
+
 #: Joint arrays written to ``trajectory.csv`` (one column per joint: ``q_ref_j1``, ...).
 CSV_JOINT_ARRAYS: tuple[str, ...] = ("q_ref", "qd_ref", "qdd_ref", "q", "qd", "tau", "tau_id")
 
