@@ -204,7 +204,9 @@ def _answer(argv: list[str], capsys) -> int:
 @settings(max_examples=60, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(path=st.sampled_from(LEAVES), value=HOSTILE, unknown=st.booleans())
-def test_every_scenario_key_with_hostile_values(tmp_path, capsys, path, value, unknown):
+def test_every_scenario_key_with_hostile_values(tmp_path, capsys, monkeypatch, path, value,
+                                                unknown):
+    monkeypatch.chdir(tmp_path)
     doc = tomllib.loads(BASE)
     _set(doc, path, value)
     if unknown:  # a misspelt key beside it
@@ -246,7 +248,8 @@ VALUES = st.sampled_from(["nan", "inf", "-inf", "1e308", "-1", "0", "1e-300", ""
 @given(command=st.sampled_from(["list", "plan", "ik", "workspace", "check", "run", "size",
                                 "render"]),
        extra=st.lists(st.tuples(st.sampled_from(FLAGS), VALUES), max_size=3))
-def test_every_command_with_hostile_arguments(tmp_path, capsys, command, extra):
+def test_every_command_with_hostile_arguments(tmp_path, capsys, monkeypatch, command, extra):
+    monkeypatch.chdir(tmp_path)  # relative --out values land here, never in the checkout
     base = tmp_path / "s.toml"
     base.write_text(BASE)
     values = [x for flag, value in extra for x in ((flag,) if flag in ("--select", "--strict",

@@ -371,3 +371,16 @@ def test_render_of_a_damaged_folder_is_one_line(tmp_path, capsys, target):
     rc = main(["render", str(out), "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and "Traceback" not in err and err.count("\n") == 1, err
+
+
+def test_a_sweep_never_writes_into_the_working_directory_or_a_users_folder(tmp_path, capsys,
+                                                                            monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "sweep.csv").write_text("my data")
+    for out in (".", "mine"):
+        rc = main(["size", QUICK, "--out", out, "--workers", "1", "--quiet"])
+        err = capsys.readouterr().err
+        assert rc == 2 and err.count("\n") == 1, (out, err)
+    assert (tmp_path / "mine" / "sweep.csv").read_text() == "my data"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine"]

@@ -334,6 +334,11 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
     """
     if not callable(runner):
         raise SweepError(f"runner: {runner!r} is not callable")
+    from sim.simulation import runfolder
+
+    # the sweep folder is cellsim's, like a run folder: never the working directory, a file,
+    # a symbolic link or a user's folder (its marker lets a later sweep reuse it)
+    out_dir = runfolder.check_out_dir(out_dir)
     variants = make_variants(base_scenario, payloads, speed_scales, out_dir)
     if workers is None:
         workers = os.cpu_count() or 1
@@ -343,7 +348,12 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
     if mp_context not in multiprocessing.get_all_start_methods():
         raise SweepError(f"mp_context: unknown start method {mp_context!r}; known: "
                          f"{', '.join(multiprocessing.get_all_start_methods())}")
-    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    try:
+        Path(out_dir).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SweepError(f"{out_dir}: cannot create the sweep folder: {exc.strerror or exc}"
+                         ) from None
+    runfolder.write_marker(out_dir)
 
     from tqdm import tqdm
 
