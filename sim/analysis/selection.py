@@ -318,7 +318,7 @@ def motor_torque(src: _Source, motor: Motor, reducer: Reducer) -> NDArray[np.flo
 
 def _pair_values(src: _Source, motor: Motor, reducer: Reducer, opts: SelectionOptions,
                  cycle_s: float) -> dict[str, float]:
-    r, m = reducer.spec, motor.spec
+    r = reducer.spec
     c = _coeffs(motor, reducer)
     duty = cycle_s + opts.dwell_s
     tau_dwell = src.tau_l_last / (r.ratio * r.efficiency)
@@ -331,7 +331,6 @@ def _pair_values(src: _Source, motor: Motor, reducer: Reducer, opts: SelectionOp
         life = r.rated_life_h * (r.rated_torque_nm / t_av) ** 3 * (r.rated_input_speed_rpm / n_av)
     else:
         life = math.inf
-    del m
     return {"rms": rms, "peak": peak, "speed": speed, "life": life, "tau_l_max": src.tau_l_max}
 
 

@@ -134,7 +134,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  verdict: pass ({len(checks)} checks, {len(warned)} warning(s))")
     timings = summary.get("timings_s", {})
     if timings:
-        parts = ", ".join(f"{k} {v:.2g}" if v < 10 else f"{k} {v:.0f}" for k, v in timings.items())
-        print(f"  wall {summary.get('total_wall_s', sum(timings.values())):.1f} s ({parts})")
+        from sim.pipeline.stages import timings_line
+
+        print("  " + timings_line(timings, summary.get("total_wall_s", sum(timings.values()))))
     print(f"  results in {out}/")
     return 1 if args.strict and summary.get("verdict") == "fail" else 0

@@ -66,8 +66,9 @@ class Stages:
         """Wall time since the stages started, s."""
         return time.perf_counter() - self._start
 
-    def line(self) -> str:
-        """``wall 12.3 s (build 0.4, plan 0.5, simulate 1.4, ...)``."""
-        parts = ", ".join(f"{k} {v:.2g}" if v < 10 else f"{k} {v:.0f}"
-                          for k, v in self.timings.items())
-        return f"wall {self.total_s:.1f} s ({parts})"
+
+
+def timings_line(timings: dict[str, float], total_s: float) -> str:
+    """``wall 12.3 s (build 0.4, plan 0.5, simulate 1.4, ...)``: a run's closing line."""
+    parts = ", ".join(f"{k} {v:.2g}" if v < 10 else f"{k} {v:.0f}" for k, v in timings.items())
+    return f"wall {total_s:.1f} s ({parts})"

@@ -238,6 +238,17 @@ class FrameRenderer:
         """Caption text of the frame at ``time`` (see :func:`~sim.render.overlay.caption_text`)."""
         return caption_text(self.record, time)
 
+    def _update_scene(self, tile: int) -> None:
+        """The renderer's scene for one tile at the current state: its model camera, or its
+        framed free camera (the tool camera re-aimed at the tool point)."""
+        view = self.views[tile]
+        if view is None:
+            self._renderer.update_scene(self.data, self.camera_ids[tile])
+            return
+        if view.track_site is not None:
+            view.lookat = self.data.site_xpos[view.track_site].copy()
+        self._renderer.update_scene(self.data, view.camera())
+
     def segment(self, time: float, tile: int = 0) -> np.ndarray:
         """Geom id seen at every pixel of one tile at ``time`` (-1: nothing), (H, W): the
         same view as :meth:`render`, without overlays (tests check what the frame shows)."""
@@ -245,13 +256,7 @@ class FrameRenderer:
             raise RenderError("segment() called after close()")
         self.set_state(time)
         r = self._renderer
-        view = self.views[tile]
-        if view is None:
-            r.update_scene(self.data, self.camera_ids[tile])
-        else:
-            if view.track_site is not None:
-                view.lookat = self.data.site_xpos[view.track_site].copy()
-            r.update_scene(self.data, view.camera())
+        self._update_scene(tile)
         r.enable_segmentation_rendering()
         try:
             seg = r.render()
@@ -281,14 +286,8 @@ class FrameRenderer:
             out = np.empty(self.frame_shape, np.uint8)
         r = self._renderer
         single = len(self.camera_ids) == 1
-        for k, cid in enumerate(self.camera_ids):
-            view = self.views[k]
-            if view is None:
-                r.update_scene(self.data, cid)
-            else:
-                if view.track_site is not None:
-                    view.lookat = self.data.site_xpos[view.track_site].copy()
-                r.update_scene(self.data, view.camera())
+        for k in range(len(self.camera_ids)):
+            self._update_scene(k)
             self.painter.paint(r.scene, time)
             if self.overlay is not None:
                 self.overlay.add_to_scene(r.scene, time, self.height, self._geoms)
