@@ -384,3 +384,88 @@ def test_a_sweep_never_writes_into_the_working_directory_or_a_users_folder(tmp_p
         assert rc == 2 and err.count("\n") == 1, (out, err)
     assert (tmp_path / "mine" / "sweep.csv").read_text() == "my data"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mine"]
+
+
+# ---------------------------------------------------------- a real full disk, a read-only parent
+def _namespace_mounts() -> bool:
+    """Whether this machine lets an unprivileged user namespace mount a tmpfs (Linux with
+    util-linux's ``unshare``; containers often allow it, some CI runners do not)."""
+    import shutil
+
+    if shutil.which("unshare") is None:
+        return False
+    probe = subprocess.run(["unshare", "-rm", "sh", "-c", "mount -t tmpfs -o size=1m tmpfs /mnt"],
+                           capture_output=True, timeout=30)
+    return probe.returncode == 0
+
+
+_MOUNTS = _namespace_mounts()
+needs_mounts = pytest.mark.skipif(not _MOUNTS, reason="this machine allows no tmpfs mount "
+                                  "in a user namespace (unshare -rm)")
+
+#: Runs inside ``unshare -rm`` (a private mount namespace): mounts a 20 MB tmpfs, writes a
+#: result into it, fills it, runs again into the same folder, then runs into a read-only
+#: bind mount; prints what it saw as JSON. The mounts vanish with the namespace.
+_DRIVER = r"""
+import json, os, subprocess, sys
+root, scenario = sys.argv[1], sys.argv[2]
+def sh(*cmd):
+    subprocess.run(cmd, check=True)
+def run(out, *extra):
+    p = subprocess.run([sys.executable, "-I", "-m", "sim", "run", scenario, "--out", out,
+                        "--no-plots", "--quiet", *extra], capture_output=True, text=True)
+    return {"rc": p.returncode, "err": p.stderr}
+disk = os.path.join(root, "disk")
+sh("mount", "-t", "tmpfs", "-o", "size=20m", "tmpfs", disk)
+seen = {"first": run(os.path.join(disk, "run"), "--no-video")}
+summary = open(os.path.join(disk, "run", "summary.json"), "rb").read()
+free = os.statvfs(disk).f_bavail * os.statvfs(disk).f_frsize
+with open(os.path.join(disk, "filler"), "wb") as fh:   # leave 1 MB: less than one result
+    fh.write(b"\0" * (free - (1 << 20)))
+seen["full_npz"] = run(os.path.join(disk, "run"), "--no-video")
+os.remove(os.path.join(disk, "filler"))
+with open(os.path.join(disk, "filler"), "wb") as fh:   # room for model.xml, not the video
+    fh.write(b"\0" * (free - (256 << 10)))
+seen["full_video"] = run(os.path.join(disk, "run"))
+seen["summary_kept"] = open(os.path.join(disk, "run", "summary.json"), "rb").read() == summary
+seen["left"] = sorted(os.listdir(disk))
+ro = os.path.join(root, "ro")
+sh("mount", "--bind", ro, ro)
+sh("mount", "-o", "remount,bind,ro", ro)
+seen["read_only"] = run(os.path.join(ro, "run"), "--no-video")
+seen["ro_left"] = sorted(os.listdir(ro))
+print(json.dumps(seen))
+"""
+
+
+@needs_mounts
+def test_a_real_full_disk_and_a_read_only_parent(tmp_path):
+    """A 20 MB tmpfs as --out: a first result fits; with the disk filled, a second run (failing
+    while writing its arrays, then while encoding its video) is one line naming the file, exit
+    2, the first result untouched and no hidden leftovers. A read-only parent: one line, exit 2,
+    nothing written."""
+    import json
+
+    (tmp_path / "disk").mkdir()
+    (tmp_path / "ro").mkdir()
+    driver = tmp_path / "driver.py"
+    driver.write_text(_DRIVER)
+    done = subprocess.run(["unshare", "-rm", sys.executable, "-I", str(driver), str(tmp_path),
+                           QUICK], capture_output=True, text=True, timeout=600,
+                          cwd=Path(__file__).resolve().parents[1])
+    assert done.returncode == 0, done.stderr
+    seen = json.loads(done.stdout)
+    assert seen["first"]["rc"] == 0, seen["first"]["err"]
+    disk = tmp_path / "disk"
+    # a run writes its video before its arrays
+    for case, file in (("full_npz", "trajectory.npz"), ("full_video", "video.mp4")):
+        rc, err = seen[case]["rc"], seen[case]["err"]
+        assert rc == 2 and err.count("\n") == 1, (case, err)
+        assert err.startswith(f"cellsim: error: {disk / 'run' / file} ") and \
+            "No space left on device" in err, (case, err)
+    assert seen["summary_kept"]
+    assert seen["left"] == ["filler", "run"]  # no hidden temporary folder, no lock
+    rc, err = seen["read_only"]["rc"], seen["read_only"]["err"]
+    assert rc == 2 and err.count("\n") == 1 and "Read-only file system" in err, err
+    assert str(tmp_path / "ro") in err
+    assert seen["ro_left"] == []

@@ -85,13 +85,27 @@ def test_video_with_each_available_backend(backend: str, run_dir: Path, tmp_path
 
 
 def test_clean_exit_after_an_error_inside_the_render_loop(run_dir: Path, tmp_path: Path) -> None:
-    """A failure mid-video (encoder rejects its options) closes everything, leaves no file."""
+    """A failure mid-video (the encoder fails at its fourth frame) closes everything, leaves no
+    file, and says what failed in one line."""
     code = (
         "import sys\n"
+        "import imageio.v2 as imageio\n"
+        "real = imageio.get_writer\n"
+        "class Failing:\n"
+        "    def __init__(self, *a, **k):\n"
+        "        self.w, self.n = real(*a, **k), 0\n"
+        "    def append_data(self, frame):\n"
+        "        self.n += 1\n"
+        "        if self.n == 4:\n"
+        "            raise RuntimeError('encoder says no')\n"
+        "        self.w.append_data(frame)\n"
+        "    def close(self):\n"
+        "        self.w.close()\n"
+        "imageio.get_writer = Failing\n"
         "from sim.render.video import write_video\n"
         "from sim.errors import RenderError\n"
         "try:\n"
-        "    write_video(sys.argv[1], sys.argv[2], width=64, height=48, fps=5, preset='nosuch')\n"
+        "    write_video(sys.argv[1], sys.argv[2], width=64, height=48, fps=5)\n"
         "except RenderError as exc:\n"
         "    print('RenderError', exc)\n"
     )
@@ -99,9 +113,36 @@ def test_clean_exit_after_an_error_inside_the_render_loop(run_dir: Path, tmp_pat
     proc = subprocess.run([sys.executable, "-c", code, str(run_dir), str(out)], env=_env(),
                           capture_output=True, text=True, timeout=300, check=False)
     assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.startswith("RenderError video encoding failed")
-    assert "Exception ignored" not in proc.stderr
+    assert proc.stdout == f"RenderError video encoding of {out} failed: encoder says no\n"
+    assert proc.stderr == ""  # ffmpeg is quiet; nothing ignored at exit
     assert list(tmp_path.iterdir()) == []  # neither the video nor its partial file
+
+
+def test_an_unknown_preset_lists_the_valid_ones(run_dir: Path, tmp_path: Path) -> None:
+    from sim.render.video import PRESETS, write_video
+
+    with pytest.raises(RenderError, match="unknown x264 preset 'nosuch'; valid: ultrafast, "):
+        write_video(run_dir, tmp_path / "x.mp4", width=64, height=48, fps=5, preset="nosuch")
+    assert "veryfast" in PRESETS and list(tmp_path.iterdir()) == []
+
+
+def test_ffmpeg_errors_reach_the_message_through_its_log(tmp_path: Path) -> None:
+    """ffmpeg runs with -v quiet; what it reports goes to a temporary log (FFREPORT) whose first
+    error line is what the user reads; the log is removed afterwards."""
+    import imageio_ffmpeg
+
+    from sim.render.video import _ffmpeg_log, _ffmpeg_said
+
+    target = tmp_path / "missing" / "x.mp4"
+    with _ffmpeg_log() as log:
+        assert log is not None and log.is_file()
+        proc = subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-v", "quiet", "-f", "lavfi",
+                               "-i", "color=size=16x16:duration=0.1", str(target)],
+                              capture_output=True, text=True, timeout=60)
+        said = _ffmpeg_said(log)
+    assert proc.returncode != 0 and proc.stderr == ""
+    assert str(target) in said and "No such file or directory" in said
+    assert not log.exists()
 
 
 def test_tiled_video_and_result(run_dir: Path, tmp_path: Path) -> None:

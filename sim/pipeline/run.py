@@ -247,6 +247,16 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
             runfolder.write_summary(tmp, summary)
             runfolder.write_marker(tmp, state="complete")
             runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
+        except OSError as exc:
+            shutil.rmtree(tmp, ignore_errors=True)
+            # the user knows the run folder, not its hidden temporary sibling (gone by now)
+            where = str(exc.filename) if exc.filename is not None else ""
+            if where.startswith(str(tmp)):
+                where = str(out_dir) + where[len(str(tmp)):]
+            if exc.errno is None:
+                raise
+            raise OSError(exc.errno, exc.strerror or str(exc),
+                          f"{where or out_dir} (nothing was replaced)") from exc
         except BaseException:
             if tmp.exists():
                 shutil.rmtree(tmp, ignore_errors=True)

@@ -15,9 +15,11 @@ from __future__ import annotations
 import os
 import queue
 import sys
+import tempfile
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -74,8 +76,10 @@ class _Encoder:
 
     _STOP = object()
 
-    def __init__(self, writer: Any, maxsize: int) -> None:
+    def __init__(self, writer: Any, maxsize: int, path: Path, log: Path | None = None) -> None:
         self.writer = writer
+        self.path = path
+        self.log = log
         self.queue: queue.Queue[Any] = queue.Queue(maxsize=max(1, maxsize))
         self.error: BaseException | None = None
         self.thread = threading.Thread(target=self._run, name="cellsim-video-encoder", daemon=True)
@@ -98,14 +102,81 @@ class _Encoder:
 
     def put(self, frame: np.ndarray, caption: str = "") -> None:
         if self.error is not None:
-            raise RenderError(f"video encoding failed: {self.error}") from self.error
+            raise _encoding_error(self.error, self.path, self.log) from self.error
         self.queue.put((frame, caption))
 
     def finish(self) -> None:
         self.queue.put(self._STOP)
         self.thread.join()
         if self.error is not None:
-            raise RenderError(f"video encoding failed: {self.error}") from self.error
+            raise _encoding_error(self.error, self.path, self.log) from self.error
+
+
+#: x264's speed presets, fastest first.
+PRESETS: tuple[str, ...] = ("ultrafast", "superfast", "veryfast", "faster", "fast", "medium",
+                            "slow", "slower", "veryslow", "placebo")
+
+
+@contextmanager
+def _ffmpeg_log() -> Iterator[Path | None]:
+    """ffmpeg runs with ``-v quiet`` (its lines would break the one-line rule on errors) and
+    reports its errors to a temporary log instead (``FFREPORT``, read by the ffmpeg that the
+    encoder thread starts); the log is removed afterwards. None when no log can be made."""
+    try:
+        fd, name = tempfile.mkstemp(prefix="cellsim-ffmpeg-", suffix=".log")
+        os.close(fd)
+    except OSError:
+        yield None
+        return
+    log = Path(name)
+    before = os.environ.get("FFREPORT")
+    escaped = str(log).replace("\\", "\\\\").replace(":", "\\:")
+    os.environ["FFREPORT"] = f"file={escaped}:level=16"
+    try:
+        yield log
+    finally:
+        if before is None:
+            os.environ.pop("FFREPORT", None)
+        else:
+            os.environ["FFREPORT"] = before
+        try:
+            log.unlink()
+        except OSError:
+            pass
+
+
+def _ffmpeg_said(log: Path | None) -> str:
+    """The first error line ffmpeg logged ('' when none)."""
+    if log is None:
+        return ""
+    try:
+        lines = log.read_text(errors="replace").splitlines()
+    except OSError:
+        return ""
+    said = [line.split("] ", 1)[-1].strip() for line in lines[2:] if line.strip()]
+    return said[0] if said else ""
+
+
+def _encoding_error(error: BaseException, path: Path, log: Path | None = None) -> Exception:
+    """One line for an encoder failure: a probe write next to the partial file tells a full or
+    read-only disk (an ``OSError`` with the path, reported like any other) from an encoder
+    fault (a ``RenderError`` with ffmpeg's first error line, else what imageio said)."""
+    probe = path.with_name(f".{path.stem}.probe")
+    try:
+        with open(probe, "wb") as fh:
+            fh.write(b"\0" * (1 << 20))
+            fh.flush()
+            os.fsync(fh.fileno())
+    except OSError as exc:
+        return OSError(exc.errno, exc.strerror or str(exc), str(path))
+    finally:
+        try:
+            probe.unlink()
+        except OSError:
+            pass
+    first = _ffmpeg_said(log) or next(
+        (line.strip() for line in str(error).splitlines() if line.strip()), type(error).__name__)
+    return RenderError(f"video encoding of {path} failed: {first}")
 
 
 def _partial_path(path: Path) -> Path:
@@ -166,6 +237,8 @@ def write_video(
         raise RenderError(f"video file {str(out_path)!r} must end in .mp4 (H.264 MP4)")
     if not (isinstance(crf, int) and 0 <= crf <= 51):
         raise RenderError(f"crf must be an integer in 0..51, got {crf!r}")
+    if preset not in PRESETS:
+        raise RenderError(f"unknown x264 preset {preset!r}; valid: {', '.join(PRESETS)}")
     started = time.perf_counter()
     with FrameRenderer(
         run, cameras=cameras, width=width, height=height, overlay=overlay, caption=caption,
@@ -177,34 +250,39 @@ def write_video(
         tmp = _partial_path(out_path)
         ok = False
         try:
-            writer = imageio.get_writer(
-                tmp, format="FFMPEG", mode="I", fps=float(fps), codec="libx264",
-                pixelformat="yuv420p", quality=None, macro_block_size=2,
-                ffmpeg_log_level="error",
-                output_params=["-crf", str(crf), "-preset", preset, "-movflags", "+faststart"],
-            )
-            loop_start = time.perf_counter()
-            try:
-                encoder = _Encoder(writer, queue_size)
-                bar = tqdm(total=len(times), unit="frame", desc="render", file=sys.stderr,
-                           disable=not (progress and sys.stderr.isatty()), leave=False,
-                           delay=1.0)  # only renders longer than a second show a bar
+            with _ffmpeg_log() as log:
+                writer = imageio.get_writer(
+                    tmp, format="FFMPEG", mode="I", fps=float(fps), codec="libx264",
+                    pixelformat="yuv420p", quality=None, macro_block_size=2,
+                    ffmpeg_log_level="quiet",
+                    output_params=["-crf", str(crf), "-preset", preset,
+                                   "-movflags", "+faststart"],
+                )
+                loop_start = time.perf_counter()
                 try:
-                    for t in times:
-                        t = float(t)
-                        text = frames.caption_at(t) if caption else ""
-                        encoder.put(frames.render(t, caption=False), text)
-                        bar.update(1)
-                finally:
-                    bar.close()
-                    encoder.finish()
-            except BaseException:
+                    encoder = _Encoder(writer, queue_size, out_path, log)
+                    bar = tqdm(total=len(times), unit="frame", desc="render", file=sys.stderr,
+                               disable=not (progress and sys.stderr.isatty()), leave=False,
+                               delay=1.0)  # only renders longer than a second show a bar
+                    try:
+                        for t in times:
+                            t = float(t)
+                            text = frames.caption_at(t) if caption else ""
+                            encoder.put(frames.render(t, caption=False), text)
+                            bar.update(1)
+                    finally:
+                        bar.close()
+                        encoder.finish()
+                except BaseException:
+                    try:
+                        writer.close()
+                    except Exception:  # noqa: BLE001 - keep the first error
+                        pass
+                    raise
                 try:
-                    writer.close()
-                except Exception:  # noqa: BLE001 - keep the first error
-                    pass
-                raise
-            writer.close()  # waits for ffmpeg to encode the last frames
+                    writer.close()  # waits for ffmpeg to encode the last frames
+                except Exception as exc:  # noqa: BLE001 - the trailer could not be written
+                    raise _encoding_error(exc, out_path, log) from exc
             loop_seconds = time.perf_counter() - loop_start
             os.replace(tmp, out_path)
             ok = True

@@ -25,7 +25,8 @@ from __future__ import annotations
 
 import json
 import zipfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -610,6 +611,19 @@ def _check_out_dir(raw: Path) -> Path:
 
 
 # ------------------------------------------------------------------------------------ writing
+@contextmanager
+def naming(path: str | Path) -> Iterator[None]:
+    """Give an operating-system error raised inside the block the path being written when it
+    has none (numpy's and zipfile's writers drop it: a full disk would say only "No space left
+    on device")."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None and exc.errno is not None:
+            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from exc
+        raise
+
+
 def write_text(folder: str | Path, name: str, text: str) -> Path:
     """Write one of the folder's text files (``MODEL_XML``, ``SCENARIO_TOML``, ...)."""
     path = Path(folder) / name
@@ -625,7 +639,8 @@ def write_summary(folder: str | Path, summary: Mapping[str, Any]) -> Path:
 def write_trajectory(folder: str | Path, arrays: Mapping[str, np.ndarray]) -> Path:
     """Write ``trajectory.npz`` (compressed) from the recorded arrays (see ``ARRAYS``)."""
     path = Path(folder) / TRAJECTORY_NPZ
-    np.savez_compressed(path, **arrays)
+    with naming(path):
+        np.savez_compressed(path, **arrays)
     return path
 
 
@@ -674,7 +689,8 @@ def write_csv(folder: str | Path, arrays: Mapping[str, np.ndarray], joints: Sequ
     header = ",".join(c for c, _ in cols)
     data = np.column_stack([np.asarray(v, dtype=float) for _, v in cols])
     path = Path(folder) / TRAJECTORY_CSV
-    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.9g")
+    with naming(path):
+        np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.9g")
     return path
 
 
