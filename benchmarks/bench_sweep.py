@@ -1,28 +1,33 @@
-"""Benchmark of parallel sweeps: serial vs process-pool wall time of ``sim.pipeline.sweep.run_sweep``.
+"""Benchmark of actuator-sizing sweeps at scale: variants per minute on the process pool and on
+Ray, and what a metrics-only variant costs against its simulation alone.
 
-By default every variant runs a stand-in workload that is shaped like ``cellsim run``: a
-two-link MuJoCo arm with the payload on its tip, PD-tracking a sine reference whose period is
-divided by the speed scale, for ``--sim-time`` seconds at 1 kHz, plus the inverse dynamics of
-the reference, written to ``trajectory.npz``. Pass ``--runner module:function`` (and
-``--scenario``) to time the real runner instead; it must accept a :class:`sim.pipeline.sweep.Variant`
-and return its run folder.
+Each sweep is the real thing (``cellsim size``'s runner, metrics only): the weld plate
+(``lrmate200ic_weld_plate``, an 82.6 s cycle) over a payload x speed-scale grid, 8 (2 x 4),
+64 (8 x 8) and 256 (16 x 16) variants. Printed per engine and size: wall time, variants per
+minute, and the ratio of a variant's wall time (inside its worker: build, plan, simulate,
+collision and limit checks, sizing) to its ``simulate`` stage (reference, inverse-dynamics
+feed-forward and MuJoCo steps), with the stages' mean times. The two engines' tables are
+compared (they must be identical, bit for bit).
+
+``--warp`` instead runs 8 variants (2 payloads x 4 speed scales) of a short scenario on the
+MuJoCo Warp backend (Warp's CPU device without a GPU: for parity, not speed) and on the pool,
+and prints the largest relative difference of the peak and RMS torques.
 
 Usage::
 
-    .venv/bin/python benchmarks/bench_sweep.py                       # stand-in runner
-    .venv/bin/python benchmarks/bench_sweep.py --payloads 0,2.5,5 --speeds 0.5,1,1.5 \\
-        --workers 2 --json bench_sweep.json
-    .venv/bin/python benchmarks/bench_sweep.py --runner sim.cli.size:run_variant --scenario bugnar_5r_weld_cycle
+    .venv/bin/python benchmarks/bench_sweep.py                  # 8, 64, 256 on pool and ray
+    .venv/bin/python benchmarks/bench_sweep.py --sizes 8 --engines pool
+    .venv/bin/python benchmarks/bench_sweep.py --warp
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
+import functools
 import json
+import math
 import os
 import platform
-import resource
 import sys
 import tempfile
 import time
@@ -32,141 +37,110 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sim.pipeline.sweep import Variant, parse_float_list, run_sweep  # noqa: E402
+from sim.cli.size import run_batch, run_variant  # noqa: E402
+from sim.pipeline.sweep import run_sweep  # noqa: E402
 
-_ARM = """
-<mujoco model="two_link">
-  <option timestep="0.001" integrator="implicitfast"/>
-  <worldbody>
-    <body name="upper">
-      <joint name="j1" type="hinge" axis="0 1 0" armature="0.1" damping="0.5"/>
-      <geom type="capsule" fromto="0 0 0 0.4 0 0" size="0.04" mass="4"/>
-      <body name="fore" pos="0.4 0 0">
-        <joint name="j2" type="hinge" axis="0 1 0" armature="0.05" damping="0.3"/>
-        <geom type="capsule" fromto="0 0 0 0.35 0 0" size="0.03" mass="2"/>
-        <body name="tip" pos="0.35 0 0"><geom type="sphere" size="0.03" mass="0.01"/></body>
-      </body>
-    </body>
-  </worldbody>
-  <actuator>
-    <motor joint="j1" forcerange="-200 200" forcelimited="true"/>
-    <motor joint="j2" forcerange="-100 100" forcelimited="true"/>
-  </actuator>
-</mujoco>
-"""
-
-SIM_TIME = 4.0  # s of simulated time per variant (overridden by --sim-time through the env)
+GRIDS = {8: (2, 4), 64: (8, 8), 256: (16, 16)}
 
 
-def standin_runner(variant: Variant) -> Path:
-    """Simulate the two-link arm for one variant and write its run folder."""
-    import mujoco
-
-    sim_time = float(os.environ.get("BENCH_SWEEP_SIM_TIME", SIM_TIME))
-    model = mujoco.MjModel.from_xml_string(_ARM)
-    model.body_mass[model.body("tip").id] += variant.payload_kg
-    data = mujoco.MjData(model)
-    T = 2.0 / variant.speed_scale  # base period 2 s, knot times divided by the scale
-    w = 2 * np.pi / T
-    amp = np.array([0.8, 1.2])
-    n = int(round(sim_time / model.opt.timestep)) + 1
-    t = np.arange(n) * model.opt.timestep
-    q_ref = amp * np.sin(w * t)[:, None]
-    qd_ref = amp * w * np.cos(w * t)[:, None]
-    qdd_ref = -amp * w * w * np.sin(w * t)[:, None]
-    kp, kv = np.array([3000.0, 1500.0]), np.array([300.0, 150.0])
-    q = np.empty((n, 2))
-    qd = np.empty((n, 2))
-    tau = np.empty((n, 2))
-    tau_id = np.empty((n, 2))
-    inv = mujoco.MjData(model)
-    for i in range(n):
-        # inverse dynamics of the reference (feed-forward and tau_id)
-        inv.qpos[:], inv.qvel[:], inv.qacc[:] = q_ref[i], qd_ref[i], qdd_ref[i]
-        mujoco.mj_inverse(model, inv)
-        tau_id[i] = inv.qfrc_inverse
-        data.ctrl[:] = tau_id[i] + kp * (q_ref[i] - data.qpos) + kv * (qd_ref[i] - data.qvel)
-        q[i], qd[i] = data.qpos, data.qvel
-        mujoco.mj_step(model, data)
-        tau[i] = data.actuator_force
-    run_dir = Path(variant.run_dir)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    np.savez(run_dir / "trajectory.npz", t=t, phase=np.zeros(n, dtype=int), q_ref=q_ref,
-             qd_ref=qd_ref, qdd_ref=qdd_ref, q=q, qd=qd, tau=tau, tau_id=tau_id)
-    (run_dir / "summary.json").write_text(json.dumps(
-        {"scenario": str(variant.scenario), "robot": "two_link", "joints": ["j1", "j2"],
-         "duration_s": sim_time}))
-    return run_dir
+def grid(n: int) -> tuple[list[float], list[float]]:
+    """Payloads 0..5 kg and speed scales 0.5..1 for an n-variant sweep."""
+    if n in GRIDS:
+        p, s = GRIDS[n]
+    else:
+        p = max(1, int(math.sqrt(n)))
+        s = max(1, n // p)
+    payloads = [round(x, 6) for x in np.linspace(0.0, 5.0, p)] if p > 1 else [2.5]
+    speeds = [round(x, 6) for x in np.linspace(0.5, 1.0, s)] if s > 1 else [1.0]
+    return payloads, speeds
 
 
-def _load_runner(spec: str):
-    module, _, name = spec.partition(":")
-    if not name:
-        raise SystemExit(f"--runner: expected module:function, got {spec!r}")
-    return getattr(importlib.import_module(module), name)
+def table(result) -> str:
+    return json.dumps([{k: repr(v) for k, v in r.items()} for r in result.rows])
+
+
+def sweep(scenario: str, n: int, engine: str, workers: int, **kw) -> dict:
+    payloads, speeds = grid(n)
+    with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
+        t0 = time.perf_counter()
+        res = run_sweep(scenario, payloads, speeds, run_variant, workers=workers,
+                        out_dir=Path(tmp) / "sweep", progress=False, engine=engine, **kw)
+        wall = time.perf_counter() - t0
+    stages: dict[str, list[float]] = {}
+    for o in res.outcomes:
+        for k, v in o.timings_s.items():
+            stages.setdefault(k, []).append(v)
+    ratios = [o.wall_s / o.timings_s["simulate"] for o in res.outcomes
+              if o.timings_s.get("simulate")]
+    return {"variants": len(res.outcomes), "engine": engine, "workers": workers,
+            "wall_s": wall, "variants_per_min": 60.0 * len(res.outcomes) / wall,
+            "variant_over_simulation": float(np.mean(ratios)) if ratios else float("nan"),
+            "stages_mean_s": {k: float(np.mean(v)) for k, v in stages.items()},
+            "failures": len(res.failures), "table": table(res)}
+
+
+def warp_parity(scenario: str, workers: int) -> dict:
+    payloads, speeds = [1.0, 3.0], [0.7, 0.8, 0.9, 1.0]
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
+        for name, kw in (("pool", {}), ("warp", {"batch": functools.partial(run_batch)})):
+            t0 = time.perf_counter()
+            res = run_sweep(scenario, payloads, speeds, run_variant, workers=workers,
+                            out_dir=Path(tmp) / name, progress=False, **kw)
+            out[name] = {"wall_s": time.perf_counter() - t0, "rows": res.rows,
+                         "variants_per_min": 60.0 * len(res.outcomes)
+                         / (time.perf_counter() - t0)}
+    worst = {}
+    for key in ("peak_torque_sim_nm", "rms_torque_sim_nm"):
+        worst[key] = max(abs(a[key] - b[key]) / max(abs(a[key]), 1e-12)
+                         for a, b in zip(out["pool"]["rows"], out["warp"]["rows"]))
+    return {"variants": len(payloads) * len(speeds), "scenario": scenario,
+            "pool_variants_per_min": out["pool"]["variants_per_min"],
+            "warp_cpu_variants_per_min": out["warp"]["variants_per_min"],
+            "max_relative_difference": worst}
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--payloads", default="0,2.5,5", help="kg, e.g. 0,2.5,5 or 0:5:2.5")
-    ap.add_argument("--speeds", default="0.5,1,1.5", help="speed scales, e.g. 0.5,1,1.5")
-    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
-                    help="parallel workers (default: all cores)")
-    ap.add_argument("--runner", default=None, help="module:function (default: stand-in arm)")
-    ap.add_argument("--scenario", default="standin", help="base scenario given to the runner")
-    ap.add_argument("--sim-time", type=float, default=SIM_TIME,
-                    help="simulated seconds per variant for the stand-in runner")
-    ap.add_argument("--repeat", type=int, default=1, help="repeat each timing, keep the best")
+    ap.add_argument("--scenario", default="lrmate200ic_weld_plate")
+    ap.add_argument("--sizes", default="8,64,256", help="variant counts (default 8,64,256)")
+    ap.add_argument("--engines", default="pool,ray", help="pool, ray or both (default)")
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--warp", action="store_true",
+                    help="Warp-CPU parity on 8 variants of --warp-scenario instead")
+    ap.add_argument("--warp-scenario", default="kacso_lrmate100ib_sequence1")
     ap.add_argument("--json", type=Path, default=None, help="write the numbers here")
     args = ap.parse_args(argv)
-
-    payloads = parse_float_list(args.payloads, "--payloads")
-    speeds = parse_float_list(args.speeds, "--speeds")
-    runner = _load_runner(args.runner) if args.runner else standin_runner
-    os.environ["BENCH_SWEEP_SIM_TIME"] = str(args.sim_time)  # inherited by spawned workers
-    n_var = len(payloads) * len(speeds)
-
-    def cpu_s() -> float:
-        own = resource.getrusage(resource.RUSAGE_SELF)
-        kids = resource.getrusage(resource.RUSAGE_CHILDREN)
-        return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
-
-    def timed(workers: int) -> tuple[float, float, list]:
-        best, cpu, rows = float("inf"), 0.0, []
-        for _ in range(max(args.repeat, 1)):
-            with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
-                c0, t0 = cpu_s(), time.perf_counter()
-                res = run_sweep(args.scenario, payloads, speeds, runner, workers=workers,
-                                out_dir=tmp, progress=False)
-                wall = time.perf_counter() - t0
-                if wall < best:
-                    best, cpu = wall, cpu_s() - c0
-                rows = [{k: v for k, v in r.items() if k != "run_dir"} for r in res.rows]
-        return best, cpu, rows
-
-    load_before = os.getloadavg()[0]
-    serial_s, serial_cpu, serial_rows = timed(1)
-    parallel_s, parallel_cpu, parallel_rows = timed(args.workers)
-    same = json.dumps(serial_rows, default=str) == json.dumps(parallel_rows, default=str)
-    speedup = serial_s / parallel_s
-    eff_workers = min(args.workers, n_var)
-    out = {
-        "variants": n_var, "workers": args.workers, "cpu_count": os.cpu_count(),
-        "runner": args.runner or "standin_runner", "sim_time_s": args.sim_time,
-        "serial_s": serial_s, "parallel_s": parallel_s, "speedup": speedup,
-        "efficiency": speedup / eff_workers, "identical_tables": same,
-        "serial_cpu_s": serial_cpu, "parallel_cpu_s": parallel_cpu,
-        "parallel_cores_busy": parallel_cpu / parallel_s, "load_avg_1min_before": load_before,
-        "python": platform.python_version(), "machine": platform.machine(),
-    }
-    print(f"{n_var} variants, {args.workers} workers on {os.cpu_count()} cores: serial "
-          f"{serial_s:.2f} s, parallel {parallel_s:.2f} s, speed-up {speedup:.2f}x "
-          f"(efficiency {out['efficiency']:.0%}); CPU {serial_cpu:.2f} s serial, "
-          f"{parallel_cpu:.2f} s parallel ({out['parallel_cores_busy']:.2f} cores busy); "
-          f"load before {load_before:.2f}; tables identical: {same}")
+    info = {"python": platform.python_version(), "cpu_count": os.cpu_count(),
+            "machine": platform.machine()}
+    if args.warp:
+        out = warp_parity(args.warp_scenario, args.workers)
+        print(f"{out['variants']} variants of {out['scenario']}: pool "
+              f"{out['pool_variants_per_min']:.1f}/min, MuJoCo Warp (CPU device) "
+              f"{out['warp_cpu_variants_per_min']:.1f}/min; largest relative difference: "
+              + ", ".join(f"{k} {v:.2%}" for k, v in out["max_relative_difference"].items()))
+        if args.json:
+            args.json.write_text(json.dumps({**info, **out}, indent=2) + "\n")
+        return 0
+    results = []
+    for n in (int(x) for x in args.sizes.split(",")):
+        tables = {}
+        for engine in args.engines.split(","):
+            r = sweep(args.scenario, n, engine, args.workers)
+            tables[engine] = r.pop("table")
+            results.append(r)
+            st = ", ".join(f"{k} {v:.2f}" for k, v in r["stages_mean_s"].items())
+            print(f"{n:4d} variants, {engine:4s}, {args.workers} workers: {r['wall_s']:7.1f} s, "
+                  f"{r['variants_per_min']:6.1f} variants/min; a variant costs "
+                  f"{r['variant_over_simulation']:.2f}x its simulation (mean s: {st})",
+                  flush=True)
+        if len(tables) > 1:
+            same = len(set(tables.values())) == 1
+            print(f"     tables identical across {', '.join(tables)}: {same}", flush=True)
+            results.append({"variants": n, "identical_tables": same})
     if args.json:
-        args.json.write_text(json.dumps(out, indent=2) + "\n")
-    return 0 if same else 1
+        args.json.write_text(json.dumps({**info, "results": results}, indent=2) + "\n")
+    return 0
 
 
 if __name__ == "__main__":

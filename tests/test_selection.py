@@ -287,14 +287,22 @@ def test_size_select_writes_the_selection_in_each_variant(tmp_path, small_catalo
     out = tmp_path / "sweep"
     rc = main(["size", "lrmate200ic_pick_place", "--select", "--catalog", str(small_catalog),
                "--dwell-s", "2", "--life-h", "10000", "--out", str(out), "--workers", "1",
-               "--quiet"])
+               "--quiet", "--keep-runs"])
     assert rc == 0
-    runs = [p.parent for p in out.rglob("selection.json")]
+    runs = [p.parent for p in out.rglob("selection.json")]  # --keep-runs: one folder each
     assert len(runs) == 1
     doc = json.loads((runs[0] / "selection.json").read_text())
     assert doc["dwell_s"] == 2.0 and doc["life_h"] == 10000.0
     assert "Actuator selection" in (runs[0] / "report.html").read_text()
     assert "selection, payload" in capsys.readouterr().out
+    # metrics only (the default): nothing per variant, the same choice printed
+    rc = main(["size", "lrmate200ic_pick_place", "--select", "--catalog", str(small_catalog),
+               "--dwell-s", "2", "--life-h", "10000", "--out", str(tmp_path / "m"),
+               "--workers", "1", "--quiet"])
+    assert rc == 0 and not list((tmp_path / "m").rglob("selection.json"))
+    printed = capsys.readouterr().out
+    chosen = next(iter(doc["joints"].values()))
+    assert "selection, payload" in printed and chosen["motor"] in printed
 
 
 def test_starter_catalogue_cites_sources_and_has_plausible_units():

@@ -46,6 +46,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fps", type=float, help="video frames per second")
     p.add_argument("--camera", action="append", metavar="NAME",
                    help="cell camera to film (repeat to tile several side by side)")
+    p.add_argument("--backend", choices=("mujoco", "warp"), default="mujoco",
+                   help="physics: MuJoCo in C (default) or MuJoCo Warp (float32, on a GPU "
+                        "where there is one; pip install 'cellsim[warp]')")
     p.add_argument("--quiet", action="store_true", help="no progress bars (the result lines only)")
     p.add_argument("--strict", action="store_true",
                    help="exit with 1 when the run's verdict is fail (a collision, a saturated "
@@ -83,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.quiet,
         selection=selection,
         csv=args.csv,
+        backend=args.backend,
     )
     summary = run_scenario(scenario, options)
     out = (args.out or default_out_dir(scenario))

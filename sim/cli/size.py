@@ -1,12 +1,16 @@
 """``cellsim size SCENARIO --payload ... --speed-scale ...``: actuator-sizing sweeps.
 
 Every (payload, speed scale) combination is simulated (the speed scale divides the knot
-times: 2 is twice as fast), in parallel over the machine's cores, and sized. The sweep folder
-(``--out``, default ``runs/<scenario>_sweep``) holds ``sweep.csv`` (one row per variant and
-joint), ``sweep.md`` (tables), ``sweep.png`` (peak and RMS torque per joint against payload and
-speed) and one run folder per variant. A variant that exceeds a speed, acceleration or
-torque limit is kept, with its negative margins and its run's verdict; the command exits 0
-when it could evaluate every variant.
+times: 2 is twice as fast) and sized, in parallel: over the machine's cores (``--engine pool``,
+the default) or as Ray tasks on a local Ray instance or an existing cluster (``--engine ray
+[--address auto|HOST:PORT]``). A variant computes its arrays, checks and sizing in memory and
+returns a few numbers per joint (metrics only); the sweep folder (``--out``, default
+``runs/<scenario>_sweep``) gets ``sweep.csv`` (one row per variant and joint), ``sweep.md``
+(tables), ``sweep.json`` and ``sweep.png`` (peak and RMS torque per joint against payload and
+speed), drawn once at the end. ``--keep-runs`` also writes one full run folder per variant
+(arrays, summary, sizing report; ``--plots`` adds each run's charts). A variant that exceeds a
+speed, acceleration or torque limit is kept, with its negative margins and its run's verdict;
+the command exits 0 when it could evaluate every variant.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import argparse
 import functools
 import os
 from pathlib import Path
+from typing import Any
 
 from sim.pipeline.sweep import Variant
 
@@ -39,7 +44,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, metavar="DIR",
                    help="sweep folder (default: runs/<scenario name>_sweep)")
     p.add_argument("--workers", type=int, default=None,
-                   help="parallel processes (default: the number of cores)")
+                   help="parallel processes, or CPUs of a local Ray instance (default: the "
+                        "number of cores)")
+    p.add_argument("--engine", choices=("pool", "ray"), default="pool",
+                   help="where variants run: a process pool on this machine (default) or Ray "
+                        "tasks (needs the extra: pip install 'cellsim[ray]')")
+    p.add_argument("--address", metavar="auto|HOST:PORT",
+                   help="with --engine ray: an existing Ray cluster ('auto': the one this "
+                        "machine belongs to); default: start a local instance")
+    p.add_argument("--backend", choices=("mujoco", "warp"), default="mujoco",
+                   help="physics: MuJoCo in C, one variant per process (default), or MuJoCo "
+                        "Warp: the variants that share a model structure step as one batch in "
+                        "this process, on a GPU where there is one (pip install "
+                        "'cellsim[warp]')")
+    p.add_argument("--keep-runs", action="store_true",
+                   help="also write each variant's run folder (arrays, summary, sizing report) "
+                        "in the sweep folder; default: metrics only, nothing per variant")
+    p.add_argument("--plots", action="store_true",
+                   help="with --keep-runs: draw each variant's plots too")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_selection_args(p)
     p.set_defaults(func=run)
@@ -76,29 +98,68 @@ def selection_overrides(args: argparse.Namespace) -> dict | None:
             "inertia_ratio_max": args.inertia_ratio_max}
 
 
-def run_variant(variant: Variant, select: dict | None = None) -> Path:
-    """Run one sweep variant (module level, so worker processes can import it).
+def run_variant(variant: Variant, select: dict | None = None, keep_runs: bool = False,
+                plots: bool = False) -> Any:
+    """Run one sweep variant (module level, so worker processes and Ray tasks can import it).
+
+    Metrics only by default: the run is evaluated in memory and a
+    :class:`~sim.pipeline.sweep.VariantMetrics` (the variant's rows of the table) comes back.
+    With ``keep_runs`` the variant's run folder is written (``variant.run_dir``) and its path
+    comes back.
 
     A variant faster or heavier than the robot allows is still simulated (speed and
     acceleration limits are not enforced): it stays in the tables with negative margins and a
     failed verdict instead of being dropped.
     """
-    import dataclasses
+    from sim.pipeline.run import RunOptions, evaluate_scenario, run_scenario
 
-    from sim.pipeline.run import RunOptions, run_scenario
-    from sim.scenario import load_scenario
-
-    scenario = load_scenario(variant.scenario).scaled(variant.speed_scale, variant.payload_kg)
-    scenario = dataclasses.replace(scenario, simulation=scenario.simulation.model_copy(
-        update={"enforce_speed_limits": False, "enforce_accel_limits": False}))
+    scenario = _variant_scenario(variant)
     selection = None
     if select is not None or scenario.sizing.select:
         from sim.pipeline.run import selection_options
 
         selection = selection_options(scenario, **(select or {}))
-    run_scenario(scenario, RunOptions(out_dir=variant.run_dir, video=False, plots=False,
-                                      progress=False, selection=selection))
-    return Path(variant.run_dir)
+    if keep_runs:
+        run_scenario(scenario, RunOptions(out_dir=variant.run_dir, video=False, plots=plots,
+                                          progress=False, selection=selection))
+        return Path(variant.run_dir)
+    return _metrics(variant, evaluate_scenario(scenario, RunOptions(
+        video=False, plots=False, progress=False, selection=selection)))
+
+
+def _variant_scenario(variant: Variant) -> Any:
+    import dataclasses
+
+    from sim.scenario import load_scenario
+
+    scenario = load_scenario(variant.scenario).scaled(variant.speed_scale, variant.payload_kg)
+    return dataclasses.replace(scenario, simulation=scenario.simulation.model_copy(
+        update={"enforce_speed_limits": False, "enforce_accel_limits": False}))
+
+
+def _metrics(variant: Variant, ev: Any) -> Any:
+    from sim.pipeline.sweep import VariantMetrics, rows_from
+
+    sized = ({j["joint"]: j for j in ev.sizing.to_dict()["joints"]}
+             if ev.sizing is not None else {})
+    rows = rows_from(variant, ev.record.arrays, ev.summary["joints"], ev.summary["verdict"],
+                     sized)
+    return VariantMetrics(tuple(rows), ev.selection.to_dict() if ev.selection else None,
+                          timings_s=dict(ev.summary.get("timings_s", {})))
+
+
+def run_batch(variants: list[Variant], select: dict | None = None) -> list[Any]:
+    """Every variant at once on MuJoCo Warp (``--backend warp``): planned one by one, simulated
+    as batches of one model structure, then checked and sized one by one; metrics only."""
+    from sim.pipeline.run import RunOptions, evaluate_scenarios, selection_options
+
+    scenarios = [_variant_scenario(v) for v in variants]
+    selection = None
+    if select is not None or scenarios[0].sizing.select:
+        selection = selection_options(scenarios[0], **(select or {}))
+    evaluations = evaluate_scenarios(scenarios, RunOptions(
+        video=False, plots=False, progress=False, selection=selection, backend="warp"))
+    return [_metrics(v, ev) for v, ev in zip(variants, evaluations)]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -126,10 +187,25 @@ def run(args: argparse.Namespace) -> int:
         from sim.pipeline.run import selection_options
 
         selection_options(scenario, **(select or {}))
+    if args.plots and not args.keep_runs:
+        raise CellsimError("--plots draws each variant's run folder: give --keep-runs too")
+    if args.address is not None and args.engine != "ray":
+        raise CellsimError("--address is for --engine ray")
+    batch = None
+    if args.backend == "warp":
+        if args.engine == "ray":
+            raise CellsimError("--backend warp runs its batch in this process, on this "
+                               "machine's device: use it without --engine ray")
+        if args.keep_runs:
+            raise CellsimError("--keep-runs is for --backend mujoco (a Warp batch computes "
+                               "metrics only)")
+        batch = functools.partial(run_batch, select=select)
     result = run_sweep(str(scenario.source), payloads, scales,
-                       functools.partial(run_variant, select=select),
+                       functools.partial(run_variant, select=select, keep_runs=args.keep_runs,
+                                         plots=args.plots),
                        workers=min(workers, len(payloads) * len(scales)), out_dir=out,
-                       progress=not args.quiet)
+                       progress=not args.quiet, engine=args.engine, address=args.address,
+                       batch=batch)
     print(f"{len(result.outcomes)} variants in {result.wall_s:.1f} s on {result.workers} "
           f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.png)")
     if select is not None or scenario.sizing.select:
@@ -142,12 +218,12 @@ def _print_selections(result) -> None:
     import json
 
     for outcome in result.outcomes:
-        if outcome.run_dir is None:
+        doc = outcome.selection
+        if doc is None and outcome.run_dir is not None:
+            path = Path(outcome.run_dir) / "selection.json"
+            doc = json.loads(path.read_text()) if path.is_file() else None
+        if doc is None:
             continue
-        path = Path(outcome.run_dir) / "selection.json"
-        if not path.is_file():
-            continue
-        doc = json.loads(path.read_text())
         print(f"selection, {outcome.variant.label}:")
         for joint, j in doc["joints"].items():
             if j["motor"] is None:

@@ -68,6 +68,8 @@ class RunOptions:
         selection: Choose a motor and a reducer per joint from a catalogue
             (:mod:`sim.analysis.selection`; ``selection.json``/``.csv``, a report section and a
             ``selection`` check per joint), or None.
+        backend: ``"mujoco"`` (MuJoCo in C) or ``"warp"`` (MuJoCo Warp, float32, on a GPU
+            where there is one: :mod:`sim.simulation.warp_batch`).
     """
 
     out_dir: Path | None = None
@@ -79,6 +81,7 @@ class RunOptions:
     progress: bool = True
     selection: Any = None
     csv: bool = False
+    backend: str = "mujoco"
 
 
 # --------------------------------------------------------------------------------------------
@@ -113,23 +116,50 @@ def default_out_dir(scenario: Scenario) -> Path:
     return Path("runs") / scenario.name
 
 
-def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[str, Any]:
-    """Run a scenario and write its run folder; returns the summary.
+@dataclass
+class Evaluation:
+    """A run evaluated in memory: what a run folder would hold, before anything is written.
 
-    The folder is built in a temporary sibling and moved into place at the end, so a failed
-    run never leaves a ``summary.json``. A run that fails mid-simulation keeps what it recorded
-    in ``<out_dir>.failed/`` with ``error.txt``.
-
-    Raises:
-        CellsimError: A user mistake or an unstable simulation (one-line message).
+    Attributes:
+        summary: The summary (metrics, checks, verdict; ``summary.json``'s content).
+        record: Every recorded sample (:class:`~sim.simulation.runfolder.RunRecord`).
+        sizing: The sizing result, or None when sizing was off.
+        selection: The actuator selection, or None when none was asked for.
+        built: The compiled cell.
     """
-    options = options or RunOptions()
-    out_dir = runfolder.check_out_dir(options.out_dir if options.out_dir
-                                      else default_out_dir(scenario))
-    feedforward = (scenario.simulation.feedforward if options.feedforward is None
-                   else options.feedforward)
-    stages = Stages(enabled=options.progress)
 
+    summary: dict[str, Any]
+    record: runfolder.RunRecord
+    sizing: SizingResult | None
+    selection: Any
+    built: BuiltCell
+
+
+#: Plans kept for reuse by metrics-only evaluations in this process (a sweep's variants that
+#: differ only in payload share their motion: planning does not depend on the payload).
+_PLANS: dict[str, Any] = {}
+_PLANS_KEPT = 4
+
+
+def _plan_key(scenario: Scenario) -> str | None:
+    """What a plan depends on: the scenario without its payload (None when it cannot be
+    fingerprinted; then nothing is reused)."""
+    import dataclasses
+    import hashlib
+    import pickle
+
+    try:
+        blob = pickle.dumps(dataclasses.replace(scenario, payload_kg=0.0))
+    except Exception:  # noqa: BLE001 - an unpicklable scenario is planned every time
+        return None
+    return hashlib.sha256(blob).hexdigest()
+
+
+def _prepare(scenario: Scenario, options: RunOptions, stages: Stages, *, reuse_plan: bool = False
+             ) -> tuple[BuiltCell, Any, dict[str, Any]]:
+    """Build the cell and plan the motion; refuse bad video settings before simulating. With
+    ``reuse_plan`` a motion planned for the same scenario in this process (another payload)
+    is reused."""
     with stages.stage("build"):
         built = build(scenario)
         _check_tcp_consistency(built, scenario)
@@ -145,9 +175,163 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
 
                 raise RenderError(f"--fps must be a positive number, got {fps!r}")
     with stages.stage("plan"):
-        motion = build_motion(scenario, built.context)
-        check_motion_limits(scenario, motion)
+        key = _plan_key(scenario) if reuse_plan else None
+        motion = _PLANS.get(key) if key is not None else None
+        if motion is None:
+            motion = build_motion(scenario, built.context)
+            check_motion_limits(scenario, motion)
+            if key is not None:
+                _PLANS[key] = motion
+                while len(_PLANS) > _PLANS_KEPT:
+                    _PLANS.pop(next(iter(_PLANS)))
         check_size(scenario, motion, float(built.model.opt.timestep))
+    return built, motion, video_args
+
+
+def _feedforward(scenario: Scenario, options: RunOptions) -> bool:
+    return (scenario.simulation.feedforward if options.feedforward is None
+            else options.feedforward)
+
+
+def _drives(scenario: Scenario) -> Any:
+    """The drives whose torque-speed curves limit the simulation, or None."""
+    drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
+    return drives if scenario.simulation.motor_speed_limits and drives else None
+
+
+def simulate_batch(scenarios: list[Scenario], prepared: list[tuple[BuiltCell, Any]],
+                   options: RunOptions) -> list[Any]:
+    """Simulate prepared variants on MuJoCo Warp, one batch per model structure (a payload of
+    0 kg has no payload body, so it batches apart from the others); records in order."""
+    from sim.simulation.warp_batch import simulate_batch as warp_batch
+
+    groups: dict[tuple[Any, ...], list[int]] = {}
+    for i, (built, _) in enumerate(prepared):
+        m = built.model
+        key = (m.nq, m.nv, m.nu, m.nbody, m.njnt, m.ngeom, m.nsite, m.nsensordata, m.neq,
+               float(m.opt.timestep), _feedforward(scenarios[i], options),
+               float(scenarios[i].simulation.settle_s))
+        groups.setdefault(key, []).append(i)
+    records: list[Any] = [None] * len(prepared)
+    for key, members in groups.items():
+        got = warp_batch([prepared[i][0] for i in members], [prepared[i][1] for i in members],
+                         feedforward=key[-2], settle_s=key[-1],
+                         drives=[_drives(scenarios[i]) for i in members])
+        for i, rec in zip(members, got):
+            records[i] = rec
+    return records
+
+
+def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOptions,
+           stages: Stages, *, on_failure: Any = None, model_path: Path | None = None,
+           rec: Any = None) -> Evaluation:
+    """Simulate (unless ``rec``, a record simulated already, is given), check (collisions,
+    clearance, limits), size, select, judge; writes nothing."""
+    feedforward = _feedforward(scenario, options)
+    if options.backend not in ("mujoco", "warp"):
+        from sim.errors import SimulationError
+
+        raise SimulationError(f"unknown backend {options.backend!r}; valid: mujoco, warp")
+    with stages.stage("simulate"):
+        if rec is None and options.backend == "warp":
+            rec = simulate_batch([scenario], [(built, motion)], options)[0]
+        elif rec is None:
+            rec = simulate(built, motion, feedforward=feedforward,
+                           settle_s=scenario.simulation.settle_s, progress=options.progress,
+                           on_failure=on_failure, drives=_drives(scenario))
+    arrays = rec.arrays
+    with stages.stage("checks"):
+        summary = make_summary(scenario, built, motion, rec, feedforward)
+        add_collisions(summary, built, motion, arrays)
+    # post-processing reads the record in memory, never the files a run writes
+    record = runfolder.RunRecord.from_arrays(
+        arrays, joints=list(summary["joints"]), phases=summary["phases"],
+        model_path=model_path, model_xml=None if model_path is not None else built.xml,
+        summary=summary)
+    with stages.stage("sizing"):
+        sizing = _size(scenario, built, record, summary) if options.sizing else None
+        selected = None
+        if options.selection is not None:
+            from sim.analysis.selection import select_actuators
+            from sim.analysis.sizing import joint_armature
+
+            selected = select_actuators(record, built.joint_ids,
+                                        joint_armature(built.model, built.joint_ids),
+                                        options.selection)
+            summary["selection"] = {
+                "catalog": list(options.selection.catalog.sources),
+                "all_joints_served": selected.all_served,
+                "joints": {j.joint: {"motor": j.chosen.motor.id if j.chosen else None,
+                                     "reducer": j.chosen.reducer.id if j.chosen else None}
+                           for j in selected.joints}}
+        checks = run_checks(arrays, summary, scenario.robot,
+                            scenario.simulation.tracking_tolerance_deg, sizing,
+                            clearance_mm=scenario.simulation.clearance_mm,
+                            selection=selected)
+        summary["checks"] = [c.to_dict() for c in checks]
+        summary["verdict"] = verdict(checks)
+        summary["warnings"] = warnings_count(checks)
+    return Evaluation(summary, record, sizing, selected, built)
+
+
+def evaluate_scenario(scenario: Scenario, options: RunOptions | None = None) -> Evaluation:
+    """Everything a run computes (summary, checks, verdict, sizing, selection), in memory:
+    no run folder, no plots, no video. What a metrics-only sweep variant does.
+
+    Raises:
+        CellsimError: A user mistake or an unstable simulation (one-line message).
+    """
+    return evaluate_scenarios([scenario], options)[0]
+
+
+def evaluate_scenarios(scenarios: list[Scenario], options: RunOptions | None = None
+                       ) -> list[Evaluation]:
+    """:func:`evaluate_scenario` for several scenarios; with ``options.backend == "warp"``
+    their simulations run as MuJoCo Warp batches (one per model structure), the rest (plans,
+    checks, sizing) one by one on the host.
+
+    Raises:
+        CellsimError: A user mistake or an unstable simulation (one-line message).
+    """
+    options = options or RunOptions(video=False, plots=False)
+    quiet = RunOptions(**{**options.__dict__, "video": False})
+    staged = [Stages(enabled=False) for _ in scenarios]
+    prepared = [_prepare(s, quiet, st, reuse_plan=True)[:2]
+                for s, st in zip(scenarios, staged)]
+    records: list[Any] = [None] * len(scenarios)
+    if options.backend == "warp":
+        import time
+
+        start = time.perf_counter()
+        records = simulate_batch(scenarios, prepared, options)
+        share = (time.perf_counter() - start) / len(scenarios)
+        for st in staged:
+            st.timings["simulate_batch"] = share
+    out = []
+    for s, (built, motion), st, rec in zip(scenarios, prepared, staged, records):
+        evaluation = _judge(s, built, motion, options, st, rec=rec)
+        evaluation.summary["timings_s"] = dict(st.timings)
+        evaluation.summary["total_wall_s"] = st.total_s
+        evaluation.summary["backend"] = options.backend
+        out.append(evaluation)
+    return out
+
+
+def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[str, Any]:
+    """Run a scenario and write its run folder; returns the summary.
+
+    The folder is built in a temporary sibling and moved into place at the end, so a failed
+    run never leaves a ``summary.json``. A run that fails mid-simulation keeps what it recorded
+    in ``<out_dir>.failed/`` with ``error.txt``.
+
+    Raises:
+        CellsimError: A user mistake or an unstable simulation (one-line message).
+    """
+    options = options or RunOptions()
+    out_dir = runfolder.check_out_dir(options.out_dir if options.out_dir
+                                      else default_out_dir(scenario))
+    stages = Stages(enabled=options.progress)
+    built, motion, video_args = _prepare(scenario, options, stages)
 
     try:
         out_dir.parent.mkdir(parents=True, exist_ok=True)
@@ -177,48 +361,16 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
                     failed.rmdir()
                 os.replace(tmp, failed)
 
-            with stages.stage("simulate"):
-                drives = apply_overrides(scenario.robot.drives, scenario.drives,
-                                         scenario.robot.joints)
-                rec = simulate(built, motion, feedforward=feedforward,
-                               settle_s=scenario.simulation.settle_s, progress=options.progress,
-                               on_failure=keep_failed,
-                               drives=drives if scenario.simulation.motor_speed_limits and drives
-                               else None)
-            arrays = rec.arrays
+            evaluation = _judge(scenario, built, motion, options, stages,
+                                on_failure=keep_failed, model_path=tmp / runfolder.MODEL_XML)
+            summary, record = evaluation.summary, evaluation.record
+            sizing, selected = evaluation.sizing, evaluation.selection
+            arrays = record.arrays
+            if selected is not None:
+                from sim.analysis.selection import write_selection
 
-            with stages.stage("checks"):
-                summary = make_summary(scenario, built, motion, rec, feedforward)
-                add_collisions(summary, built, motion, arrays)
-            # post-processing reads the record in memory, never the files it writes; the folder
-            # only becomes visible (moved into place) once everything succeeded
-            record = runfolder.RunRecord.from_arrays(
-                arrays, joints=list(summary["joints"]), phases=summary["phases"],
-                model_path=tmp / runfolder.MODEL_XML, summary=summary)
-            with stages.stage("sizing"):
-                sizing = _size(scenario, built, record, summary) if options.sizing else None
-                selected = None
-                if options.selection is not None:
-                    from sim.analysis.selection import select_actuators, write_selection
-                    from sim.analysis.sizing import joint_armature
-
-                    selected = select_actuators(record, built.joint_ids,
-                                                joint_armature(built.model, built.joint_ids),
-                                                options.selection)
-                    write_selection(tmp, selected)
-                    summary["selection"] = {
-                        "catalog": list(options.selection.catalog.sources),
-                        "all_joints_served": selected.all_served,
-                        "joints": {j.joint: {"motor": j.chosen.motor.id if j.chosen else None,
-                                             "reducer": j.chosen.reducer.id if j.chosen else None}
-                                   for j in selected.joints}}
-                checks = run_checks(arrays, summary, scenario.robot,
-                                    scenario.simulation.tracking_tolerance_deg, sizing,
-                                    clearance_mm=scenario.simulation.clearance_mm,
-                                    selection=selected)
-                summary["checks"] = [c.to_dict() for c in checks]
-                summary["verdict"] = verdict(checks)
-                summary["warnings"] = warnings_count(checks)
+                write_selection(tmp, selected)
+            # the folder only becomes visible (moved into place) once everything succeeded
             if options.plots:
                 with stages.stage("plots"):
                     from sim.analysis.plots import write_plots
@@ -244,6 +396,7 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
                     write_sizing(tmp, sizing, summary=summary, selection=selected)
             summary["timings_s"] = dict(stages.timings)
             summary["total_wall_s"] = stages.total_s
+            summary["backend"] = options.backend
             runfolder.write_summary(tmp, summary)
             runfolder.write_marker(tmp, state="complete")
             runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran

@@ -24,6 +24,7 @@ payload and against speed scale) and ``sweep.json``.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import multiprocessing
@@ -31,7 +32,7 @@ import os
 import re
 import time
 import traceback
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -214,36 +215,50 @@ class Outcome:
     error: str | None = None
     traceback: str | None = None
     wall_s: float = 0.0
+    selection: dict[str, Any] | None = None
+    timings_s: dict[str, float] = field(default_factory=dict)
 
 
-def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
-    """Rows of sweep.csv for one finished variant (one per joint).
+@dataclass(frozen=True)
+class VariantMetrics:
+    """What a metrics-only runner returns instead of a run folder: the variant's rows of
+    sweep.csv, computed where the variant ran (no file written), and its actuator selection
+    (``selection.json``'s content) when one was made. Small: what crosses a process or a
+    cluster is a few numbers per joint, never the arrays."""
 
-    Peak and RMS torques are recomputed from ``trajectory.npz`` (both sources; the unsuffixed
-    value is the larger of the two); the margin, verdict and limiting check are copied from
-    ``sizing.json`` when the runner wrote one.
+    rows: tuple[dict[str, Any], ...]
+    selection: dict[str, Any] | None = None
+    timings_s: dict[str, float] = field(default_factory=dict)
+
+
+def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequence[str],
+              verdict: str, sized: Mapping[str, Mapping[str, Any]], run_dir: str = ""
+              ) -> list[dict[str, Any]]:
+    """Rows of sweep.csv for one variant (one per joint), from its recorded arrays.
+
+    Args:
+        variant: The variant.
+        arrays: ``t``, ``tau``, ``tau_id``, ``qd_ref``, ``qd`` (N samples; torques N m,
+            speeds rad/s).
+        joints: Joint names, one per column.
+        verdict: The run's verdict (``"pass"``/``"fail"``).
+        sized: ``sizing.json``'s joints by name (``margin_pct``, ``pass``, ``limiting``);
+            empty when the run was not sized.
+        run_dir: The variant's run folder ("" when none was kept).
+
+    Peak and RMS torques are computed from both sources; the unsuffixed value is the larger.
     """
-    traj = load_trajectory(run_dir)
-    summary = load_summary(run_dir)
-    n = traj["tau"].shape[1]
-    names = list(summary.get("joints") or [f"j{k + 1}" for k in range(n)])
-    sizing_path = Path(run_dir) / SIZING_JSON
-    sized: dict[str, dict[str, Any]] = {}
-    if sizing_path.is_file():
-        try:
-            sized = {j["joint"]: j for j in json.loads(sizing_path.read_text()).get("joints", [])}
-        except (json.JSONDecodeError, KeyError, TypeError):
-            sized = {}
-    t = traj["t"]
+    t = np.asarray(arrays["t"], dtype=float)
     rows = []
-    for k, name in enumerate(names):
-        pk_id, _ = peak_abs(t, traj["tau_id"][:, k])
-        pk_sim, _ = peak_abs(t, traj["tau"][:, k])
-        rms_id = float(rms(t, traj["tau_id"][:, k]))
-        rms_sim = float(rms(t, traj["tau"][:, k]))
-        speed = max(peak_abs(t, traj["qd_ref"][:, k])[0], peak_abs(t, traj["qd"][:, k])[0])
-        power = max(peak_abs(t, traj["tau_id"][:, k] * traj["qd_ref"][:, k])[0],
-                    peak_abs(t, traj["tau"][:, k] * traj["qd"][:, k])[0])
+    for k, name in enumerate(joints):
+        tau_id, tau = arrays["tau_id"][:, k], arrays["tau"][:, k]
+        pk_id, _ = peak_abs(t, tau_id)
+        pk_sim, _ = peak_abs(t, tau)
+        rms_id = float(rms(t, tau_id))
+        rms_sim = float(rms(t, tau))
+        speed = max(peak_abs(t, arrays["qd_ref"][:, k])[0], peak_abs(t, arrays["qd"][:, k])[0])
+        power = max(peak_abs(t, tau_id * arrays["qd_ref"][:, k])[0],
+                    peak_abs(t, tau * arrays["qd"][:, k])[0])
         s = sized.get(name, {})
         margin = s.get("margin_pct")
         rows.append({
@@ -256,10 +271,27 @@ def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
             "margin_pct": float("nan") if margin is None else float(margin),
             "pass": ("PASS" if s["pass"] else "FAIL") if "pass" in s else "",
             "limiting": s.get("limiting") or "",
-            "verdict": summary.get("verdict", ""),
+            "verdict": verdict,
             "run_dir": str(run_dir),
         })
     return rows
+
+
+def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
+    """Rows of sweep.csv for one variant whose run folder was written (one per joint): the
+    arrays from ``trajectory.npz``, the margins from ``sizing.json`` when there is one."""
+    traj = load_trajectory(run_dir)
+    summary = load_summary(run_dir)
+    n = traj["tau"].shape[1]
+    names = list(summary.get("joints") or [f"j{k + 1}" for k in range(n)])
+    sizing_path = Path(run_dir) / SIZING_JSON
+    sized: dict[str, dict[str, Any]] = {}
+    if sizing_path.is_file():
+        try:
+            sized = {j["joint"]: j for j in json.loads(sizing_path.read_text()).get("joints", [])}
+        except (json.JSONDecodeError, KeyError, TypeError):
+            sized = {}
+    return rows_from(variant, traj, names, summary.get("verdict", ""), sized, str(run_dir))
 
 
 def run_variant(runner: Callable[[Variant], Any], variant: Variant) -> Outcome:
@@ -267,11 +299,14 @@ def run_variant(runner: Callable[[Variant], Any], variant: Variant) -> Outcome:
     text, so that unpicklable exceptions cannot break the process pool)."""
     t0 = time.perf_counter()
     try:
-        run_dir = runner(variant)
-        if run_dir is None:
+        got = runner(variant)
+        if got is None:
             raise CellsimError("the runner returned no run folder")
-        rows = variant_rows(variant, run_dir)
-        return Outcome(variant, str(run_dir), tuple(rows), wall_s=time.perf_counter() - t0)
+        if isinstance(got, VariantMetrics):  # metrics only: nothing was written
+            return Outcome(variant, None, tuple(got.rows), selection=got.selection,
+                           wall_s=time.perf_counter() - t0, timings_s=dict(got.timings_s))
+        rows = variant_rows(variant, got)
+        return Outcome(variant, str(got), tuple(rows), wall_s=time.perf_counter() - t0)
     except BaseException as exc:  # noqa: BLE001 - reported per variant
         if isinstance(exc, KeyboardInterrupt):
             raise
@@ -308,7 +343,9 @@ class SweepResult:
 def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Sequence[float],
               runner: Callable[[Variant], Any], workers: int | None = None,
               out_dir: str | Path = "sweep", *, mp_context: str = "spawn",
-              progress: bool = True, write: bool = True, raise_on_failure: bool = True
+              progress: bool = True, write: bool = True, raise_on_failure: bool = True,
+              engine: str = "pool", address: str | None = None,
+              batch: Callable[[Sequence[Variant]], Sequence[Any]] | None = None
               ) -> SweepResult:
     """Run every ``(payload, speed_scale)`` variant of ``base_scenario`` and tabulate them.
 
@@ -325,6 +362,13 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
         progress: Show a progress bar (tqdm; silent when not a terminal).
         write: Write ``sweep.csv``, ``sweep.md``, ``sweep.json``, ``sweep.png``.
         raise_on_failure: Raise :class:`SweepError` after writing when a variant failed.
+        engine: ``"pool"`` (a process pool on this machine) or ``"ray"`` (Ray tasks: a local
+            Ray instance, or the cluster at ``address``); see :data:`ENGINES`.
+        address: Ray only: ``"auto"`` (the cluster this machine belongs to), ``"HOST:PORT"``,
+            or None to start a local instance with ``workers`` CPUs.
+        batch: Instead of ``runner`` per variant: one call with every variant, returning what
+            the runner would for each, in order (a batched backend: MuJoCo Warp); runs in
+            this process, the engine is not used.
 
     Returns:
         The :class:`SweepResult`.
@@ -334,6 +378,13 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
     """
     if not callable(runner):
         raise SweepError(f"runner: {runner!r} is not callable")
+    if engine not in ENGINES:
+        raise SweepError(f"engine: unknown {engine!r}; valid: {', '.join(ENGINES)}")
+    if address is not None and engine != "ray":
+        raise SweepError(f"--address {address!r} is for --engine ray (the pool runs on this "
+                         "machine)")
+    if engine == "ray":
+        _import_ray()  # before any folder is made
     from sim.simulation import runfolder
 
     # the sweep folder is cellsim's, like a run folder: never the working directory, a file,
@@ -361,21 +412,29 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
     t0 = time.perf_counter()
     results: list[Outcome | None] = [None] * len(variants)
     try:
-        if workers == 1:
+        if batch is not None:
+            _run_batch(batch, variants, results)
+            bar.update(len(variants))
+        elif engine == "ray":
+            _run_on_ray(runner, variants, results, address, workers, bar)
+        elif workers == 1:
             for v in variants:
                 results[v.index] = run_variant(runner, v)
                 bar.update()
         else:
             ctx = multiprocessing.get_context(mp_context)
             with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-                futures = {pool.submit(run_variant, runner, v): v for v in variants}
+                futures = {pool.submit(run_group, runner, g): g
+                           for g in task_groups(variants, workers)}
                 for fut in as_completed(futures):
-                    v = futures[fut]
+                    group = futures[fut]
                     try:
-                        results[v.index] = fut.result()
+                        for o in fut.result():
+                            results[o.variant.index] = o
                     except Exception as exc:  # the worker died (BrokenProcessPool, pickling)
-                        results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {exc}")
-                    bar.update()
+                        for v in group:
+                            results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {exc}")
+                    bar.update(len(group))
     finally:
         bar.close()
     result = SweepResult(outcomes=[r for r in results if r is not None], workers=workers,
@@ -389,6 +448,128 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
         raise SweepError(f"{len(failures)} of {len(result.outcomes)} sweep variants failed; first: "
                          f"{first.variant.label}: {first.error}{where}")
     return result
+
+
+#: Where variants run: a process pool on this machine, or Ray (a local instance or a cluster).
+ENGINES: tuple[str, ...] = ("pool", "ray")
+
+
+def _import_ray() -> Any:
+    try:
+        import ray
+    except ImportError:
+        raise SweepError("--engine ray needs Ray: pip install 'cellsim[ray]' (or use "
+                         "--engine pool)") from None
+    return ray
+
+
+def task_groups(variants: Sequence[Variant], workers: int) -> list[list[Variant]]:
+    """The variants cut into tasks for ``workers`` parallel workers: the variants of one speed
+    scale run together, in one worker, one after the other (a plan depends on the speed scale,
+    not on the payload, so the worker plans once and reuses it), split into enough tasks that
+    every worker has at least two to take. The results do not depend on the grouping (they
+    are gathered by variant index)."""
+    by_speed: dict[float, list[Variant]] = {}
+    for v in variants:
+        by_speed.setdefault(v.speed_scale, []).append(v)
+    per_speed = max(1, math.ceil(2 * max(workers, 1) / len(by_speed)))
+    groups: list[list[Variant]] = []
+    for members in by_speed.values():
+        size = max(1, math.ceil(len(members) / per_speed))
+        groups.extend(members[k:k + size] for k in range(0, len(members), size))
+    return groups
+
+
+def run_group(runner: Callable[[Variant], Any], variants: Sequence[Variant]) -> list[Outcome]:
+    """Run variants one after the other in this process (a task of a parallel sweep)."""
+    return [run_variant(runner, v) for v in variants]
+
+
+def _run_batch(batch: Callable[[Sequence[Variant]], Sequence[Any]],
+               variants: Sequence[Variant], results: list[Outcome | None]) -> None:
+    """One batched call for every variant; an error stops them all (it is reported for each)."""
+    t0 = time.perf_counter()
+    try:
+        got = list(batch(variants))
+    except BaseException as exc:  # noqa: BLE001 - reported per variant
+        if isinstance(exc, KeyboardInterrupt):
+            raise
+        msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        tb = traceback.format_exc()
+        for v in variants:
+            results[v.index] = Outcome(v, None, (), msg, tb)
+        return
+    share = (time.perf_counter() - t0) / max(len(variants), 1)
+    for v, item in zip(variants, got):
+        results[v.index] = run_variant(lambda _v, item=item: item, v)
+        results[v.index] = dataclasses.replace(results[v.index], wall_s=share)
+
+
+def _check_reachable(address: str, timeout_s: float = 5.0) -> None:
+    """Refuse a cluster address nobody answers at (Ray itself would retry for minutes)."""
+    import socket
+
+    where = address.split("://", 1)[-1]
+    host, _, port = where.rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise SweepError(f"--address {address!r}: expected auto or HOST:PORT (the Ray head "
+                         "node's GCS port, 6379 by default)")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s):
+            pass
+    except OSError as exc:
+        raise SweepError(f"--address {address}: cannot connect to Ray: "
+                         f"{exc.strerror or exc}") from None
+
+
+def _run_on_ray(runner: Callable[[Variant], Any], variants: Sequence[Variant],
+                results: list[Outcome | None], address: str | None, workers: int,
+                bar: Any) -> None:
+    """Run the variants as Ray tasks (one CPU each) and put their outcomes in ``results``
+    (variant order, whatever the completion order).
+
+    With ``address`` None a local Ray instance with ``workers`` CPUs is started and shut down
+    afterwards; otherwise cellsim connects to that cluster (which must have the same cellsim
+    installed on every node) and leaves it running. A task that dies (a worker killed, a node
+    lost) becomes that variant's error; the others go on.
+    """
+    import logging
+
+    ray = _import_ray()
+    if address not in (None, "auto"):
+        _check_reachable(address)
+    started = not ray.is_initialized()
+    if started:
+        kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
+                                  "logging_level": logging.ERROR, "configure_logging": False}
+        if address is None:
+            kwargs["num_cpus"] = workers
+        try:
+            ray.init(address=address, **kwargs)
+        except (ConnectionError, RuntimeError, ValueError) as exc:
+            first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            raise SweepError(f"--address {address}: cannot connect to Ray: {first}"
+                             if address else f"cannot start a local Ray instance: {first}"
+                             ) from None
+    try:
+        task = ray.remote(num_cpus=1, max_retries=0)(run_group)
+        cpus = workers if address is None else int(ray.cluster_resources().get("CPU", workers))
+        pending = {task.remote(runner, g): g for g in task_groups(variants, cpus)}
+        while pending:
+            done, _ = ray.wait(list(pending), num_returns=1)
+            for ref in done:
+                group = pending.pop(ref)
+                try:
+                    for o in ray.get(ref):
+                        results[o.variant.index] = o
+                except Exception as exc:  # noqa: BLE001 - a lost worker or node
+                    first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+                    for v in group:
+                        results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {first}")
+                bar.update(len(group))
+    finally:
+        if started:
+            ray.shutdown()
 
 
 # --------------------------------------------------------------------------------------------
