@@ -236,10 +236,12 @@ def _argv(draw_command: str, values: list[str], base: Path, out: Path) -> list[s
 
 FLAGS = ["--payload", "--speed-scale", "--workers", "--fps", "--width", "--height", "--camera",
          "--out", "--catalog", "--life-h", "--dwell-s", "--rank", "--inertia-ratio-max",
-         "--euler-zyx-deg", "--gl", "--select", "--strict", "--json"]
+         "--euler-zyx-deg", "--gl", "--select", "--strict", "--json", "--engine", "--address",
+         "--backend", "--keep-runs", "--plots"]
 VALUES = st.sampled_from(["nan", "inf", "-inf", "1e308", "-1", "0", "1e-300", "", "x" * 300,
                           "..", ".", "/", "0:1e308:1e-300", "1,2,,3", "-0", "999999999",
-                          "egl", "osmesa", "mass", "overview", "/dev/null", "1:0:1"])
+                          "egl", "osmesa", "mass", "overview", "/dev/null", "1:0:1", "ray",
+                          "127.0.0.1:1", "auto"])
 
 
 @pytest.mark.slow
@@ -252,8 +254,8 @@ def test_every_command_with_hostile_arguments(tmp_path, capsys, monkeypatch, com
     monkeypatch.chdir(tmp_path)  # relative --out values land here, never in the checkout
     base = tmp_path / "s.toml"
     base.write_text(BASE)
-    values = [x for flag, value in extra for x in ((flag,) if flag in ("--select", "--strict",
-                                                                     "--json") else (flag, value))]
+    values = [x for flag, value in extra for x in ((flag,) if flag in (
+        "--select", "--strict", "--json", "--keep-runs", "--plots") else (flag, value))]
     with bounded():
         _answer(_argv(command, values, base, tmp_path), capsys)
 

@@ -394,8 +394,12 @@ def _namespace_mounts() -> bool:
 
     if shutil.which("unshare") is None:
         return False
-    probe = subprocess.run(["unshare", "-rm", "sh", "-c", "mount -t tmpfs -o size=1m tmpfs /mnt"],
-                           capture_output=True, timeout=30)
+    try:
+        probe = subprocess.run(["unshare", "-rm", "sh", "-c",
+                                "mount -t tmpfs -o size=1m tmpfs /mnt"],
+                               capture_output=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return False
     return probe.returncode == 0
 
 
@@ -429,6 +433,15 @@ with open(os.path.join(disk, "filler"), "wb") as fh:   # room for model.xml, not
 seen["full_video"] = run(os.path.join(disk, "run"))
 seen["summary_kept"] = open(os.path.join(disk, "run", "summary.json"), "rb").read() == summary
 seen["left"] = sorted(os.listdir(disk))
+with open(os.path.join(disk, "filler2"), "wb") as fh:   # nothing left at all
+    try:
+        fh.write(b"\0" * (1 << 20))
+    except OSError:
+        pass
+p = subprocess.run([sys.executable, "-I", "-m", "sim", "workspace", "lrmate200ic5l", "--out",
+                    os.path.join(disk, "ws.png")], capture_output=True, text=True)
+seen["workspace_full"] = {"rc": p.returncode, "err": p.stderr}
+seen["ws_left"] = sorted(n for n in os.listdir(disk) if "ws.png" in n)
 ro = os.path.join(root, "ro")
 sh("mount", "--bind", ro, ro)
 sh("mount", "-o", "remount,bind,ro", ro)
@@ -465,6 +478,10 @@ def test_a_real_full_disk_and_a_read_only_parent(tmp_path):
             "No space left on device" in err, (case, err)
     assert seen["summary_kept"]
     assert seen["left"] == ["filler", "run"]  # no hidden temporary folder, no lock
+    rc, err = seen["workspace_full"]["rc"], seen["workspace_full"]["err"]
+    assert rc == 2 and err.count("\n") == 1 and "No space left on device" in err, err
+    assert str(disk / "ws.png") in err
+    assert seen["ws_left"] == []  # neither a half-written picture nor its temporary file
     rc, err = seen["read_only"]["rc"], seen["read_only"]["err"]
     assert rc == 2 and err.count("\n") == 1 and "Read-only file system" in err, err
     assert str(tmp_path / "ro") in err

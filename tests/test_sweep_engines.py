@@ -87,3 +87,15 @@ def test_an_unreachable_ray_cluster_is_one_line(tmp_path, capsys):
                "--address", "127.0.0.1:1"])
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1 and "cannot connect to Ray" in err, err
+    assert not (tmp_path / "s").exists()  # refused before the sweep folder was made
+
+
+def test_warp_backend_options_are_checked(tmp_path, capsys):
+    path = SCENARIO
+    for extra, words in ((["--engine", "ray"], "without --engine ray"),
+                         (["--keep-runs"], "--keep-runs is for --backend mujoco")):
+        rc = main(["size", str(path), "--out", str(tmp_path / "s"), "--quiet", "--backend",
+                   "warp", *extra])
+        err = capsys.readouterr().err
+        assert rc == 2 and words in err, err
+    assert not (tmp_path / "s").exists()

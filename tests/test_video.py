@@ -134,6 +134,7 @@ def test_ffmpeg_errors_reach_the_message_through_its_log(tmp_path: Path) -> None
     from sim.render.video import _ffmpeg_log, _ffmpeg_said
 
     target = tmp_path / "missing" / "x.mp4"
+    before = os.environ.get("FFREPORT")
     with _ffmpeg_log() as log:
         assert log is not None and log.is_file()
         proc = subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-v", "quiet", "-f", "lavfi",
@@ -142,7 +143,7 @@ def test_ffmpeg_errors_reach_the_message_through_its_log(tmp_path: Path) -> None
         said = _ffmpeg_said(log)
     assert proc.returncode != 0 and proc.stderr == ""
     assert str(target) in said and "No such file or directory" in said
-    assert not log.exists()
+    assert not log.exists() and os.environ.get("FFREPORT") == before
 
 
 def test_tiled_video_and_result(run_dir: Path, tmp_path: Path) -> None:

@@ -19,8 +19,6 @@ import csv
 import html
 import io
 import json
-import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -37,6 +35,7 @@ from sim.analysis.sizing import (
     load_summary,
     peak_envelope,
 )
+from sim.core.files import write_atomic
 from sim.simulation.collisions import CLEARANCE_RANGE_M
 from sim.simulation.runfolder import (
     REPORT_HTML,
@@ -58,36 +57,6 @@ REQUIRED_COLUMNS = ("joint", "peak_torque_nm", "rms_torque_nm", "peak_speed_rad_
 # --------------------------------------------------------------------------------------------
 # Atomic files
 # --------------------------------------------------------------------------------------------
-
-def write_atomic(path: str | Path, data: bytes | str) -> Path:
-    """Write ``data`` to ``path`` through a temporary file and ``os.replace``.
-
-    Args:
-        path: Destination; its folder is created when missing.
-        data: Bytes, or text (written as UTF-8).
-
-    Returns:
-        The destination path.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    raw = data.encode("utf-8") if isinstance(data, str) else data
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(raw)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-    return path
-
 
 def csv_text(columns: Sequence[str], rows: Sequence[Mapping[str, Any]]) -> str:
     """CSV text with a header; floats in their shortest exact form, NaN/None as empty cells."""

@@ -116,14 +116,14 @@ def time_integral(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64] | float:
     x = np.asarray(x, dtype=float)
     dt = np.diff(t)
     mid = 0.5 * (x[1:] + x[:-1])
-    terms = dt * mid if mid.ndim == 1 else dt[:, None] * mid
-    # an exactly rounded sum (math.fsum): the same bits whatever BLAS, its thread count or the
-    # arrays' alignment (a sweep on Ray, one thread per task, gives the pool's table exactly)
-    if terms.ndim == 1:
-        return math.fsum(terms)
+    terms = dt.reshape((-1,) + (1,) * (mid.ndim - 1)) * mid
     flat = terms.reshape(terms.shape[0], -1)
-    out = np.array([math.fsum(flat[:, k]) for k in range(flat.shape[1])])
-    return out.reshape(terms.shape[1:])
+    # an exactly rounded sum (math.fsum): the same bits whatever BLAS, its thread count or the
+    # arrays' alignment (a sweep on Ray, one thread per task, gives the pool's table exactly);
+    # numpy's sum where a term is not finite (fsum raises on inf - inf and on overflow)
+    out = np.array([math.fsum(col) if np.all(np.isfinite(col)) else float(np.sum(col))
+                    for col in flat.T])
+    return float(out[0]) if terms.ndim == 1 else out.reshape(terms.shape[1:])
 
 
 def rms(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64] | float:

@@ -111,7 +111,7 @@ def run_variant(variant: Variant, select: dict | None = None, keep_runs: bool = 
     acceleration limits are not enforced): it stays in the tables with negative margins and a
     failed verdict instead of being dropped.
     """
-    from sim.pipeline.run import RunOptions, evaluate_scenario, run_scenario
+    from sim.pipeline.run import RunOptions, evaluate_scenario, run_and_write
 
     scenario = _variant_scenario(variant)
     selection = None
@@ -119,10 +119,11 @@ def run_variant(variant: Variant, select: dict | None = None, keep_runs: bool = 
         from sim.pipeline.run import selection_options
 
         selection = selection_options(scenario, **(select or {}))
-    if keep_runs:
-        run_scenario(scenario, RunOptions(out_dir=variant.run_dir, video=False, plots=plots,
-                                          progress=False, selection=selection))
-        return Path(variant.run_dir)
+    if keep_runs:  # the same rows, from every sample in memory, and the folder written
+        ev = run_and_write(scenario, RunOptions(out_dir=variant.run_dir, video=False,
+                                                plots=plots, progress=False,
+                                                selection=selection))
+        return _metrics(variant, ev, run_dir=str(variant.run_dir))
     return _metrics(variant, evaluate_scenario(scenario, RunOptions(
         video=False, plots=False, progress=False, selection=selection)))
 
@@ -130,22 +131,24 @@ def run_variant(variant: Variant, select: dict | None = None, keep_runs: bool = 
 def _variant_scenario(variant: Variant) -> Any:
     import dataclasses
 
-    from sim.scenario import load_scenario
+    from sim.scenario import Scenario, load_scenario
 
-    scenario = load_scenario(variant.scenario).scaled(variant.speed_scale, variant.payload_kg)
+    base = variant.scenario if isinstance(variant.scenario, Scenario) \
+        else load_scenario(variant.scenario)
+    scenario = base.scaled(variant.speed_scale, variant.payload_kg)
     return dataclasses.replace(scenario, simulation=scenario.simulation.model_copy(
         update={"enforce_speed_limits": False, "enforce_accel_limits": False}))
 
 
-def _metrics(variant: Variant, ev: Any) -> Any:
+def _metrics(variant: Variant, ev: Any, run_dir: str | None = None) -> Any:
     from sim.pipeline.sweep import VariantMetrics, rows_from
 
     sized = ({j["joint"]: j for j in ev.sizing.to_dict()["joints"]}
              if ev.sizing is not None else {})
     rows = rows_from(variant, ev.record.arrays, ev.summary["joints"], ev.summary["verdict"],
-                     sized)
+                     sized, run_dir or "")
     return VariantMetrics(tuple(rows), ev.selection.to_dict() if ev.selection else None,
-                          timings_s=dict(ev.summary.get("timings_s", {})))
+                          timings_s=dict(ev.summary.get("timings_s", {})), run_dir=run_dir)
 
 
 def run_batch(variants: list[Variant], select: dict | None = None) -> list[Any]:
@@ -153,13 +156,21 @@ def run_batch(variants: list[Variant], select: dict | None = None) -> list[Any]:
     as batches of one model structure, then checked and sized one by one; metrics only."""
     from sim.pipeline.run import RunOptions, evaluate_scenarios, selection_options
 
-    scenarios = [_variant_scenario(v) for v in variants]
+    # speed-major: the variants of one speed scale follow each other, so each plan is made
+    # once and reused for every payload
+    order = sorted(range(len(variants)),
+                   key=lambda i: (variants[i].speed_scale, variants[i].payload_kg))
+    scenarios = [_variant_scenario(variants[i]) for i in order]
     selection = None
     if select is not None or scenarios[0].sizing.select:
         selection = selection_options(scenarios[0], **(select or {}))
     evaluations = evaluate_scenarios(scenarios, RunOptions(
-        video=False, plots=False, progress=False, selection=selection, backend="warp"))
-    return [_metrics(v, ev) for v, ev in zip(variants, evaluations)]
+        video=False, plots=False, progress=False, selection=selection, backend="warp"),
+        labels=[variants[i].label for i in order])
+    out: list[Any] = [None] * len(variants)
+    for i, ev in zip(order, evaluations):
+        out[i] = _metrics(variants[i], ev)
+    return out
 
 
 def run(args: argparse.Namespace) -> int:
@@ -199,8 +210,12 @@ def run(args: argparse.Namespace) -> int:
         if args.keep_runs:
             raise CellsimError("--keep-runs is for --backend mujoco (a Warp batch computes "
                                "metrics only)")
+        from sim.simulation.warp_batch import default_device
+
+        default_device()  # MuJoCo Warp is there (else one line), before any folder is made
         batch = functools.partial(run_batch, select=select)
-    result = run_sweep(str(scenario.source), payloads, scales,
+    # the loaded scenario travels with each variant (a Ray node needs no copy of the file)
+    result = run_sweep(scenario, payloads, scales,
                        functools.partial(run_variant, select=select, keep_runs=args.keep_runs,
                                          plots=args.plots),
                        workers=min(workers, len(payloads) * len(scales)), out_dir=out,

@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 from sim import __version__
 from sim.analysis.sizing import SizingResult, apply_overrides
 from sim.analysis.verdict import run_checks, verdict, warnings_count
-from sim.errors import InternalError, RunFolderError
+from sim.errors import InternalError, RenderError, RunFolderError
 from sim.pipeline.stages import Stages
 from sim.scenario import Scenario
 from sim.simulation import runfolder
@@ -200,7 +200,7 @@ def _drives(scenario: Scenario) -> Any:
 
 
 def simulate_batch(scenarios: list[Scenario], prepared: list[tuple[BuiltCell, Any]],
-                   options: RunOptions) -> list[Any]:
+                   options: RunOptions, labels: list[str] | None = None) -> list[Any]:
     """Simulate prepared variants on MuJoCo Warp, one batch per model structure (a payload of
     0 kg has no payload body, so it batches apart from the others); records in order."""
     from sim.simulation.warp_batch import simulate_batch as warp_batch
@@ -213,10 +213,12 @@ def simulate_batch(scenarios: list[Scenario], prepared: list[tuple[BuiltCell, An
                float(scenarios[i].simulation.settle_s))
         groups.setdefault(key, []).append(i)
     records: list[Any] = [None] * len(prepared)
+    names = labels or [s.name for s in scenarios]
     for key, members in groups.items():
         got = warp_batch([prepared[i][0] for i in members], [prepared[i][1] for i in members],
                          feedforward=key[-2], settle_s=key[-1],
-                         drives=[_drives(scenarios[i]) for i in members])
+                         drives=[_drives(scenarios[i]) for i in members],
+                         labels=[names[i] for i in members])
         for i, rec in zip(members, got):
             records[i] = rec
     return records
@@ -284,11 +286,11 @@ def evaluate_scenario(scenario: Scenario, options: RunOptions | None = None) -> 
     return evaluate_scenarios([scenario], options)[0]
 
 
-def evaluate_scenarios(scenarios: list[Scenario], options: RunOptions | None = None
-                       ) -> list[Evaluation]:
+def evaluate_scenarios(scenarios: list[Scenario], options: RunOptions | None = None,
+                       labels: list[str] | None = None) -> list[Evaluation]:
     """:func:`evaluate_scenario` for several scenarios; with ``options.backend == "warp"``
     their simulations run as MuJoCo Warp batches (one per model structure), the rest (plans,
-    checks, sizing) one by one on the host.
+    checks, sizing) one by one on the host. ``labels`` name the scenarios in errors.
 
     Raises:
         CellsimError: A user mistake or an unstable simulation (one-line message).
@@ -303,7 +305,7 @@ def evaluate_scenarios(scenarios: list[Scenario], options: RunOptions | None = N
         import time
 
         start = time.perf_counter()
-        records = simulate_batch(scenarios, prepared, options)
+        records = simulate_batch(scenarios, prepared, options, labels)
         share = (time.perf_counter() - start) / len(scenarios)
         for st in staged:
             st.timings["simulate_batch"] = share
@@ -327,6 +329,12 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
     Raises:
         CellsimError: A user mistake or an unstable simulation (one-line message).
     """
+    return run_and_write(scenario, options).summary
+
+
+def run_and_write(scenario: Scenario, options: RunOptions | None = None) -> Evaluation:
+    """:func:`run_scenario`, returning the whole evaluation in memory (every sample, not only
+    what ``trajectory.npz`` keeps at ``record_hz``) besides writing the run folder."""
     options = options or RunOptions()
     out_dir = runfolder.check_out_dir(options.out_dir if options.out_dir
                                       else default_out_dir(scenario))
@@ -400,6 +408,11 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
             runfolder.write_summary(tmp, summary)
             runfolder.write_marker(tmp, state="complete")
             runfolder.check_out_dir(out_dir)  # again: the place may have changed while we ran
+        except RenderError as exc:  # name the run folder, not its hidden temporary sibling
+            shutil.rmtree(tmp, ignore_errors=True)
+            if str(tmp) in str(exc):
+                raise RenderError(str(exc).replace(str(tmp), str(out_dir))) from exc
+            raise
         except OSError as exc:
             shutil.rmtree(tmp, ignore_errors=True)
             # the user knows the run folder, not its hidden temporary sibling (gone by now)
@@ -422,7 +435,7 @@ def run_scenario(scenario: Scenario, options: RunOptions | None = None) -> dict[
         stale = runfolder.failed_folder(out_dir)
         if runfolder.is_run_folder(stale):
             shutil.rmtree(stale, ignore_errors=True)
-    return summary
+    return evaluation
 
 
 def add_collisions(summary: dict[str, Any], built: BuiltCell, motion: Any,

@@ -222,13 +222,15 @@ class Outcome:
 @dataclass(frozen=True)
 class VariantMetrics:
     """What a metrics-only runner returns instead of a run folder: the variant's rows of
-    sweep.csv, computed where the variant ran (no file written), and its actuator selection
-    (``selection.json``'s content) when one was made. Small: what crosses a process or a
-    cluster is a few numbers per joint, never the arrays."""
+    sweep.csv, computed where the variant ran from every sample in memory, its actuator
+    selection (``selection.json``'s content) when one was made, its stage timings, and its run
+    folder when one was kept. Small: what crosses a process or a cluster is a few numbers per
+    joint, never the arrays."""
 
     rows: tuple[dict[str, Any], ...]
     selection: dict[str, Any] | None = None
     timings_s: dict[str, float] = field(default_factory=dict)
+    run_dir: str | None = None
 
 
 def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequence[str],
@@ -302,8 +304,8 @@ def run_variant(runner: Callable[[Variant], Any], variant: Variant) -> Outcome:
         got = runner(variant)
         if got is None:
             raise CellsimError("the runner returned no run folder")
-        if isinstance(got, VariantMetrics):  # metrics only: nothing was written
-            return Outcome(variant, None, tuple(got.rows), selection=got.selection,
+        if isinstance(got, VariantMetrics):  # computed in memory (a run folder or none)
+            return Outcome(variant, got.run_dir, tuple(got.rows), selection=got.selection,
                            wall_s=time.perf_counter() - t0, timings_s=dict(got.timings_s))
         rows = variant_rows(variant, got)
         return Outcome(variant, str(got), tuple(rows), wall_s=time.perf_counter() - t0)
@@ -383,8 +385,10 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
     if address is not None and engine != "ray":
         raise SweepError(f"--address {address!r} is for --engine ray (the pool runs on this "
                          "machine)")
-    if engine == "ray":
-        _import_ray()  # before any folder is made
+    if engine == "ray":  # before any folder is made
+        _import_ray()
+        if address not in (None, "auto"):
+            _check_reachable(address)
     from sim.simulation import runfolder
 
     # the sweep folder is cellsim's, like a run folder: never the working directory, a file,
@@ -499,6 +503,12 @@ def _run_batch(batch: Callable[[Sequence[Variant]], Sequence[Any]],
         for v in variants:
             results[v.index] = Outcome(v, None, (), msg, tb)
         return
+    if len(got) != len(variants):
+        msg = (f"InternalError: the batch returned {len(got)} results for {len(variants)} "
+               "variants")
+        for v in variants:
+            results[v.index] = Outcome(v, None, (), msg)
+        return
     share = (time.perf_counter() - t0) / max(len(variants), 1)
     for v, item in zip(variants, got):
         results[v.index] = run_variant(lambda _v, item=item: item, v)
@@ -536,8 +546,6 @@ def _run_on_ray(runner: Callable[[Variant], Any], variants: Sequence[Variant],
     import logging
 
     ray = _import_ray()
-    if address not in (None, "auto"):
-        _check_reachable(address)
     started = not ray.is_initialized()
     if started:
         kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,

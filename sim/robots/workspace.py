@@ -163,6 +163,14 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
     fig.suptitle(title or f"{model.name} workspace")
     fig.tight_layout()
     out = Path(out)
-    fig.savefig(out, dpi=90)
-    plt.close(fig)
+    import io
+
+    from sim.core.files import write_atomic
+
+    try:
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=90)
+        write_atomic(out, buf.getvalue())  # a full disk leaves no half-written picture
+    finally:
+        plt.close(fig)
     return reach

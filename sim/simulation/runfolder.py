@@ -25,14 +25,14 @@ from __future__ import annotations
 
 import json
 import zipfile
-from collections.abc import Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from sim.core.files import naming
 from sim.errors import RunFolderError
 
 # ------------------------------------------------------------------------------------ schema
@@ -611,19 +611,6 @@ def _check_out_dir(raw: Path) -> Path:
 
 
 # ------------------------------------------------------------------------------------ writing
-@contextmanager
-def naming(path: str | Path) -> Iterator[None]:
-    """Give an operating-system error raised inside the block the path being written when it
-    has none (numpy's and zipfile's writers drop it: a full disk would say only "No space left
-    on device")."""
-    try:
-        yield
-    except OSError as exc:
-        if exc.filename is None and exc.errno is not None:
-            raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from exc
-        raise
-
-
 def write_text(folder: str | Path, name: str, text: str) -> Path:
     """Write one of the folder's text files (``MODEL_XML``, ``SCENARIO_TOML``, ...)."""
     path = Path(folder) / name

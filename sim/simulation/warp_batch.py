@@ -26,6 +26,7 @@ Warp compiles its kernels on first use (about a minute on the CPU device) and ca
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -56,11 +57,32 @@ def _import_warp() -> tuple[Any, Any]:
         wp.config.quiet = True  # no banner
         if hasattr(wp, "LOG_WARNING"):  # no "Module ... load on device" line per kernel
             wp.config.log_level = wp.LOG_WARNING
+        _quiet_init(wp)
         import mujoco_warp as mjw
     except ImportError:
         raise SimulationError("--backend warp needs MuJoCo Warp: pip install 'cellsim[warp]' "
                               "(or use --backend mujoco)") from None
     return wp, mjw
+
+
+def _quiet_init(wp: Any) -> None:
+    """Initialise Warp with its standard error set aside: without a GPU it prints "Warp CUDA
+    warning: Could not find or load the NVIDIA CUDA driver" from C, which a run on Warp's CPU
+    device does not need (:func:`default_device` says which device runs)."""
+    import sys
+    import tempfile
+
+    sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        with tempfile.TemporaryFile() as sink:
+            os.dup2(sink.fileno(), 2)
+            try:
+                wp.init()
+            finally:
+                os.dup2(saved, 2)
+    finally:
+        os.close(saved)
 
 
 def default_device() -> str:
@@ -83,7 +105,7 @@ def _model_arrays(model: Any) -> dict[str, NDArray[Any]]:
     return out
 
 
-def _batched_fields(models: Sequence[Any]) -> list[str]:
+def _batched_fields(models: Sequence[Any], labels: Sequence[str]) -> list[str]:
     """The model arrays that differ between the variants (each must be batchable in MuJoCo
     Warp); the sizes and every other array must agree.
 
@@ -101,9 +123,10 @@ def _batched_fields(models: Sequence[Any]) -> list[str]:
         for name, value in _model_arrays(model).items():
             ref = first.get(name)
             if ref is None or ref.shape != value.shape:
-                raise SimulationError(f"--backend warp: variant {i} has another model structure "
-                                      f"({name} has shape {value.shape}, not {getattr(ref, 'shape', None)}); "
-                                      "a batch needs one")
+                raise SimulationError(
+                    f"--backend warp: {labels[i]} has another model structure than {labels[0]} "
+                    f"({name} has shape {value.shape}, not {getattr(ref, 'shape', None)}); a "
+                    "batch needs one")
             if name in differ or np.array_equal(ref, value, equal_nan=True):
                 continue
             if name not in warp_fields:
@@ -119,7 +142,8 @@ def _batched_fields(models: Sequence[Any]) -> list[str]:
 def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
                    feedforward: bool, settle_s: float = 0.0,
                    drives: Sequence[Sequence[Drive] | None] | None = None,
-                   device: str | None = None) -> list[SimulationRecord]:
+                   device: str | None = None, labels: Sequence[str] | None = None
+                   ) -> list[SimulationRecord]:
     """Simulate every variant's reference motion as one MuJoCo Warp batch.
 
     Args:
@@ -130,6 +154,7 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
         drives: Per variant, the drives whose torque-speed curves limit the actuators (None:
             the constant ``forcerange``).
         device: Warp device (``"cpu"``, ``"cuda"``, ``"cuda:1"``); default :func:`default_device`.
+        labels: How errors name each variant (default ``"variant 0"``, ...).
 
     Returns:
         One :class:`~sim.simulation.simulate.SimulationRecord` per variant, in order; the
@@ -145,6 +170,7 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
     if len(builts) != len(motions) or not builts:
         raise SimulationError("simulate_batch: one motion per compiled cell, at least one")
     models = [b.model for b in builts]
+    labels = list(labels) if labels is not None else [f"variant {i}" for i in range(len(builts))]
     dt = float(models[0].opt.timestep)
     if any(float(m.opt.timestep) != dt for m in models):
         raise SimulationError("--backend warp: the variants' timesteps differ; a batch steps "
@@ -191,13 +217,15 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
         frange[:, w] = base
         frange[:, w, built.robot_act, 0] = -lim
         frange[:, w, built.robot_act, 1] = lim
-    varying_limits = not all(np.array_equal(frange[0, w], frange[k, w])
-                             for w in range(nworld) for k in (n_max // 2, n_max))
+    # limits that differ from the models' force ranges at any step (a drive's torque-speed
+    # curve binding) are copied to the device every step
+    model_ranges = np.stack([m.actuator_forcerange for m in models]).astype(np.float32)
+    varying_limits = bool(np.any(frange != model_ranges[None]))
 
     device = device or default_device()
     try:
         with wp.ScopedDevice(device):
-            batched = _batched_fields(models)
+            batched = _batched_fields(models, labels)
             if varying_limits and "actuator_forcerange" not in batched:
                 batched.append("actuator_forcerange")
             try:
@@ -233,6 +261,8 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
             wp.copy(qpos_dev[0], dw.qpos)
             wp.copy(qvel_dev[0], dw.qvel)
             start = time.perf_counter()
+            nacon_dev = wp.zeros(n_max + 1, dtype=int)
+            nefc_dev = wp.zeros((n_max + 1, nworld), dtype=int)
             for k in range(n_max):
                 wp.copy(dw.ctrl, ctrl_dev[k])
                 if frange_dev is not None:
@@ -241,6 +271,8 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
                 wp.copy(qpos_dev[k + 1], dw.qpos)
                 wp.copy(qvel_dev[k + 1], dw.qvel)
                 wp.copy(sens_dev[k], dw.sensordata)  # computed at state k, before the step
+                wp.copy(nacon_dev, dw.nacon, dest_offset=k, count=1)
+                wp.copy(nefc_dev[k], dw.nefc)
             wp.copy(dw.ctrl, ctrl_dev[n_max])
             if frange_dev is not None:
                 wp.copy(mw.actuator_forcerange, frange_dev[n_max])
@@ -248,6 +280,16 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
             wp.copy(sens_dev[n_max], dw.sensordata)
             wp.synchronize()
             wall = time.perf_counter() - start
+            # MuJoCo Warp drops contacts and constraints beyond its buffers without a warning
+            # (MuJoCo in C warns, and the CPU path fails on it): fail here too
+            if int(nacon_dev.numpy().max()) >= int(dw.naconmax):
+                raise SimulationError(f"--backend warp: more than {int(dw.naconmax)} contacts "
+                                      "at once in the batch; use --backend mujoco")
+            worst = nefc_dev.numpy().max(axis=0)
+            if np.any(worst >= int(dw.njmax)):
+                w = int(np.argmax(worst))
+                raise SimulationError(f"--backend warp: {labels[w]} has more than "
+                                      f"{int(dw.njmax)} constraints at once; use --backend mujoco")
             qpos = qpos_dev.numpy().astype(np.float64)
             qvel = qvel_dev.numpy().astype(np.float64)
             sens = sens_dev.numpy().astype(np.float64)
@@ -264,7 +306,7 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
         bad = ~(np.all(np.isfinite(q), axis=1) & np.all(np.isfinite(v), axis=1))
         if bad.any():
             k = int(np.argmax(bad))
-            raise SimulationError(f"variant {w}: simulation unstable at t = {p['t'][k]:.4f} s "
+            raise SimulationError(f"{labels[w]}: simulation unstable at t = {p['t'][k]:.4f} s "
                                   "(NaN in the state, MuJoCo Warp); try a smaller "
                                   "simulation.timestep_s")
         arrays = _arrays(built, motion, p["t"], p["ref"], p["tau_id"], p["ff"], q, v, s,
