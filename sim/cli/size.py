@@ -28,8 +28,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "size", help="actuator-sizing sweep over payloads and speed scales",
         description="Simulate SCENARIO for every combination of --payload and --speed-scale "
-                    "(in parallel), size every joint's actuator, and write sweep.csv, sweep.md, "
-                    "sweep.json and sweep.png with one run folder per variant. Variants are "
+                    "(in parallel: a process pool, Ray, or one MuJoCo Warp batch), size every "
+                    "joint's actuator, and write sweep.csv, sweep.md, sweep.json and sweep.png "
+                    "(metrics only: nothing per variant unless --keep-runs). Variants are "
                     "simulated even past the robot's speed or acceleration limits (the "
                     "scenario's enforce_* keys are not applied): they stay in the tables with "
                     "negative margins and their run's verdict. Exit 0 when every variant was "
