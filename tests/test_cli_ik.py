@@ -40,7 +40,8 @@ def test_ik_json_round_trip(capsys, name):
     code, out, err = _run(capsys, "ik", name, *_pose_args(name, q), "--all", "--json")
     assert code == 0, err
     doc = json.loads(out)
-    assert set(doc) == {"robot", "solutions"} and doc["robot"] == name
+    assert set(doc) == {"robot", "tool", "solutions"} and doc["robot"] == name
+    assert doc["tool"] is None
     assert len(doc["solutions"]) >= 2
     for s in doc["solutions"]:
         assert set(s) == {"joints_deg", "within_limits"}
@@ -171,3 +172,48 @@ def test_euler_helpers_round_trip():
     for a, b, g in rng.uniform([-3, -1.5, -3], [3, 1.5, 3], size=(20, 3)):
         np.testing.assert_allclose(matrix_to_euler_zyx(euler_zyx_to_matrix(a, b, g)), [a, b, g],
                                    atol=1e-12)
+
+
+@pytest.mark.parametrize("robot, tool, xyz", [
+    ("lrmate200ic5l", "mig_torch", (500.0, 0.0, 300.0)),
+    ("lrmate200ic5l", "vacuum_gripper", (450.0, 100.0, 200.0)),
+    ("lrmate100ib", "mig_torch_long", (520.0, 0.0, 150.0)),
+    ("robot_5r", "mig_torch_long", (900.0, 200.0, 300.0)),
+])
+def test_ik_with_a_tool_puts_the_tool_tip_there(robot, tool, xyz, capsys):
+    """`cellsim ik --tool`: the answer, set on the compiled robot with that tool in MuJoCo,
+    puts the tool's tcp site at X Y Z in frame 0 (an independent check of the closed form with
+    the tool); without --tool, the answer puts the bare robot's tcp there."""
+    import json
+
+    import mujoco
+
+    from sim.cells import build_cell
+    from sim.cells.tools import TOOLS
+    from sim.robots.registry import ROBOTS
+
+    args = ["ik", robot, *(str(v) for v in xyz), "--json"]
+    assert main([*args, "--tool", tool]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["tool"] == tool and doc["solutions"]
+    def tcp_mm(tool_spec, joints_deg):
+        cell = build_cell(None, ROBOTS[robot], tool=tool_spec)
+        model = cell.compile()
+        data = mujoco.MjData(model)
+        for name, v in zip(cell.joint_names, np.deg2rad(joints_deg)):
+            data.qpos[model.joint(name).qposadr[0]] = v
+        mujoco.mj_kinematics(model, data)
+        T0 = cell.world_from_frame0
+        p_world = data.site_xpos[model.site(cell.tcp_site).id]
+        return 1000.0 * (T0[:3, :3].T @ (p_world - T0[:3, 3]))
+
+    assert np.allclose(tcp_mm(TOOLS[tool], doc["solutions"][0]["joints_deg"]), xyz, atol=1e-6)
+    assert main(args) == 0
+    bare = json.loads(capsys.readouterr().out)
+    assert np.allclose(tcp_mm(None, bare["solutions"][0]["joints_deg"]), xyz, atol=1e-6)
+
+
+def test_ik_unknown_tool_lists_the_tools(capsys):
+    assert main(["ik", "lrmate200ic5l", "500", "0", "300", "--tool", "torch9"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "mig_torch" in err and "vacuum_gripper" in err

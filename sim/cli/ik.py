@@ -1,4 +1,5 @@
-"""``cellsim ik ROBOT X Y Z [--euler-zyx-deg A B G] [--all] [--json]``: analytic inverse kinematics.
+"""``cellsim ik ROBOT X Y Z [--euler-zyx-deg A B G] [--tool NAME] [--all] [--json]``: analytic inverse
+kinematics.
 
 Position in mm in the robot's ``frame0``; orientation of its ``tcp`` frame as Z-Y-X Euler
 angles in degrees, ``R = Rz(A) Ry(B) Rx(G)`` (seed 000 eq. 6); default: the tcp orientation at
@@ -7,7 +8,8 @@ then closest to home; see :mod:`sim.robots.ik`), in degrees, only the best unles
 ``--all``. For the 5-axis robots A is implied by the position: a disagreeing A is replaced
 (one note on stderr). ``--json`` prints::
 
-    {"robot": str, "solutions": [{"joints_deg": [..], "within_limits": bool}]}
+    {"robot": str, "tool": str or null,
+     "solutions": [{"joints_deg": [..], "within_limits": bool}]}
 """
 
 from __future__ import annotations
@@ -41,6 +43,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--euler-zyx-deg", metavar=("A", "B", "G"), nargs=3, type=float, default=None,
                    help="tcp orientation, Z-Y-X Euler angles in degrees (default: the home "
                         "orientation); for 5-axis robots A is implied by the position")
+    p.add_argument("--tool", metavar="NAME", default=None,
+                   help="the tcp is this tool's tip (see `cellsim list`); default: the flange "
+                        "centre (no tool)")
     p.add_argument("--all", action="store_true", help="print every solution, not only the best")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)
@@ -58,7 +63,13 @@ def run(args: argparse.Namespace) -> int:
     _check_finite("X Y Z", position)
     if args.euler_zyx_deg is not None:
         _check_finite("A B G", args.euler_zyx_deg)
-    model = kinematic_model(spec)
+    if args.tool is None or args.tool == "none":
+        model = kinematic_model(spec)
+    else:
+        from sim.cells.compose import prepare_robot
+        from sim.cells.tools import TOOLS
+
+        model = prepare_robot(spec, TOOLS.get(args.tool)).kinematics()
     p = np.asarray(position, dtype=float) / 1000.0
     if args.euler_zyx_deg is None:
         R = model.family.default_orientation(model.fk(np.zeros(model.n_joints))[:3, :3], p)
@@ -78,13 +89,14 @@ def run(args: argparse.Namespace) -> int:
         print(f"cellsim: warning: {w.message}", file=sys.stderr)
     shown = sols if args.all else sols[:1]
     if args.json:
-        doc = {"robot": spec.name,
+        doc = {"robot": spec.name, "tool": args.tool,
                "solutions": [{"joints_deg": [float(v) for v in np.rad2deg(s.q)],
                               "within_limits": bool(s.within_limits)} for s in shown]}
         print(json.dumps(doc))
         return 0
-    print(f"{spec.title} ({spec.name}): {len(sols)} solution(s), best first; joints "
-          f"{' '.join(spec.joints)} in deg")
+    with_tool = f" with tool {args.tool}" if args.tool not in (None, "none") else ""
+    print(f"{spec.title} ({spec.name}){with_tool}: {len(sols)} solution(s), best first; "
+          f"joints {' '.join(spec.joints)} in deg")
     for i, s in enumerate(shown, 1):
         joints = " ".join(f"{v:9.3f}" for v in np.rad2deg(s.q))
         flag = "within limits" if s.within_limits else "OUTSIDE joint limits"
