@@ -97,3 +97,26 @@ def test_list_shows_every_robot_and_scenario(capsys):
     for name in ("lrmate100ib", "lrmate200ic5l", "robot_5r", *shipped_scenarios()):
         assert name in out
     assert "(invalid" not in out
+
+
+def test_list_shows_each_cells_objects_seams_and_cameras(capsys):
+    """Each cell's block names its objects (rings once, no painted marks), its seams with
+    their lengths and its cameras; the weld table's lengths from its own dimensions."""
+    import math
+
+    from sim.cells import CELLS, weld_table
+
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    blocks = out.split("cells:\n", 1)[1].split("tools:\n", 1)[0]
+    for name in CELLS:
+        assert f"  {name} " in blocks
+    table = blocks.split("  weld_table ", 1)[1]
+    objects = next(ln for ln in table.splitlines() if "objects:" in ln)
+    assert objects.endswith(", wall") and "wall0" not in objects and "line_mark" not in objects
+    line_mm = 1000.0 * (weld_table.LINE_R[1] - weld_table.LINE_R[0])
+    arc_mm = 1000.0 * weld_table.ARC_R * math.radians(weld_table.ARC_DEG[1] - weld_table.ARC_DEG[0])
+    assert f"seams: line (line, {line_mm:.0f} mm), arc (arc, {arc_mm:.0f} mm)" in table
+    assert "cameras: overview, tool" in table
+    pick = blocks.split("  pick ", 1)[1].split("\n  weld_", 1)[0]
+    assert "parts: part0, part1, part2, part3" in pick and "seams:" not in pick

@@ -1,4 +1,5 @@
-"""``cellsim list``: robots, cells, tools and scenarios, one line each."""
+"""``cellsim list``: robots, cells (with their objects, seams, parts and cameras), tools and
+scenarios."""
 
 from __future__ import annotations
 
@@ -26,6 +27,39 @@ def _scenario_line(name: str, path) -> str:
         return f"  {name:32s} (invalid: {exc})"
 
 
+def _cell_lines(spec) -> list[str]:
+    """A cell's robots, objects (a ring of staves counts once; painted marks are left out),
+    seams (kind, length), parts and cameras, from the cell composed for its first robot."""
+    from sim.cells import build_cell
+
+    try:
+        cell = build_cell(spec, ROBOTS[spec.robots[0]])
+    except CellsimError as exc:  # a broken cell must not hide the others
+        return [f"(cannot be built: {exc})"]
+    member = {g: obj for obj, geoms in cell.objects.items() for g in geoms}
+    objects: list[str] = []
+    for geom in cell.mjcf.worldbody.find_all("geom"):
+        full = geom.full_identifier
+        if not geom.name or full.startswith("robot/") or geom.name == "floor":
+            continue
+        if geom.name in cell.parts or full in cell.parts:
+            continue
+        if geom.contype == 0 and geom.conaffinity == 0:  # a painted mark, not an object
+            continue
+        name = member.get(full, geom.name)
+        if name not in objects:
+            objects.append(name)
+    seams = [f"{s.name} ({s.kind}, {1000.0 * s.length():.0f} mm)" for s in cell.seams.values()]
+    lines = [f"robots: {', '.join(spec.robots)}; mounts: {', '.join(spec.mounts)}",
+             f"objects: {', '.join(objects)}"]
+    if seams:
+        lines.append(f"seams: {', '.join(seams)}")
+    if cell.parts:
+        lines.append(f"parts: {', '.join(cell.parts)}")
+    lines.append(f"cameras: {', '.join(cell.cameras)}")
+    return lines
+
+
 def run(args: argparse.Namespace) -> int:
     print("robots:")
     for spec in ROBOTS.values():
@@ -33,10 +67,14 @@ def run(args: argparse.Namespace) -> int:
     from sim.cells import CELLS
     from sim.cells.tools import TOOLS
 
-    for title, registry in (("cells", CELLS), ("tools", TOOLS)):
-        print(f"{title}:")
-        for name, item in sorted(registry.items()):
-            print(f"  {name:32s} {item.description}")
+    print("cells:")
+    for name, item in sorted(CELLS.items()):
+        print(f"  {name:32s} {item.description}")
+        for line in _cell_lines(item):
+            print(f"      {line}")
+    print("tools:")
+    for name, item in sorted(TOOLS.items()):
+        print(f"  {name:32s} {item.description}")
     print("scenarios:")
     for name, path in shipped_scenarios().items():
         print(_scenario_line(name, path))
