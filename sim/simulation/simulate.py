@@ -178,25 +178,8 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
     n_steps = int(round((motion.duration + settle_s) / dt))
     t = motion.t0 + dt * np.arange(n_steps + 1)
     ref = motion.at(t)
-    kp = model.actuator_gainprm[built.robot_act, 0]
-    kv = -model.actuator_biasprm[built.robot_act, 2]
-
-    if feedforward:  # both in one pass over the samples
-        tau_id, ff = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd, discrete=(False, True))
-    else:
-        tau_id = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd)
-        ff = np.zeros_like(tau_id)
-
-    nu, nv = model.nu, model.nv
-    controls = np.zeros((n_steps + 1, nu))
-    # A position actuator's force is kp (ctrl - q) - kv qd, clamped to its forcerange. With
-    # feed-forward the set-point is shifted by (kv/kp) qd_ref, so the servo acts on the velocity
-    # error too, and by tau_ff / kp, so the drive also delivers the feed-forward torque: the
-    # whole torque passes through the drive and its limit.
-    controls[:, built.robot_act] = (ref.q + (kv / kp) * ref.qd + ff / kp) if feedforward \
-        else ref.q
-    if built.suction_act is not None:
-        controls[:, built.suction_act] = vacuum(motion.tool_state(t, "suction"), dt)
+    tau_id, ff, controls = reference_controls(built, motion, t, ref, feedforward)
+    nv = model.nv
 
     flat = built.force_limits[:, 1]
     limit = np.tile(flat, (n_steps + 1, 1))  # the drive's limit at each step, N m
@@ -286,6 +269,44 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
         model.actuator_forcerange[built.robot_act] = saved_range
     arrays = _arrays(built, motion, t, ref, tau_id, ff, qpos, qvel, sens, limit)
     return SimulationRecord(arrays=arrays, wall_s=wall, steps=n_steps, timestep=dt)
+
+
+def reference_controls(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
+                       feedforward: bool
+                       ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The controls of every step, known before stepping (they do not depend on the state).
+
+    A position actuator's force is kp (ctrl - q) - kv qd, clamped to its forcerange. With
+    feed-forward the set-point is shifted by (kv/kp) qd_ref, so the servo acts on the velocity
+    error too, and by tau_ff / kp, so the drive also delivers the feed-forward torque: the whole
+    torque passes through the drive and its limit. The suction actuator follows the tool state.
+
+    Args:
+        built: The compiled cell.
+        motion: The reference motion.
+        t: Sample times, s, (N,).
+        ref: ``motion.at(t)``.
+        feedforward: With the inverse-dynamics feed-forward.
+
+    Returns:
+        ``(tau_id, tau_ff, controls)``: the reference's inverse dynamics (N, n) and the
+        feed-forward (N, n; zeros without), N m; the controls (N, nu).
+    """
+    model = built.model
+    kp = model.actuator_gainprm[built.robot_act, 0]
+    kv = -model.actuator_biasprm[built.robot_act, 2]
+    if feedforward:  # both in one pass over the samples
+        tau_id, ff = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd, discrete=(False, True))
+    else:
+        tau_id = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd)
+        ff = np.zeros_like(tau_id)
+    controls = np.zeros((t.size, model.nu))
+    controls[:, built.robot_act] = (ref.q + (kv / kp) * ref.qd + ff / kp) if feedforward \
+        else ref.q
+    if built.suction_act is not None:
+        controls[:, built.suction_act] = vacuum(motion.tool_state(t, "suction"),
+                                                float(model.opt.timestep))
+    return tau_id, ff, controls
 
 
 def _envelope_chunk(drives: Sequence[Drive], env_ref: NDArray[np.float64],

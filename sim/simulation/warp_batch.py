@@ -42,8 +42,7 @@ from sim.simulation.simulate import (
     SimulationRecord,
     _arrays,
     _joint_peak,
-    inverse_dynamics,
-    vacuum,
+    reference_controls,
 )
 
 #: Simulation backends: MuJoCo in C (one variant at a time) or MuJoCo Warp (batched).
@@ -182,23 +181,10 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
     # host side: references, feed-forward, controls and drive limits per variant
     per: list[dict[str, Any]] = []
     for built, motion, drv in zip(builts, motions, drives):
-        model = built.model
         n = int(round((motion.duration + settle_s) / dt))
         t = motion.t0 + dt * np.arange(n + 1)
         ref = motion.at(t)
-        kp = model.actuator_gainprm[built.robot_act, 0]
-        kv = -model.actuator_biasprm[built.robot_act, 2]
-        if feedforward:
-            tau_id, ff = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd,
-                                          discrete=(False, True))
-        else:
-            tau_id = inverse_dynamics(model, built, ref.q, ref.qd, ref.qdd)
-            ff = np.zeros_like(tau_id)
-        controls = np.zeros((n + 1, nu))
-        controls[:, built.robot_act] = (ref.q + (kv / kp) * ref.qd + ff / kp) if feedforward \
-            else ref.q
-        if built.suction_act is not None:
-            controls[:, built.suction_act] = vacuum(motion.tool_state(t, "suction"), dt)
+        tau_id, ff, controls = reference_controls(built, motion, t, ref, feedforward)
         flat = built.force_limits[:, 1]
         limit = np.tile(flat, (n + 1, 1))
         if drv is not None:
