@@ -87,9 +87,9 @@ def warp_parity(scenario: str, workers: int) -> dict:
             t0 = time.perf_counter()
             res = run_sweep(scenario, payloads, speeds, run_variant, workers=workers,
                             out_dir=Path(tmp) / name, progress=False, **kw)
-            out[name] = {"wall_s": time.perf_counter() - t0, "rows": res.rows,
-                         "variants_per_min": 60.0 * len(res.outcomes)
-                         / (time.perf_counter() - t0)}
+            wall = time.perf_counter() - t0
+            out[name] = {"wall_s": wall, "rows": res.rows,
+                         "variants_per_min": 60.0 * len(res.outcomes) / wall}
     worst = {}
     for key in ("peak_torque_sim_nm", "rms_torque_sim_nm"):
         # joints that carry at least 2 % of the variant's largest value (a joint that stays

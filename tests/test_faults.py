@@ -160,10 +160,17 @@ def test_sizes_are_bounded_before_anything_is_allocated(tmp_path, capsys, edit, 
     assert not (tmp_path / "run").exists()
 
 
-def test_sweep_ranges_are_bounded(capsys):
+def test_sweep_ranges_are_bounded(tmp_path, capsys):
     rc = main(["size", "lrmate200ic_pick_place", "--payload", "0:1e308:1e-300", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and "--payload" in err and "at most 10000" in err and err.count("\n") == 1
+    # each list within its bound, their product not: refused before any folder or variant
+    rc = main(["size", "lrmate200ic_pick_place", "--payload", "0:200:1", "--speed-scale",
+               "0.5:1.5:0.01", "--quiet", "--out", str(tmp_path / "s")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "201 payloads x 101 speed scales make 20301 variants (at most 10000)" \
+        in err and err.count("\n") == 1
+    assert not (tmp_path / "s").exists()
 
 
 @pytest.mark.render

@@ -99,14 +99,16 @@ def selection_overrides(args: argparse.Namespace) -> dict | None:
             "inertia_ratio_max": args.inertia_ratio_max}
 
 
-def run_variant(variant: Variant, select: dict | None = None, keep_runs: bool = False,
+def run_variant(variant: Variant, selection: Any = None, keep_runs: bool = False,
                 plots: bool = False) -> Any:
     """Run one sweep variant (module level, so worker processes and Ray tasks can import it).
 
     Metrics only by default: the run is evaluated in memory and a
     :class:`~sim.pipeline.sweep.VariantMetrics` (the variant's rows of the table) comes back.
-    With ``keep_runs`` the variant's run folder is written (``variant.run_dir``) and its path
-    comes back.
+    With ``keep_runs`` the variant's run folder is also written (``variant.run_dir``; its rows
+    still come from every sample in memory). ``selection`` is the actuator selection's
+    settings with the catalogue loaded (:func:`sim.pipeline.run.selection_options`, once for
+    the whole sweep), or None.
 
     A variant faster or heavier than the robot allows is still simulated (speed and
     acceleration limits are not enforced): it stays in the tables with negative margins and a
@@ -115,12 +117,7 @@ def run_variant(variant: Variant, select: dict | None = None, keep_runs: bool = 
     from sim.pipeline.run import RunOptions, evaluate_scenario, run_and_write
 
     scenario = _variant_scenario(variant)
-    selection = None
-    if select is not None or scenario.sizing.select:
-        from sim.pipeline.run import selection_options
-
-        selection = selection_options(scenario, **(select or {}))
-    if keep_runs:  # the same rows, from every sample in memory, and the folder written
+    if keep_runs:
         ev = run_and_write(scenario, RunOptions(out_dir=variant.run_dir, video=False,
                                                 plots=plots, progress=False,
                                                 selection=selection))
@@ -152,19 +149,17 @@ def _metrics(variant: Variant, ev: Any, run_dir: str | None = None) -> Any:
                           timings_s=dict(ev.summary.get("timings_s", {})), run_dir=run_dir)
 
 
-def run_batch(variants: list[Variant], select: dict | None = None) -> list[Any]:
+def run_batch(variants: list[Variant], selection: Any = None) -> list[Any]:
     """Every variant at once on MuJoCo Warp (``--backend warp``): planned one by one, simulated
-    as batches of one model structure, then checked and sized one by one; metrics only."""
-    from sim.pipeline.run import RunOptions, evaluate_scenarios, selection_options
+    as batches of one model structure, then checked and sized one by one; metrics only.
+    ``selection`` as for :func:`run_variant`."""
+    from sim.pipeline.run import RunOptions, evaluate_scenarios
 
     # speed-major: the variants of one speed scale follow each other, so each plan is made
     # once and reused for every payload
     order = sorted(range(len(variants)),
                    key=lambda i: (variants[i].speed_scale, variants[i].payload_kg))
     scenarios = [_variant_scenario(variants[i]) for i in order]
-    selection = None
-    if select is not None or scenarios[0].sizing.select:
-        selection = selection_options(scenarios[0], **(select or {}))
     evaluations = evaluate_scenarios(scenarios, RunOptions(
         video=False, plots=False, progress=False, selection=selection, backend="warp"),
         labels=[variants[i].label for i in order])
@@ -195,10 +190,11 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or Path("runs") / f"{scenario.name}_sweep"
     workers = args.workers or os.cpu_count() or 1
     select = selection_overrides(args)
-    if select is not None or scenario.sizing.select:  # a bad catalogue fails before any run
+    selection = None
+    if select is not None or scenario.sizing.select:  # loaded once; a bad one fails here
         from sim.pipeline.run import selection_options
 
-        selection_options(scenario, **(select or {}))
+        selection = selection_options(scenario, **(select or {}))
     if args.plots and not args.keep_runs:
         raise CellsimError("--plots draws each variant's run folder: give --keep-runs too")
     if args.address is not None and args.engine != "ray":
@@ -214,31 +210,28 @@ def run(args: argparse.Namespace) -> int:
         from sim.simulation.warp_batch import default_device
 
         default_device()  # MuJoCo Warp is there (else one line), before any folder is made
-        batch = functools.partial(run_batch, select=select)
+        batch = functools.partial(run_batch, selection=selection)
     # the loaded scenario travels with each variant (a Ray node needs no copy of the file)
     result = run_sweep(scenario, payloads, scales,
-                       functools.partial(run_variant, select=select, keep_runs=args.keep_runs,
+                       functools.partial(run_variant, selection=selection,
+                                         keep_runs=args.keep_runs,
                                          plots=args.plots),
                        workers=min(workers, len(payloads) * len(scales)), out_dir=out,
                        progress=not args.quiet, engine=args.engine, address=args.address,
                        batch=batch)
     print(f"{len(result.outcomes)} variants in {result.wall_s:.1f} s on {result.workers} "
           f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.png)")
-    if select is not None or scenario.sizing.select:
+    if selection is not None:
         _print_selections(result)
     return 0
 
 
 def _print_selections(result) -> None:
-    """Each variant's choice per joint (from its selection.json)."""
-    import json
-
+    """Each variant's choice per joint (``selection.json``'s content, returned by the
+    variant)."""
     for outcome in result.outcomes:
         doc = outcome.selection
-        if doc is None and outcome.run_dir is not None:
-            path = Path(outcome.run_dir) / "selection.json"
-            doc = json.loads(path.read_text()) if path.is_file() else None
-        if doc is None:
+        if doc is None:  # a failed variant
             continue
         print(f"selection, {outcome.variant.label}:")
         for joint, j in doc["joints"].items():

@@ -171,8 +171,6 @@ def _prepare(scenario: Scenario, options: RunOptions, stages: Stages, *, reuse_p
             validate_size(video_args.get("width", 640), video_args.get("height", 480))
             fps = video_args.get("fps", 30.0)
             if not (np.isfinite(fps) and fps > 0):
-                from sim.errors import RenderError
-
                 raise RenderError(f"--fps must be a positive number, got {fps!r}")
     with stages.stage("plan"):
         key = _plan_key(scenario) if reuse_plan else None

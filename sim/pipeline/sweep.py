@@ -24,7 +24,6 @@ payload and against speed scale) and ``sweep.json``.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import multiprocessing
@@ -199,6 +198,9 @@ def make_variants(base_scenario: Any, payloads: Sequence[float], speed_scales: S
     """Every ``(payload, speed_scale)`` combination, payload-major, validated."""
     ps = validate_payloads(payloads)
     ss = validate_speed_scales(speed_scales)
+    if len(ps) * len(ss) > MAX_SWEEP_VARIANTS:  # each list may be long, not their product
+        raise SweepError(f"{len(ps)} payloads x {len(ss)} speed scales make "
+                         f"{len(ps) * len(ss)} variants (at most {MAX_SWEEP_VARIANTS})")
     out = Path(out_dir)
     combos = [(p, s) for p in ps for s in ss]
     return [Variant(p, s, base_scenario, out / Variant(p, s).slug, i)
@@ -296,19 +298,23 @@ def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
     return rows_from(variant, traj, names, summary.get("verdict", ""), sized, str(run_dir))
 
 
+def _outcome(variant: Variant, got: Any, wall_s: float) -> Outcome:
+    """The outcome of what a runner returned: metrics computed in memory, or a run folder to
+    read the rows from."""
+    if got is None:
+        raise CellsimError("the runner returned no run folder")
+    if isinstance(got, VariantMetrics):  # computed in memory (a run folder or none)
+        return Outcome(variant, got.run_dir, tuple(got.rows), selection=got.selection,
+                       wall_s=wall_s, timings_s=dict(got.timings_s))
+    return Outcome(variant, str(got), tuple(variant_rows(variant, got)), wall_s=wall_s)
+
+
 def run_variant(runner: Callable[[Variant], Any], variant: Variant) -> Outcome:
     """Run one variant and read its results; never raises (errors go into the outcome, as
     text, so that unpicklable exceptions cannot break the process pool)."""
     t0 = time.perf_counter()
     try:
-        got = runner(variant)
-        if got is None:
-            raise CellsimError("the runner returned no run folder")
-        if isinstance(got, VariantMetrics):  # computed in memory (a run folder or none)
-            return Outcome(variant, got.run_dir, tuple(got.rows), selection=got.selection,
-                           wall_s=time.perf_counter() - t0, timings_s=dict(got.timings_s))
-        rows = variant_rows(variant, got)
-        return Outcome(variant, str(got), tuple(rows), wall_s=time.perf_counter() - t0)
+        return _outcome(variant, runner(variant), time.perf_counter() - t0)
     except BaseException as exc:  # noqa: BLE001 - reported per variant
         if isinstance(exc, KeyboardInterrupt):
             raise
@@ -421,10 +427,11 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
             bar.update(len(variants))
         elif engine == "ray":
             _run_on_ray(runner, variants, results, address, workers, bar)
-        elif workers == 1:
-            for v in variants:
-                results[v.index] = run_variant(runner, v)
-                bar.update()
+        elif workers == 1:  # in this process, a speed scale's variants one after the other
+            for group in task_groups(variants, 1):
+                for v in group:
+                    results[v.index] = run_variant(runner, v)
+                    bar.update()
         else:
             ctx = multiprocessing.get_context(mp_context)
             with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
@@ -511,8 +518,11 @@ def _run_batch(batch: Callable[[Sequence[Variant]], Sequence[Any]],
         return
     share = (time.perf_counter() - t0) / max(len(variants), 1)
     for v, item in zip(variants, got):
-        results[v.index] = run_variant(lambda _v, item=item: item, v)
-        results[v.index] = dataclasses.replace(results[v.index], wall_s=share)
+        try:
+            results[v.index] = _outcome(v, item, share)
+        except Exception as exc:  # noqa: BLE001 - reported per variant
+            results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {exc}".splitlines()[0],
+                                       traceback.format_exc(), wall_s=share)
 
 
 def _check_reachable(address: str, timeout_s: float = 5.0) -> None:
