@@ -30,6 +30,7 @@ each other and the suction cup.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -139,6 +140,7 @@ class RobotStatics:
     flange_local: NDArray[np.float64]
     tcp_body: str
     tcp_local_pos: NDArray[np.float64]
+    tcp_local_rot: NDArray[np.float64]
     approach_flange: NDArray[np.float64]
     tcp_minus_flange: float
     flange_axial: float
@@ -198,6 +200,7 @@ def _robot_statics(spec: RobotSpec) -> RobotStatics:
         flange_local=transform(matrix_from_quat(m.site_quat[fid]), m.site_pos[fid]),
         tcp_body=m.body(m.site_bodyid[tid]).name,
         tcp_local_pos=m.site_pos[tid].copy(),
+        tcp_local_rot=matrix_from_quat(m.site_quat[tid]),
         approach_flange=a_fl,
         tcp_minus_flange=along,
         flange_axial=flange_axial,
@@ -220,6 +223,8 @@ class RobotRig:
         tcp_from_flange: Distance flange -> tcp along the approach axis with the tool, m.
         tool_body: Body the ``tool`` camera follows (the tool's top body, else the flange body).
         payload_kg: Lumped payload at the tcp, kg.
+        tcp_local: Pose of the tcp site in the flange body for a tool that is not straight
+            (:attr:`ToolSpec.straight`), (4, 4); None otherwise.
     """
 
     spec: RobotSpec
@@ -230,6 +235,7 @@ class RobotRig:
     tool_body: mjcf.Element
     payload_kg: float = 0.0
     home_q: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    tcp_local: NDArray[np.float64] | None = None
 
     @property
     def frame0_height(self) -> float:
@@ -250,6 +256,16 @@ class RobotRig:
         from the MJCF).
         """
         km = kinematic_model(self.spec)
+        if self.tcp_local is not None:
+            # a tool that is not straight: the seed's tool frame on the flange, and the
+            # constant flange -> tcp transform as the model's tcp offset
+            km_f = km.with_family(km.family.with_tool(self.statics.flange_axial))
+            km_f.tcp_offset = transform(km.tcp_offset[:3, :3])
+            st = self.statics
+            bare = transform(st.tcp_local_rot, st.flange_local[:3, 3])  # bare tcp at the flange
+            offset = km_f.tcp_offset @ np.linalg.solve(bare, self.tcp_local)
+            offset[np.abs(offset) < 1e-15] = 0.0
+            return dataclasses.replace(km_f, tcp_offset=offset)
         reach = self.statics.flange_axial + self.tcp_from_flange
         km = km.with_family(km.family.with_tool(reach))
         km.tcp_offset = transform(km.tcp_offset[:3, :3])
@@ -309,7 +325,18 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
         tcp_from_flange = tool.length_m
     if tcp.parent is not flange_body:
         raise CellsimError(f"robot {spec.name!r}: sites flange and tcp must share a body")
-    tcp_pos = pf + Rf @ (tcp_from_flange * st.approach_flange)
+    tcp_local = None
+    if tool is not None and not tool.straight:
+        # the tcp site turned by the tool's tcp rotation (expressed in the flange body), so that
+        # an unturned tcp keeps the bare tcp's axes; placed at the tool's tcp
+        X = tool.tcp_pose()
+        tcp_pos = pf + R_mount @ X[:3, 3]
+        R_tcp = R_mount @ X[:3, :3] @ R_mount.T @ st.tcp_local_rot
+        tcp.quat = quat_from_matrix(R_tcp)
+        tcp_local = transform(R_tcp, tcp_pos)
+        tcp_from_flange = float(np.linalg.norm(X[:3, 3]))
+    else:
+        tcp_pos = pf + Rf @ (tcp_from_flange * st.approach_flange)
     tcp.pos = tcp_pos
     if payload_kg > 0.0:
         r = payload_radius(payload_kg)
@@ -320,7 +347,7 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
                  group=1, rgba=(0.9, 0.8, 0.1, 0.35))
     return RobotRig(spec=spec, tool=tool, model=robot, statics=st,
                     tcp_from_flange=tcp_from_flange, tool_body=tool_body,
-                    payload_kg=payload_kg, home_q=st.home_q.copy())
+                    payload_kg=payload_kg, home_q=st.home_q.copy(), tcp_local=tcp_local)
 
 
 # ---------------------------------------------------------------------------- world
@@ -410,6 +437,13 @@ def add_box(body: mjcf.Element, name: str, center, half_size, material: str,
                     material=material, contype=bits, conaffinity=bits, **kw)
 
 
+class Ring(list):
+    """The staves of :func:`add_ring` (a list of geoms) with the ring's parameters
+    (``params``: radii, heights, angles in m and rad), so a cell can be written as a file."""
+
+    params: dict
+
+
 def add_ring(body: mjcf.Element, name: str, r_in: float, r_out: float, z0: float, z1: float,
              material: str, n: int = 72, phi0: float = 0.0, phi1: float = 2 * np.pi,
              center=(0.0, 0.0), contact: bool = True) -> list[mjcf.Element]:
@@ -419,7 +453,11 @@ def add_ring(body: mjcf.Element, name: str, r_in: float, r_out: float, z0: float
     ``n`` lines; the faceting error at r_out is ``r_out (1/cos(pi/n) - 1)``). Returns the
     staves (one object of the cell: :attr:`Layout.objects`).
     """
-    staves = []
+    staves = Ring()
+    staves.params = {"r_in": float(r_in), "r_out": float(r_out), "z0": float(z0),
+                     "z1": float(z1), "material": material, "n": int(n), "phi0": float(phi0),
+                     "phi1": float(phi1), "center": (float(center[0]), float(center[1])),
+                     "contact": bool(contact)}
     dphi = (phi1 - phi0) / n
     half_w = r_out * np.tan(dphi / 2.0)
     rm = (r_in + r_out) / 2.0
@@ -465,6 +503,7 @@ class Layout:
     dims: dict[str, float] = field(default_factory=dict)
     objects: dict[str, list[mjcf.Element]] = field(default_factory=dict)
     seam_objects: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    frames: dict[str, NDArray[np.float64]] = field(default_factory=dict)
 
 
 def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:

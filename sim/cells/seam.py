@@ -31,6 +31,15 @@ world. Which tcp axis is the torch axis depends on the robot family (``tool_axis
 
 Arcs are given by three points (start, via, end) in travel order; ``normal`` is the arc plane's
 unit normal, right-handed with the travel direction (counter-clockwise seen from its tip).
+Polylines are two or more points in travel order (:meth:`Seam.segments` gives their straight
+segments as line seams; welding one in a single pass with corner blending is the weld-programs
+issue's).
+
+**Stand-off** (``standoff_m``): a seam may ask for a contact-tip-to-work distance other than
+the tool's nominal stick-out (a cell file's per-seam ``stickout_mm``). The tool point (the wire
+tip at the nominal stick-out) then runs ``standoff_m = stickout - nominal`` back along the torch
+axis from the seam (:meth:`Seam.tcp_point`): the torch is farther from the work by that much
+and the wire reaches the seam.
 """
 
 from __future__ import annotations
@@ -60,8 +69,9 @@ class Seam:
 
     Attributes:
         name: Seam name, unique in its cell.
-        kind: ``"line"`` or ``"arc"``.
+        kind: ``"line"``, ``"arc"`` or ``"polyline"``.
         points: Line: (2, 3) start, end. Arc: (3, 3) start, via, end, in travel order.
+            Polyline: (N, 3), N >= 2, in travel order.
         normal: Arc plane unit normal (3,), right-handed with the travel direction; None for
             lines (computed from the points when None is given for an arc).
         torch_work_angle_deg: Work angle ``w``, deg (module docstring).
@@ -74,10 +84,12 @@ class Seam:
         world_from_frame0: Pose of the robot's frame 0 in world (4, 4); used for the ``5r``
             roll convention (J1 axis = its z axis through its origin). Identity if None.
         description: One line: what joint this is.
+        standoff_m: Distance the tool point keeps back from the seam along the torch axis, m
+            (module docstring); 0 puts the tool point on the seam.
     """
 
     name: str
-    kind: Literal["line", "arc"]
+    kind: Literal["line", "arc", "polyline"]
     points: NDArray[np.float64]
     normal: NDArray[np.float64] | None
     torch_work_angle_deg: float
@@ -87,15 +99,16 @@ class Seam:
     tool_axis: int = 2
     world_from_frame0: NDArray[np.float64] | None = None
     description: str = ""
+    standoff_m: float = 0.0
 
     # ------------------------------------------------------------------ validation
     def __post_init__(self) -> None:
         set_ = object.__setattr__
         pts = np.array(self.points, dtype=float)
-        if self.kind not in ("line", "arc"):
-            raise CellsimError(f"seam {self.name!r}: kind must be 'line' or 'arc', "
+        if self.kind not in ("line", "arc", "polyline"):
+            raise CellsimError(f"seam {self.name!r}: kind must be 'line', 'arc' or 'polyline', "
                                f"got {self.kind!r}")
-        want = (2, 3) if self.kind == "line" else (3, 3)
+        want = {"line": (2, 3), "arc": (3, 3)}.get(self.kind, (max(len(pts), 2), 3))
         if pts.shape != want or not np.all(np.isfinite(pts)):
             raise CellsimError(f"seam {self.name!r}: a {self.kind} needs finite points of shape "
                                f"{want}, got {pts.shape}")
@@ -108,6 +121,17 @@ class Seam:
             raise CellsimError(f"seam {self.name!r}: tool_axis must be 0 (5r) or 2 (fanuc6)")
         T = np.eye(4) if self.world_from_frame0 is None else np.array(self.world_from_frame0, float)
         set_(self, "world_from_frame0", T)
+        if not (np.isfinite(self.standoff_m) and abs(self.standoff_m) < 1.0):
+            raise CellsimError(f"seam {self.name!r}: standoff_m must be a finite length under "
+                               f"1 m, got {self.standoff_m!r}")
+        if self.kind == "polyline":
+            seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+            if np.any(seg < 1e-6):
+                k = int(np.argmax(seg < 1e-6))
+                raise CellsimError(f"seam {self.name!r}: points {k} and {k + 1} coincide")
+            set_(self, "normal", None if self.normal is None else _unit(self.normal, "normal"))
+            set_(self, "_cum", np.concatenate([[0.0], np.cumsum(seg)]))
+            return
         if self.kind == "line":
             if np.linalg.norm(pts[1] - pts[0]) < 1e-6:
                 raise CellsimError(f"seam {self.name!r}: start and end coincide")
@@ -170,6 +194,8 @@ class Seam:
 
     def length(self) -> float:
         """Seam length, m."""
+        if self.kind == "polyline":
+            return float(self._cum[-1])  # type: ignore[attr-defined]
         if self.kind == "line":
             return float(np.linalg.norm(self.points[1] - self.points[0]))
         return self._radius * self._sweep  # type: ignore[attr-defined]
@@ -184,6 +210,9 @@ class Seam:
     def point(self, s: float) -> NDArray[np.float64]:
         """Point at arc length ``s`` (m), world, m, (3,)."""
         s = self._check_s(s)
+        if self.kind == "polyline":
+            k, u = self._segment(s)
+            return self.points[k] + (self.points[k + 1] - self.points[k]) * u
         if self.kind == "line":
             p0, p1 = self.points
             return p0 + (p1 - p0) * (s / self.length())
@@ -194,11 +223,58 @@ class Seam:
     def tangent(self, s: float) -> NDArray[np.float64]:
         """Unit travel direction at arc length ``s`` (m), (3,)."""
         s = self._check_s(s)
+        if self.kind == "polyline":
+            k, _ = self._segment(s)
+            d = self.points[k + 1] - self.points[k]
+            return d / np.linalg.norm(d)
         if self.kind == "line":
             d = self.points[1] - self.points[0]
             return d / np.linalg.norm(d)
         th = s / self._radius  # type: ignore[attr-defined]
         return -np.sin(th) * self._u + np.cos(th) * self._v  # type: ignore[attr-defined]
+
+    def _segment(self, s: float) -> tuple[int, float]:
+        """Polyline segment index holding ``s`` and the fraction along it (a corner belongs to
+        the segment it ends)."""
+        cum = self._cum  # type: ignore[attr-defined]
+        k = int(np.clip(np.searchsorted(cum, s, side="left") - 1, 0, len(cum) - 2))
+        return k, (s - cum[k]) / (cum[k + 1] - cum[k])
+
+    def segments(self) -> list[Seam]:
+        """The straight segments of a polyline as line seams ``<name>/1``, ``<name>/2``, ...
+        (same torch posture and stand-off); a line or arc gives itself."""
+        if self.kind != "polyline":
+            return [self]
+        return [Seam(name=f"{self.name}/{k + 1}", kind="line",
+                     points=self.points[k:k + 2].copy(), normal=None,
+                     torch_work_angle_deg=self.torch_work_angle_deg,
+                     torch_travel_angle_deg=self.torch_travel_angle_deg,
+                     surface_normal=self.surface_normal, torch_side=self.torch_side,
+                     tool_axis=self.tool_axis, world_from_frame0=self.world_from_frame0,
+                     description=f"segment {k + 1} of {self.name}", standoff_m=self.standoff_m)
+                for k in range(len(self.points) - 1)]
+
+    def tcp_point(self, s: float) -> NDArray[np.float64]:
+        """Where the tool point goes at ``s``: the seam point moved ``standoff_m`` back along
+        the torch axis, world, m, (3,)."""
+        p = self.point(s)
+        return p if self.standoff_m == 0.0 else p - self.standoff_m * self.torch_axis(s)
+
+    def tcp_points(self) -> NDArray[np.float64]:
+        """The tool point's control points (:meth:`tcp_point` at the seam's own points): a
+        line's start and end, an arc's start, via and end (the stand-off path of an arc with
+        a constant torch posture is the coaxial arc through them), (k, 3), m."""
+        if self.standoff_m == 0.0:
+            return self.points.copy()
+        if self.kind == "arc":
+            v = self.points[1] - self._center  # type: ignore[attr-defined]
+            th = float(np.mod(np.arctan2(v @ self._v, v @ self._u), 2 * np.pi))  # type: ignore[attr-defined]
+            ss = [0.0, th * self._radius, self.length()]  # type: ignore[attr-defined]
+        elif self.kind == "line":
+            ss = [0.0, self.length()]
+        else:
+            ss = list(self._cum)  # type: ignore[attr-defined]
+        return np.array([self.tcp_point(x) for x in ss])
 
     def sample(self, n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``n >= 2`` equally spaced arc lengths (n,) and their points (n, 3), m."""
@@ -253,10 +329,10 @@ class Seam:
         return float(np.rad2deg(np.arcsin(np.clip(abs(self.torch_axis(s) @ normal), 0.0, 1.0))))
 
     def pose(self, s: float) -> NDArray[np.float64]:
-        """Desired tcp pose at ``s`` in world, (4, 4)."""
+        """Desired tcp pose at ``s`` in world (the stand-off included), (4, 4)."""
         T = np.eye(4)
         T[:3, :3] = self.torch_rotation(s)
-        T[:3, 3] = self.point(s)
+        T[:3, 3] = self.tcp_point(s)
         return T
 
     def transformed(self, T: ArrayLike) -> Seam:
@@ -273,4 +349,4 @@ class Seam:
                     torch_travel_angle_deg=self.torch_travel_angle_deg,
                     surface_normal=R @ self.surface_normal, torch_side=self.torch_side,
                     tool_axis=self.tool_axis, world_from_frame0=T @ self.world_from_frame0,
-                    description=self.description)
+                    description=self.description, standoff_m=self.standoff_m)

@@ -72,7 +72,9 @@ within 0.35 s of lifting, while ``implicit``, ``Euler`` and ``RK4`` held it (see
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 from dm_control import mjcf
@@ -122,6 +124,13 @@ class ToolSpec:
             is on; a gripper's cup lip, which may touch the part it picks. Every other geom of
             the tool (nozzle, torch body, ...) must never touch anything
             (:mod:`sim.simulation.collisions`).
+        tcp_in_tool: Pose of the tool centre point in the tool frame, (4, 4) as nested tuples,
+            for a tool whose tcp is off the flange axis or turned (a tool file's ``tcp_mm`` and
+            ``tcp_euler_zyx_deg``); None for a straight tool (tcp at ``(0, 0, length_m)``,
+            oriented as the tool frame).
+        stickout_m: Nominal wire stick-out of a torch (contact tip to wire tip), m.
+        source: The tool file, for a tool given as a file (:mod:`sim.cells.toolfile`).
+        builder: Builds the tool's MJCF (a tool file's own); None for the shipped tools.
     """
 
     name: str
@@ -131,6 +140,23 @@ class ToolSpec:
     kind: str = "torch"
     suction_gain_n: float = 0.0
     work_geoms: tuple[str, ...] = ()
+    tcp_in_tool: tuple[tuple[float, ...], ...] | None = None
+    stickout_m: float = 0.015
+    source: Path | None = None
+    builder: Callable[[], object] | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def straight(self) -> bool:
+        """The tcp lies on the flange axis, oriented as the tool frame."""
+        return self.tcp_in_tool is None
+
+    def tcp_pose(self) -> np.ndarray:
+        """Pose of the tcp in the tool frame, (4, 4), m."""
+        if self.tcp_in_tool is None:
+            T = np.eye(4)
+            T[2, 3] = self.length_m
+            return T
+        return np.array(self.tcp_in_tool, dtype=float)
 
 
 #: The shipped tools by name.
@@ -274,4 +300,6 @@ def build_tool(spec: ToolSpec) -> mjcf.RootElement:
         ``(0, 0, length_m)`` (the tool centre point, oriented as the tool frame) and, for the
         vacuum gripper, a body ``cup`` and an adhesion actuator ``suction``.
     """
+    if spec.builder is not None:
+        return spec.builder()  # type: ignore[return-value]
     return _BUILDERS[spec.name](spec)

@@ -146,8 +146,9 @@ def build(rig: RobotRig, mount: str) -> Layout:
     add_ring(wb, "seam", R - 0.002, R + 0.002, zs, zs + 0.0005, "seam", n=64, phi0=ring_phi0,
              phi1=ring_phi0 + (phi_end - phi0), contact=False)
     if mount == "floor":
-        wb.add("geom", name="column", type="cylinder", fromto=[0, 0, 0, 0, 0, base_h - 0.03],
-               size=[COLUMN_RADIUS], material="concrete", contype=2, conaffinity=2)
+        col_h = base_h - 0.03
+        wb.add("geom", name="column", type="cylinder", pos=[0, 0, col_h / 2],
+               size=[COLUMN_RADIUS, col_h / 2], material="concrete", contype=2, conaffinity=2)
         add_box(wb, "column_plate", [0, 0, base_h - 0.015], [0.34, 0.34, 0.015], "dark_steel")
     else:
         span = R + 1.2

@@ -44,8 +44,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="tcp orientation, Z-Y-X Euler angles in degrees (default: the home "
                         "orientation); for 5-axis robots A is implied by the position")
     p.add_argument("--tool", metavar="NAME", default=None,
-                   help="the tcp is this tool's tip (see `cellsim list`); default: the flange "
-                        "centre (no tool)")
+                   help="the tcp is this tool's tip: a shipped tool (see `cellsim list`) or a "
+                        "tool file (docs/cell-format.md); default: the flange centre (no tool)")
     p.add_argument("--all", action="store_true", help="print every solution, not only the best")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)
@@ -66,10 +66,10 @@ def run(args: argparse.Namespace) -> int:
     if args.tool is None or args.tool == "none":
         model = kinematic_model(spec)
     else:
+        from sim.cells import tool_from_ref
         from sim.cells.compose import prepare_robot
-        from sim.cells.tools import TOOLS
 
-        model = prepare_robot(spec, TOOLS.get(args.tool)).kinematics()
+        model = prepare_robot(spec, tool_from_ref(args.tool, None)).kinematics()
     p = np.asarray(position, dtype=float) / 1000.0
     if args.euler_zyx_deg is None:
         R = model.family.default_orientation(model.fk(np.zeros(model.n_joints))[:3, :3], p)

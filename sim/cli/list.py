@@ -13,7 +13,10 @@ from sim.robots.registry import ROBOTS
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("list", help="list robots, cells, tools and scenarios",
                        description="List the robots, cells, tools and shipped scenarios, "
-                                   "one line each.")
+                                   "one line each; with --cell, one cell file's content.")
+    p.add_argument("--cell", metavar="FILE", default=None,
+                   help="show a cell file's robot, objects, seams, parts and cameras "
+                        "(docs/cell-format.md) instead")
     p.set_defaults(func=run)
 
 
@@ -27,7 +30,7 @@ def _scenario_line(name: str, path) -> str:
         return f"  {name:32s} (invalid: {exc})"
 
 
-def _cell_lines(spec) -> list[str]:
+def _cell_lines(spec, strict: bool = False) -> list[str]:
     """A cell's robots, objects (a ring of staves counts once; painted marks are left out),
     seams (kind, length), parts and cameras, from the cell composed for its first robot."""
     from sim.cells import build_cell
@@ -35,6 +38,8 @@ def _cell_lines(spec) -> list[str]:
     try:
         cell = build_cell(spec, ROBOTS[spec.robots[0]])
     except CellsimError as exc:  # a broken cell must not hide the others
+        if strict:
+            raise
         return [f"(cannot be built: {exc})"]
     member = {g: obj for obj, geoms in cell.objects.items() for g in geoms}
     objects: list[str] = []
@@ -61,6 +66,14 @@ def _cell_lines(spec) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    if getattr(args, "cell", None) is not None:
+        from sim.cells import load_cell
+
+        spec = load_cell(args.cell)  # a bad file: one line, exit 2
+        print(f"{spec.name}: {spec.description} ({spec.source})")
+        for line in _cell_lines(spec, strict=True):
+            print(f"    {line}")
+        return 0
     print("robots:")
     for spec in ROBOTS.values():
         print(f"  {spec.name:32s} {spec.n_joints} axes  {spec.description}")

@@ -138,14 +138,26 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
 
     # imported here: sim.cells imports mujoco, and the command line must be able to choose the
     # OpenGL backend (MUJOCO_GL) after loading a scenario
-    from sim.cells import BARE, CELLS, resolve_tool
+    from sim.cells import BARE, resolve_cell, resolve_tool
 
+    base = Path(source).parent if str(source) != "<scenario>" else Path.cwd()
     try:
-        cell = None if spec.cell is None else CELLS.get(spec.cell)
-    except UnknownNameError as exc:
+        cell = None if spec.cell is None else resolve_cell(spec.cell, base)
+    except CellsimError as exc:  # a cell file's own error names its file and key
         raise ScenarioError(f"{where}: cell: {exc}") from None
+    mount = spec.mount
+    if cell is not None and cell.source is not None:
+        file_mount = cell.mounts[0]
+        if "mount" in spec.model_fields_set and spec.mount != file_mount:
+            raise ScenarioError(f"{where}: mount: {spec.mount!r}, but cell file {cell.source.name} "
+                                f"mounts the robot on the {file_mount} ([robot] mount); leave "
+                                "mount out or make the two agree")
+        mount = file_mount
+        if robot.name not in cell.robots:
+            raise ScenarioError(f"{where}: robot: cell file {cell.source.name} is laid out for "
+                                f"{cell.robots[0]} ([robot] model), not {robot.name}")
     try:
-        tool = resolve_tool(BARE if cell is None else cell, spec.tool)
+        tool = resolve_tool(BARE if cell is None else cell, spec.tool, base)
     except CellsimError as exc:
         raise ScenarioError(f"{where}: tool: {exc}") from None
     tool_kind = None if tool is None else tool.kind
@@ -180,7 +192,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         text=text,
         cell=cell,
         tool=tool,
-        mount=spec.mount,
+        mount=mount,
         payload_kg=spec.payload_kg,
         simulation=spec.simulation,
         video=spec.video,
@@ -295,15 +307,20 @@ def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
     if spec.euler_zyx_deg is not None and spec.to_mm is None:
         raise ScenarioError(f"{where}.euler_zyx_deg: only used with to_mm")
     if spec.to_seam is not None:
+        if spec.frame != "frame0":
+            raise ScenarioError(f"{where}.frame: only used with to_mm (a seam is in its cell)")
         return PoseTarget(seam=spec.to_seam)
     if spec.to_mm is None:
+        if spec.frame != "frame0":
+            raise ScenarioError(f"{where}.frame: only used with to_mm")
         return None
     rot = None
     if spec.euler_zyx_deg is not None:
         from sim.core.rotations import euler_zyx_to_matrix
 
         rot = euler_zyx_to_matrix(*np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)))
-    return PoseTarget(position=np.asarray(spec.to_mm, dtype=float) * 1e-3, rotation=rot)
+    return PoseTarget(position=np.asarray(spec.to_mm, dtype=float) * 1e-3, rotation=rot,
+                      frame=spec.frame)
 
 
 def _build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec,
@@ -321,7 +338,10 @@ def _build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec
                   speed=spec.speed_mm_s * 1e-3, sample_period=spec.sample_period_s,
                   ramp=spec.ramp_s, orientation=spec.orientation, seam=spec.seam,
                   euler_zyx=None if spec.euler_zyx_deg is None
-                  else np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)))
+                  else np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)),
+                  frame=spec.frame)
+    if spec.seam is not None and spec.frame != "frame0":
+        raise ScenarioError(f"{where}.frame: not used with seam (a seam is in its cell)")
     if isinstance(spec, LinearPhaseSpec):
         if (spec.seam is None) == (spec.to_mm is None):
             raise ScenarioError(f"{where}: give exactly one of seam or to_mm")
@@ -417,10 +437,9 @@ def _strip_tags(loc: tuple[Any, ...]) -> tuple[Any, ...]:
 
 
 def _format_loc(loc: tuple[Any, ...]) -> str:
-    out = ""
-    for part in _strip_tags(loc):
-        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
-    return out or "(top level)"
+    from sim.core.tomlschema import format_loc
+
+    return format_loc(_strip_tags(loc))
 
 
 def _model_at(loc: tuple[Any, ...], raw: Any) -> type[BaseModel] | None:

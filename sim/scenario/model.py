@@ -92,19 +92,23 @@ class PoseTarget:
     """Where a joint phase ends, in Cartesian terms (solved by inverse kinematics).
 
     Attributes:
-        position: tcp position in frame 0, m, (3,), or ``None`` with ``seam``.
-        rotation: tcp orientation in frame 0, (3, 3); ``None`` keeps the previous one.
+        position: tcp position in ``frame``, m, (3,), or ``None`` with ``seam``.
+        rotation: tcp orientation in ``frame``, (3, 3); ``None`` keeps the previous one.
         seam: A cell seam whose start (and torch posture) is the target.
+        frame: Frame of ``position`` and ``rotation``: ``frame0`` (the robot's), ``world`` or a
+            cell object's name.
     """
 
     position: NDArray[np.float64] | None = None
     rotation: NDArray[np.float64] | None = None
     seam: str | None = None
+    frame: str = "frame0"
 
 
 @dataclass(frozen=True)
 class CartesianPhase:
-    """A validated Cartesian phase (``linear`` or ``circular``), lengths in metres, frame0.
+    """A validated Cartesian phase (``linear`` or ``circular``), lengths in metres, points,
+    axis and Euler angles in ``frame`` (``frame0``, ``world`` or a cell object).
 
     Attributes:
         kind: ``"linear"`` or ``"circular"``.
@@ -131,6 +135,7 @@ class CartesianPhase:
     axis: NDArray[np.float64] | None = None
     sweep: float | None = None
     euler_zyx: NDArray[np.float64] | None = None
+    frame: str = "frame0"
 
 
 @dataclass(frozen=True)

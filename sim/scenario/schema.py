@@ -64,6 +64,8 @@ class JointPhaseSpec(_Strict):
     to_mm: Vec3 | None = None
     to_seam: str | None = None
     euler_zyx_deg: Vec3 | None = None
+    frame: str = Field("frame0", description='frame of to_mm and euler_zyx_deg: "frame0", '
+                       '"world" or a cell object')
     note: str | None = Field(None, description="free text (e.g. which seed value was chosen)")
 
 
@@ -76,6 +78,8 @@ class _CartesianSpec(_Strict):
     sample_period_s: float = Field(0.1, gt=0)
     ramp_s: float | None = Field(None, gt=0)
     euler_zyx_deg: Vec3 | None = None
+    frame: str = Field("frame0", description='frame of the points, axis and euler_zyx_deg: '
+                       '"frame0", "world" or a cell object')
     note: str | None = None
 
 

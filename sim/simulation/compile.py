@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.errors import InternalError
+from sim.errors import CellError, CellsimError, InternalError
 from sim.scenario import Scenario
 from sim.simulation.motion import CartesianContext
 
@@ -120,9 +120,12 @@ def build(scenario: Scenario) -> BuiltCell:
                  for p in cell.parts]
     tcp_site, frame0_site = model.site(cell.tcp_site).id, model.site(cell.frame0_site).id
     kin = _tool_kinematics(closed_form_model(scenario.robot), model, frame0_site, tcp_site,
-                           robot_qpos)
+                           robot_qpos,
+                           None if cell.tool is None or cell.tool.straight
+                           else model.site(cell.flange_site).id)
     ctx = CartesianContext(kinematics=kin, seams=dict(cell.seams),
-                           world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float))
+                           world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float),
+                           frames=dict(cell.frames))
     limits = np.where(model.actuator_forcelimited[robot_act, None].astype(bool),
                       model.actuator_forcerange[robot_act] * model.actuator_gear[robot_act, :1],
                       np.array([-np.inf, np.inf]))
@@ -133,7 +136,7 @@ def build(scenario: Scenario) -> BuiltCell:
 
 
 def _tool_kinematics(kin: KinematicModel, model: Any, f0: int, tcp: int,
-                     robot_qpos: NDArray[np.int64]) -> KinematicModel:
+                     robot_qpos: NDArray[np.int64], flange: int | None = None) -> KinematicModel:
     """The closed-form kinematics with the attached tool, measured from the compiled cell.
 
     Tools are straight (their tip lies on the seeds' tool axis), so the tool changes one
@@ -141,12 +144,32 @@ def _tool_kinematics(kin: KinematicModel, model: Any, f0: int, tcp: int,
     length ``r`` of the 200iC (seed 004, along z6 beyond R6). It is read off MuJoCo's ``tcp``
     in ``frame0`` at q = 0, where the seeds put the tool point at ``(l1 + l2 + l3, 0, d1)`` and
     ``(d2 + R4 + R6 + r, 0, d3 + d4)``; :func:`_check_tcp_consistency` then checks the whole pose.
+
+    A tool that is not straight (``flange`` given: a tool file's turned or offset tcp) keeps the
+    seed's tool frame on the flange, and the constant transform from it to MuJoCo's ``tcp``
+    at q = 0 becomes the model's ``tcp_offset`` (six-axis arms take any; the 5R family only
+    one on its J5 axis, and says so).
     """
+    import dataclasses
+
     import mujoco
 
     data = mujoco.MjData(model)
     data.qpos[robot_qpos] = 0.0
     mujoco.mj_kinematics(model, data)
-    p = data.site_xmat[f0].reshape(3, 3).T @ (data.site_xpos[tcp] - data.site_xpos[f0])
-    return kin.with_family(kin.family.tool_from_home_tcp(p))
+    R0 = data.site_xmat[f0].reshape(3, 3)
+    p = R0.T @ (data.site_xpos[tcp] - data.site_xpos[f0])
+    if flange is None:
+        return kin.with_family(kin.family.tool_from_home_tcp(p))
+    p_flange = R0.T @ (data.site_xpos[flange] - data.site_xpos[f0])
+    base = kin.with_family(kin.family.tool_from_home_tcp(p_flange))
+    T_tcp = np.eye(4)
+    T_tcp[:3, :3] = R0.T @ data.site_xmat[tcp].reshape(3, 3)
+    T_tcp[:3, 3] = p
+    offset = base.tcp_offset @ np.linalg.solve(base.fk(np.zeros(base.n_joints)), T_tcp)
+    offset[np.abs(offset) < 1e-15] = 0.0
+    try:
+        return dataclasses.replace(base, tcp_offset=offset)
+    except CellsimError as exc:
+        raise CellError(f"tool {model.site(tcp).name}: {exc}") from None
 

@@ -12,6 +12,7 @@ given in the world frame and converted with the cell's ``world_from_frame0``.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -179,11 +180,32 @@ class CartesianContext:
             (``fk(q)`` gives the tcp pose in frame 0; used by ``ik_path``).
         seams: Cell seams by name (world frame).
         world_from_frame0: Pose of frame 0 in the world, (4, 4).
+        frames: Poses of the cell's objects in the world by name, (4, 4) each: scenario points
+            may be given in them (``frame = "<object>"``).
     """
 
     kinematics: Any
     seams: dict[str, Any] = field(default_factory=dict)
     world_from_frame0: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    frames: dict[str, NDArray[np.float64]] = field(default_factory=dict)
+
+    def frame0_from(self, frame: str, label: str) -> NDArray[np.float64]:
+        """Pose of a named frame in frame 0, (4, 4): ``frame0`` (the robot's), ``world`` or a
+        cell object (:attr:`frames`: each object's pose in world).
+
+        Raises:
+            ScenarioError: Unknown frame (the message lists the valid ones).
+        """
+        if frame == "frame0":
+            return np.eye(4)
+        if frame == "world":
+            return self.frame0_from_world
+        if frame not in self.frames:
+            from sim.errors import UnknownNameError
+
+            raise ScenarioError(f"{label}.frame: "
+                                f"{UnknownNameError('frame', frame, ['frame0', 'world', *self.frames])}")
+        return self.frame0_from_world @ self.frames[frame]
 
     @property
     def frame0_from_world(self) -> NDArray[np.float64]:
@@ -371,11 +393,12 @@ def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianCont
     T = np.eye(4)
     if tgt.seam is not None:
         seam = _seam(ctx, tgt.seam, f"{label}.to_seam")
-        T[:3, 3] = ctx.to_frame0(seam.points[0])
+        T[:3, 3] = ctx.to_frame0(seam.tcp_point(0.0))
         T[:3, :3] = ctx.rot_to_frame0(seam.torch_rotation(0.0))
     else:
-        T[:3, 3] = tgt.position
-        T[:3, :3] = (tgt.rotation if tgt.rotation is not None
+        F = ctx.frame0_from(tgt.frame, label)
+        T[:3, 3] = F[:3, :3] @ tgt.position + F[:3, 3]
+        T[:3, :3] = (F[:3, :3] @ tgt.rotation if tgt.rotation is not None
                      else np.asarray(ctx.kinematics.fk(q0), dtype=float)[:3, :3])
     key = "to_seam" if tgt.seam is not None else "to_mm"
     try:
@@ -417,6 +440,13 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     kin = ctx.kinematics
     T0 = np.asarray(kin.fk(q0), dtype=float)
     p0, R0 = T0[:3, 3], T0[:3, :3]
+    F = ctx.frame0_from(phase.frame, label)  # the phase's points are in this frame
+
+    def pt(v: Any) -> Any:
+        return None if v is None else F[:3, :3] @ np.asarray(v, dtype=float) + F[:3, 3]
+
+    to, via, center = pt(phase.to), pt(phase.via), pt(phase.center)
+    axis = None if phase.axis is None else F[:3, :3] @ np.asarray(phase.axis, dtype=float)
 
     seam = None
     if phase.seam is not None:
@@ -424,7 +454,7 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
         if seam.kind != ("line" if phase.kind == "linear" else "arc"):
             raise ScenarioError(f"{label}.seam: {phase.seam!r} is a {seam.kind} seam; a "
                                 f"{phase.kind} phase needs a {'line' if phase.kind == 'linear' else 'arc'}")
-        start = ctx.to_frame0(seam.points[0])
+        start = ctx.to_frame0(seam.tcp_point(0.0))
         gap = float(np.linalg.norm(start - p0))
         if gap > 5e-4:
             raise ScenarioError(
@@ -438,25 +468,26 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     if phase.orientation == "euler":
         from sim.core.rotations import euler_zyx_to_matrix
 
-        rot_end = euler_zyx_to_matrix(*phase.euler_zyx)
+        rot_end = F[:3, :3] @ euler_zyx_to_matrix(*phase.euler_zyx)
     elif phase.orientation == "seam":
         rot_end = ctx.rot_to_frame0(seam.torch_rotation(seam.length()))
     kw: dict[str, Any] = dict(rotation_start=R0, orientation=mode,
                               ramp_time=phase.ramp if phase.ramp is not None
-                              else default_ramp(phase, p0, seam, ctx))
+                              else default_ramp(dataclasses.replace(
+                                  phase, to=to, via=via, center=center, axis=axis), p0, seam, ctx))
     if mode != "carry":
         kw["rotation_end"] = rot_end
     try:
         if phase.kind == "linear":
-            end = ctx.to_frame0(seam.points[1]) if seam is not None else phase.to
+            end = ctx.to_frame0(seam.tcp_points()[1]) if seam is not None else to
             cart = adnia.linear_move(p0, end, phase.speed, **kw)
         elif seam is not None:
-            via, end = ctx.to_frame0(seam.points[1]), ctx.to_frame0(seam.points[2])
+            via, end = ctx.to_frame0(seam.tcp_points()[1]), ctx.to_frame0(seam.tcp_points()[2])
             cart = adnia.arc_move(p0, via, end, phase.speed, **kw)
-        elif phase.via is not None:
-            cart = adnia.arc_move(p0, phase.via, phase.to, phase.speed, **kw)
+        elif via is not None:
+            cart = adnia.arc_move(p0, via, to, phase.speed, **kw)
         else:
-            cart = adnia.circle_move(phase.center, phase.axis, p0, phase.sweep, phase.speed, **kw)
+            cart = adnia.circle_move(center, axis, p0, phase.sweep, phase.speed, **kw)
     except PlannerError as exc:
         raise ScenarioError(f"{label}: {exc}") from None
 
