@@ -11,6 +11,7 @@ import difflib
 import re
 import tomllib
 import typing
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -76,15 +77,30 @@ def _toml_type(value: Any) -> str:
     return type(value).__name__
 
 
-def describe(exc: ValidationError, root: type[BaseModel]) -> str:
-    """One line for the first error: the key's dotted path and what is wrong with it."""
+def describe(exc: ValidationError, root: type[BaseModel], *,
+             locate: Callable[[tuple[Any, ...]], type[BaseModel] | None] | None = None,
+             strip: Callable[[tuple[Any, ...]], tuple[Any, ...]] | None = None,
+             union_hint: str | None = None) -> str:
+    """One line for the first error: the key's dotted path and what is wrong with it.
+
+    Args:
+        exc: pydantic's error.
+        root: The file's top-level model.
+        locate: The model validating the table at a location (default :func:`model_at`);
+            for the valid keys listed after an unknown one.
+        strip: Drops pydantic's union tags from a location (default: none).
+        union_hint: Message for an unknown tag of a tagged union (``kind: must be one of``).
+    """
+    strip = strip or (lambda loc: loc)
+    locate = locate or (lambda loc: model_at(root, loc))
     errors = exc.errors(include_url=False)
+    # a misspelt key also makes the right key "missing": report the unknown key first
     err = min(errors, key=lambda e: e["type"] != "extra_forbidden")
-    loc = tuple(err["loc"])
+    loc = strip(tuple(err["loc"]))
     path = format_loc(loc)
     kind = err["type"]
     if kind == "extra_forbidden":
-        parent = model_at(root, loc[:-1])
+        parent = locate(loc[:-1])
         valid = sorted(parent.model_fields) if parent else []
         close = difflib.get_close_matches(str(loc[-1]), valid, n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
@@ -93,6 +109,8 @@ def describe(exc: ValidationError, root: type[BaseModel]) -> str:
         return f"{path}: required key is missing"
     if kind == "finite_number":
         return f"{path}: must be a finite number (NaN and inf are not allowed)"
+    if kind in ("union_tag_invalid", "union_tag_not_found") and union_hint:
+        return f"{path}.{union_hint}"
     if kind in ("float_type", "int_type", "string_type", "list_type", "bool_type", "model_type",
                 "dict_type"):
         expected = {"float_type": "a number", "int_type": "an integer", "string_type": "a string",

@@ -391,38 +391,12 @@ def _check_continuity(prev: JointPhase, phase: JointPhase, where: str, robot: Ro
 
 
 def _describe_validation_error(exc: ValidationError, raw: Any) -> str:
-    """One line for the first pydantic error: dotted key path and what is wrong."""
-    errors = exc.errors(include_url=False)
-    # A misspelt key also makes the right key "missing": report the unknown key first.
-    err = min(errors, key=lambda e: e["type"] != "extra_forbidden")
-    loc = _strip_tags(err["loc"])
-    path = _format_loc(loc)
-    kind = err["type"]
-    if kind == "extra_forbidden":
-        parent_model = _model_at(loc[:-1], raw)
-        valid = sorted(parent_model.model_fields) if parent_model else []
-        close = difflib.get_close_matches(str(loc[-1]), valid, n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        return f"{path}: unknown key{hint}; valid keys: {', '.join(valid)}"
-    if kind == "missing":
-        return f"{path}: required key is missing"
-    if kind == "finite_number":
-        return f"{path}: must be a finite number (NaN and inf are not allowed)"
-    msg = err["msg"]
-    if kind == "literal_error":
-        msg = msg.replace("Input should be", "must be")
-    elif kind in ("union_tag_invalid", "union_tag_not_found"):
-        return f"{path}.kind: must be one of {', '.join(repr(k) for k in PHASE_KINDS)}"
-    elif kind in ("greater_than", "greater_than_equal", "less_than_equal", "less_than"):
-        msg = msg.replace("Input should be", "must be")
-    elif kind in ("too_short", "too_long"):
-        msg = msg.replace("List should have", "must have")
-    elif kind in ("float_type", "int_type", "string_type", "list_type", "bool_type", "model_type"):
-        expected = {"float_type": "a number", "int_type": "an integer", "string_type": "a string",
-                    "list_type": "an array", "bool_type": "true or false",
-                    "model_type": "a table"}[kind]
-        msg = f"must be {expected}, got {_toml_type(err.get('input'))}"
-    return f"{path}: {msg}"
+    """One line for the first pydantic error: dotted key path and what is wrong
+    (:func:`sim.core.tomlschema.describe`, with the phases' tagged union)."""
+    from sim.core.tomlschema import describe
+
+    return describe(exc, ScenarioSpec, locate=lambda loc: _model_at(loc, raw), strip=_strip_tags,
+                    union_hint=f"kind: must be one of {', '.join(repr(k) for k in PHASE_KINDS)}")
 
 
 def _strip_tags(loc: tuple[Any, ...]) -> tuple[Any, ...]:
@@ -434,12 +408,6 @@ def _strip_tags(loc: tuple[Any, ...]) -> tuple[Any, ...]:
             continue
         out.append(part)
     return tuple(out)
-
-
-def _format_loc(loc: tuple[Any, ...]) -> str:
-    from sim.core.tomlschema import format_loc
-
-    return format_loc(_strip_tags(loc))
 
 
 def _model_at(loc: tuple[Any, ...], raw: Any) -> type[BaseModel] | None:
@@ -461,20 +429,6 @@ def _model_at(loc: tuple[Any, ...], raw: Any) -> type[BaseModel] | None:
     if len(loc) == 1:
         return {"simulation": SimulationSpec, "video": VideoSpec}.get(head)
     return None
-
-
-def _toml_type(value: Any) -> str:
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, str):
-        return f"the string {value!r}"
-    if isinstance(value, (int, float)):
-        return f"the number {value!r}"
-    if isinstance(value, list):
-        return "an array"
-    if isinstance(value, dict):
-        return "a table"
-    return type(value).__name__
 
 
 # --------------------------------------------------------------------------------------------
