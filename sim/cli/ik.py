@@ -36,7 +36,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "at X Y Z (mm, frame0) with orientation R = Rz(A) Ry(B) Rx(G) (deg). "
                     "Solutions are listed best first: inside the joint ranges, then closest "
                     "to home (joint distance weighted by 1/max speed).")
-    p.add_argument("robot", metavar="ROBOT", help="robot name (see `cellsim list`)")
+    p.add_argument("robot", metavar="ROBOT",
+                   help="robot name (see `cellsim list`), or an arm as data: a URDF file, a "
+                        "robot.toml or its folder (closed form when ortho-parallel with a "
+                        "spherical wrist, numeric otherwise)")
     for axis in "XYZ":
         p.add_argument(axis.lower(), metavar=axis, type=float,
                        help=f"tcp {axis.lower()} in frame0, mm")
@@ -57,12 +60,50 @@ def _check_finite(label: str, values: list[float]) -> None:
             raise KinematicsError(f"{name} must be a finite number, got {v}")
 
 
+def _run_arm(args: argparse.Namespace) -> int:
+    """``cellsim ik`` of an arm given as data (:mod:`sim.robots.arm`): the flange pose in the
+    arm's base frame (a DH table's frame 0, a URDF's root link)."""
+    from sim.robots.arm import load_arm
+
+    if args.tool not in (None, "none"):
+        raise KinematicsError("--tool is for the shipped robots; an arm given as data solves for "
+                              "its flange")
+    arm = load_arm(args.robot)
+    p = np.asarray([args.x, args.y, args.z], dtype=float) / 1000.0
+    if args.euler_zyx_deg is None:
+        R = arm.fk(np.zeros(arm.chain.n))[:3, :3]
+    else:
+        R = euler_zyx_to_matrix(*np.deg2rad(args.euler_zyx_deg))
+    sols = arm.ik(make_transform(R, p))
+    shown = sols if args.all else sols[:1]
+    if args.json:
+        print(json.dumps({"robot": arm.name, "solver": arm.solver, "tool": None,
+                          "solutions": [{"joints_deg": [float(v) for v in np.rad2deg(s.q)],
+                                         "within_limits": bool(s.within_limits),
+                                         "branch": s.branch} for s in shown]}))
+        return 0
+    how = "closed form (OPW)" if arm.opw is not None else f"numeric ({arm.why_numeric})"
+    print(f"{arm.name} ({arm.source}): {len(sols)} solution(s), {how}; joints "
+          f"{' '.join(arm.chain.joint_names)} in deg")
+    for i, s in enumerate(shown, 1):
+        joints = " ".join(f"{v:9.3f}" for v in np.rad2deg(s.q))
+        flag = "within limits" if s.within_limits else "OUTSIDE joint limits"
+        print(f"  {i:2d}: {joints}   {flag}  [{s.branch}]")
+    if not args.all and len(sols) > 1:
+        print(f"  ({len(sols) - 1} more with --all)")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
-    spec = get_robot(args.robot)
+    from sim.robots.arm import is_arm_path
+
     position = [args.x, args.y, args.z]
     _check_finite("X Y Z", position)
     if args.euler_zyx_deg is not None:
         _check_finite("A B G", args.euler_zyx_deg)
+    if is_arm_path(args.robot):
+        return _run_arm(args)
+    spec = get_robot(args.robot)
     if args.tool is None or args.tool == "none":
         model = kinematic_model(spec)
     else:

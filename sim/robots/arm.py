@@ -1,0 +1,220 @@
+"""An arm given as data (a URDF, or a ``robot.toml`` with a DH table): its chain and its IK.
+
+:func:`load_arm` reads ``*.urdf`` files and ``robot.toml`` files (or the folder holding one);
+:class:`Arm` solves inverse kinematics with the closed form when the arm is ortho-parallel with
+a spherical wrist (:mod:`sim.robots.opw`: all 8 branches, plus the whole-turn variants of
+joints whose range exceeds 360 deg) and numerically otherwise (:mod:`sim.robots.numeric_ik`).
+
+``robot.toml`` (this slice reads its kinematics and joint tables)::
+
+    name = "my_arm"
+    description = "..."
+    [kinematics]
+    convention = "dh"            # "dh" | "mdh" | "urdf"
+    dh = [[a_mm, alpha_deg, d_mm, theta_offset_deg], ...]   # joint value q = theta - offset
+    # urdf = "arm.urdf"          # with convention = "urdf", relative to robot.toml
+    [joints]
+    range_deg = [[-170, 170], ...]
+    max_speed_deg_s = [...]
+
+For a robot given by a DH table, frame 0 (``cellsim ik``) is the table's base frame.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from pydantic import Field
+
+from sim.core.tomlschema import Strict, load_toml
+from sim.errors import KinematicsError
+from sim.robots import opw
+from sim.robots.chain import Chain, chain_from_dh, chain_from_urdf
+from sim.robots.numeric_ik import solve_ik as numeric_solve
+
+class KinematicsBlock(Strict):
+    convention: Literal["dh", "mdh", "urdf"]
+    dh: list[list[float]] | None = None
+    urdf: str | None = None
+
+
+class JointsBlock(Strict):
+    range_deg: list[list[float]] | None = None
+    max_speed_deg_s: list[float] | None = None
+    max_accel_deg_s2: list[float] | None = None
+
+
+class RobotFileSpec(Strict):
+    name: str = Field(pattern=r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*$")
+    description: str = ""
+    kinematics: KinematicsBlock
+    joints: JointsBlock = JointsBlock()
+
+
+@dataclass(frozen=True)
+class Solution:
+    """One IK solution: joint values (rad, (n,)), its branch label, within the limits."""
+
+    q: NDArray[np.float64]
+    branch: str
+    within_limits: bool
+
+
+@dataclass
+class Arm:
+    """A chain with its inverse kinematics (module docstring).
+
+    Attributes:
+        name: The arm's name. chain: Its kinematics. opw: OPW parameters when it is one (else
+        None, and ``why_numeric`` says why). source: The file it came from.
+    """
+
+    name: str
+    chain: Chain
+    opw: opw.OPWParameters | None
+    why_numeric: str = ""
+    source: Path | None = None
+
+    @property
+    def solver(self) -> str:
+        return "opw" if self.opw is not None else "numeric"
+
+    def fk(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Flange pose in frame 0 (the chain's base), (4, 4)."""
+        return self.chain.fk(q)
+
+    def ik(self, T: ArrayLike, current: ArrayLike | None = None) -> list[Solution]:
+        """Every solution of a flange pose: in the limits first, then nearest ``current``.
+
+        The closed form gives its 8 branches and, for joints with a range over 360 deg, each
+        whole-turn variant inside the range; the numeric solver the distinct solutions its seeds
+        reach. Solutions outside the limits are kept (flagged) when no variant is inside.
+        """
+        T = np.asarray(T, dtype=float)
+        lo, hi = self.chain.lower, self.chain.upper
+        cur = np.zeros(self.chain.n) if current is None else np.asarray(current, dtype=float)
+        out: list[Solution] = []
+        if self.opw is not None:
+            rows = opw.inverse(self.opw, T)
+            for q in rows:
+                if np.isnan(q).any():
+                    continue
+                if np.max(np.abs(self.chain.fk(q) - T)) > 1e-7:
+                    continue  # a branch the arm's geometry makes spurious
+                label = opw.configuration(self.opw, q)
+                variants = [_turns(q[i], lo[i], hi[i]) for i in range(len(q))]
+                if all(variants):
+                    for combo in itertools.product(*variants):
+                        out.append(Solution(np.array(combo), label, True))
+                else:
+                    out.append(Solution(q, label, False))
+        else:
+            for q in numeric_solve(self.chain, T, cur):
+                out.append(Solution(q, "numeric", True))
+        out = _dedupe(out)
+        out.sort(key=lambda s: (not s.within_limits, float(np.sum(np.abs(s.q - cur)))))
+        return out
+
+
+def _turns(q: float, lo: float, hi: float) -> list[float]:
+    """``q + 2 pi k`` for every whole k that lands in [lo, hi]."""
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return [q] if lo - 1e-9 <= q <= hi + 1e-9 else []
+    k0 = math.ceil((lo - q) / (2 * math.pi) - 1e-12)
+    out = []
+    k = k0
+    while q + 2 * math.pi * k <= hi + 1e-9:
+        out.append(q + 2 * math.pi * k)
+        k += 1
+    return out
+
+
+def _dedupe(sols: list[Solution]) -> list[Solution]:
+    out: list[Solution] = []
+    for s in sols:
+        if not any(np.max(np.abs(s.q - o.q)) < 1e-9 for o in out):
+            out.append(s)
+    return out
+
+
+def arm_from_chain(chain: Chain, source: Path | None = None) -> Arm:
+    """An :class:`Arm`: OPW when its axes at q = 0 make one, else numeric."""
+    if chain.n == 6:
+        axes, points, F = chain.frames(np.zeros(6))
+        try:
+            return Arm(chain.name, chain, opw.opw_from_axes(axes, points, F, chain.name),
+                       source=source)
+        except KinematicsError as exc:
+            return Arm(chain.name, chain, None, why_numeric=str(exc), source=source)
+    return Arm(chain.name, chain, None, why_numeric=f"{chain.n} joints (the closed form is for 6)",
+               source=source)
+
+
+def load_arm(path: str | Path) -> Arm:
+    """An arm from a URDF file, a ``robot.toml`` or a folder holding one.
+
+    Raises:
+        KinematicsError: One line naming the file and the key or joint: missing file, a DH row
+            of the wrong length, an unsupported joint type, limits with lower > upper.
+    """
+    path = Path(path)
+    if path.is_dir():
+        path = path / "robot.toml"
+    if path.suffix.lower() == ".urdf":
+        return arm_from_chain(chain_from_urdf(path), path)
+    spec, _ = load_toml(path, RobotFileSpec, KinematicsError)
+    k = spec.kinematics
+    where = str(path)
+    if k.convention == "urdf":
+        if k.urdf is None:
+            raise KinematicsError(f"{where}: kinematics.urdf: required with convention = \"urdf\"")
+        chain = chain_from_urdf(path.parent / k.urdf)
+    else:
+        if k.dh is None or not k.dh:
+            raise KinematicsError(f"{where}: kinematics.dh: required with convention = "
+                                  f"\"{k.convention}\" (rows [a_mm, alpha_deg, d_mm, "
+                                  "theta_offset_deg])")
+        for i, row in enumerate(k.dh):
+            if len(row) != 4:
+                raise KinematicsError(f"{where}: kinematics.dh[{i}]: {len(row)} values; a row is "
+                                      "[a_mm, alpha_deg, d_mm, theta_offset_deg]")
+        rows = np.array(k.dh, dtype=float)
+        rows[:, 0] *= 1e-3
+        rows[:, 2] *= 1e-3
+        rows[:, 1] = np.deg2rad(rows[:, 1])
+        rows[:, 3] = np.deg2rad(rows[:, 3])
+        n = len(rows)
+        lo = np.full(n, -np.inf)
+        hi = np.full(n, np.inf)
+        j = spec.joints
+        if j.range_deg is not None:
+            if len(j.range_deg) != n:
+                raise KinematicsError(f"{where}: joints.range_deg: {len(j.range_deg)} rows for "
+                                      f"{n} joints")
+            for i, r in enumerate(j.range_deg):
+                if len(r) != 2:
+                    raise KinematicsError(f"{where}: joints.range_deg[{i}]: give [lower, upper]")
+                if r[0] > r[1]:
+                    raise KinematicsError(f"{where}: joints.range_deg[{i}]: lower {r[0]:g} > "
+                                          f"upper {r[1]:g}")
+            lo, hi = np.deg2rad(np.array(j.range_deg, dtype=float)).T
+        chain = chain_from_dh(rows, k.convention, name=spec.name, lower=lo, upper=hi)
+    import dataclasses
+
+    chain = dataclasses.replace(chain, name=spec.name)
+    return arm_from_chain(chain, path)
+
+
+def is_arm_path(ref: str) -> bool:
+    """A robot reference that names a file or folder rather than a shipped robot."""
+    p = Path(ref)
+    return ref.endswith((".urdf", ".toml")) or "/" in ref or p.is_dir()
+
+
+__all__ = ["Arm", "Solution", "arm_from_chain", "is_arm_path", "load_arm"]

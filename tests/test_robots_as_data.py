@@ -1,0 +1,251 @@
+"""Robots as data (issue 13, first slice): arms from a DH table or a URDF, their forward
+kinematics, the OPW closed form derived from the joint axes, and a numeric IK otherwise.
+
+Independent references: the textbook DH product (:func:`sim.robots.chain.dh_product`, written
+from the formulas, not from the chain code); the URDF's own joint chain; the OPW parameters that
+ROS-Industrial publishes for the KUKA KR 6 R700 sixx and KR 6 R900-2
+(``kuka_kr6_support/config/opw_kinematics_kr6r700sixx.yaml`` and
+``opw_parameters_kr6r900_2.yaml``, github.com/ros-industrial/kuka_experimental, commit e78bbd1).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sim.errors import KinematicsError
+from sim.robots import opw
+from sim.robots.arm import load_arm
+from sim.robots.chain import chain_from_dh, chain_from_urdf, dh_product
+from sim.robots.numeric_ik import pose_error
+from sim.robots.numeric_ik import solve_ik as numeric_ik
+
+DATA = Path(__file__).resolve().parent / "data"
+
+#: Published OPW parameters (m, rad): kuka_experimental e78bbd1, kuka_kr6_support/config.
+PUBLISHED = {
+    "kuka_kr6r700sixx": dict(a1=0.025, a2=-0.035, b=0.0, c1=0.400, c2=0.315, c3=0.365, c4=0.080,
+                             offsets=(0.0, -np.pi / 2, 0, 0, 0, 0), signs=(-1, 1, 1, -1, 1, -1)),
+    "kuka_kr6r900_2": dict(a1=0.025, a2=-0.025, b=0.0, c1=0.400, c2=0.455, c3=0.420, c4=0.090,
+                           offsets=(0.0, -np.pi / 2, 0, 0, 0, 0), signs=(-1, 1, 1, -1, 1, -1)),
+}
+
+#: A six-axis OPW arm as a standard DH table [a m, alpha rad, d m, theta_offset rad] (an
+#: LR Mate 200iC-like geometry: a1 = 75, c1 = 330, c2 = 300, a2 = -75, c3 = 320, c4 = 80 mm).
+OPW_DH = np.array([[0.075, -np.pi / 2, 0.330, 0.0], [0.300, 0.0, 0.0, -np.pi / 2],
+                   [0.075, -np.pi / 2, 0.0, 0.0], [0.0, np.pi / 2, 0.320, 0.0],
+                   [0.0, -np.pi / 2, 0.0, 0.0], [0.0, 0.0, 0.080, 0.0]])
+#: A UR5 (offset wrist: not OPW), standard DH from Universal Robots' published table.
+UR5_DH = np.array([[0.0, np.pi / 2, 0.089159, 0.0], [-0.425, 0.0, 0.0, 0.0],
+                   [-0.39225, 0.0, 0.0, 0.0], [0.0, np.pi / 2, 0.10915, 0.0],
+                   [0.0, -np.pi / 2, 0.09465, 0.0], [0.0, 0.0, 0.0823, 0.0]])
+
+
+def random_q(chain, n: int, seed: int = 1) -> np.ndarray:
+    lo = np.where(np.isfinite(chain.lower), chain.lower, -np.pi)
+    hi = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
+    return np.random.default_rng(seed).uniform(lo, hi, size=(n, chain.n))
+
+
+def robot_toml(rows: np.ndarray, name: str, convention: str = "dh") -> str:
+    dh = ",\n  ".join(f"[{float(a * 1e3)!r}, {float(np.rad2deg(al))!r}, {float(d * 1e3)!r}, "
+                      f"{float(np.rad2deg(o))!r}]"
+                      for a, al, d, o in rows)
+    rng = ", ".join("[-170, 170]" for _ in rows)
+    return (f'name = "{name}"\n[kinematics]\nconvention = "{convention}"\ndh = [\n  {dh}\n]\n'
+            f"[joints]\nrange_deg = [{rng}]\n")
+
+
+def urdf_from_dh(rows: np.ndarray, name: str) -> str:
+    """The same arm as a URDF: joint i's origin is the DH transform of the rows before it
+    (written with rpy from the rotation), its axis z."""
+    from sim.core.rotations import matrix_to_euler_zyx
+
+    out = [f'<robot name="{name}">', '<link name="base"/>']
+    prev = "base"
+    T = np.eye(4)
+    for i, row in enumerate(rows):
+        origin = T
+        y, p, r = (float(v) for v in matrix_to_euler_zyx(origin[:3, :3]))
+        xyz = " ".join(repr(float(v)) for v in origin[:3, 3])
+        out += [f'<link name="l{i + 1}"/>',
+                f'<joint name="j{i + 1}" type="revolute"><parent link="{prev}"/>'
+                f'<child link="l{i + 1}"/><origin xyz="{xyz}" rpy="{r!r} {p!r} {y!r}"/>'
+                f'<axis xyz="0 0 1"/><limit lower="-2.96706" upper="2.96706" velocity="3"/>'
+                "</joint>"]
+        prev = f"l{i + 1}"
+        a, al, d, off = row
+        T = dh_product([[a, al, d, off]], [0.0])
+    y, p, r = (float(v) for v in matrix_to_euler_zyx(T[:3, :3]))
+    xyz = " ".join(repr(float(v)) for v in T[:3, 3])
+    out += ['<link name="tool0"/>', f'<joint name="flange" type="fixed"><parent link="{prev}"/>'
+            f'<child link="tool0"/><origin xyz="{xyz}" rpy="{r!r} {p!r} {y!r}"/></joint>',
+            "</robot>"]
+    return "\n".join(out)
+
+
+# ---------------------------------------------------------------------------- OPW from URDF
+@pytest.mark.parametrize("name", sorted(PUBLISHED))
+def test_opw_parameters_derived_from_the_urdf_equal_the_published_ones(name):
+    chain = chain_from_urdf(DATA / f"{name}.urdf")
+    axes, points, flange = chain.frames(np.zeros(6))
+    p = opw.opw_from_axes(axes, points, flange, name)
+    want = PUBLISHED[name]
+    for k, v in p.lengths().items():
+        assert v == pytest.approx(want[k], abs=1e-12), k
+    np.testing.assert_allclose(p.offsets, want["offsets"], atol=1e-12)
+    assert p.signs == want["signs"]
+    # tool0 is the OPW end frame (z along the tool axis)
+    np.testing.assert_allclose(p.flange, np.eye(4), atol=1e-12)
+
+
+@pytest.mark.parametrize("name", sorted(PUBLISHED))
+def test_opw_forward_equals_the_urdf_chain(name):
+    """1000 random configurations: the OPW closed form and the URDF's joint product agree to
+    1e-9 m (position) and 1e-9 (rotation entries)."""
+    arm = load_arm(DATA / f"{name}.urdf")
+    assert arm.solver == "opw"
+    Q = random_q(arm.chain, 1000)
+    T = opw.forward(arm.opw, Q)
+    err = max(np.abs(T[i] - arm.chain.fk(Q[i])).max() for i in range(len(Q)))
+    assert err < 1e-9, err
+
+
+# ---------------------------------------------------------------------------- DH and URDF
+@pytest.fixture(scope="module")
+def dh_arm(tmp_path_factory):
+    """The OPW_DH arm as a robot folder (robot.toml with the DH table) and as a URDF."""
+    root = tmp_path_factory.mktemp("arm")
+    (root / "my_arm").mkdir()
+    (root / "my_arm" / "robot.toml").write_text(robot_toml(OPW_DH, "my_arm"))
+    (root / "my_arm.urdf").write_text(urdf_from_dh(OPW_DH, "my_arm_urdf"))
+    return load_arm(root / "my_arm"), load_arm(root / "my_arm.urdf")
+
+
+def test_dh_table_and_urdf_forward_kinematics_equal_the_dh_product(dh_arm):
+    """The robot folder (DH table) and the same arm as a URDF: FK equals an independent DH
+    product to 1e-9 m for 1000 random configurations."""
+    from_dh, from_urdf = dh_arm
+    Q = random_q(from_dh.chain, 1000, seed=7)
+    for q in Q:
+        ref = dh_product(OPW_DH, q)
+        assert np.abs(from_dh.fk(q) - ref).max() < 1e-9
+        assert np.abs(from_urdf.fk(q) - ref).max() < 1e-9
+
+
+def test_the_dh_arm_is_recognised_as_opw_both_ways(dh_arm):
+    for arm in dh_arm:
+        assert arm.solver == "opw", arm.why_numeric
+        assert arm.opw.lengths()["c2"] == pytest.approx(0.300, abs=1e-12)
+
+
+@pytest.mark.parametrize("which", ["dh", "urdf", "kuka_kr6r700sixx", "kuka_kr6r900_2"])
+def test_ik_returns_every_configuration_the_pose_came_from(which, dh_arm):
+    """Random poses (FK of random configurations): the configuration is among the solutions
+    (modulo 2 pi), every solution reproduces the pose to 1e-9, at most 8 distinct solutions
+    modulo 2 pi."""
+    arm = {"dh": dh_arm[0], "urdf": dh_arm[1]}.get(which) or load_arm(DATA / f"{which}.urdf")
+    Q = random_q(arm.chain, 1000, seed=3)
+    for q in Q:
+        T = arm.fk(q)
+        sols = arm.ik(T)
+        assert sols
+        for s in sols:
+            assert np.linalg.norm(pose_error(arm.fk(s.q), T)) < 1e-9
+        wrapped = np.array([np.mod(s.q + np.pi, 2 * np.pi) - np.pi for s in sols])
+        distinct = []
+        for w in wrapped:
+            if not any(np.abs(np.angle(np.exp(1j * (w - d)))).max() < 1e-7 for d in distinct):
+                distinct.append(w)
+        assert len(distinct) <= 8
+        d = np.abs(np.angle(np.exp(1j * (wrapped - q)))).max(axis=1)
+        assert d.min() < 1e-7, (q, d.min())
+
+
+def test_a_joint_beyond_360_degrees_gets_its_whole_turn_variants():
+    """KR 6 J6 ranges +-350 deg: the configuration with q6 = 20 deg comes with q6 = -340 deg
+    (and not 380 deg, outside the range)."""
+    arm = load_arm(DATA / "kuka_kr6r700sixx.urdf")
+    q = np.deg2rad([10, -80, 100, 20, 40, 20])
+    q6 = sorted(np.rad2deg(s.q[5]) for s in arm.ik(arm.fk(q))
+                if np.abs(s.q[:5] - q[:5]).max() < 1e-9)
+    np.testing.assert_allclose(q6, [20 - 360, 20], atol=1e-9)
+
+
+# ---------------------------------------------------------------------------- numeric IK
+def test_an_offset_wrist_arm_falls_back_to_the_numeric_solver(tmp_path):
+    (tmp_path / "robot.toml").write_text(robot_toml(UR5_DH, "ur5"))
+    arm = load_arm(tmp_path)
+    assert arm.solver == "numeric" and "wrist" in arm.why_numeric
+
+
+def test_numeric_ik_solves_99_percent_of_reachable_poses(tmp_path):
+    """200 random reachable poses of a UR5 (its seeds: the zero pose, then random ones): at
+    least 99 % solved to a pose error under 1e-9; the 20 ms budget per pose is measured by
+    benchmarks/bench_numeric_ik.py, not here."""
+    chain = chain_from_dh(UR5_DH, lower=np.full(6, -2 * np.pi), upper=np.full(6, 2 * np.pi))
+    Q = random_q(chain, 200, seed=11)
+    solved = 0
+    for q in Q:
+        T = chain.fk(q)
+        sols = numeric_ik(chain, T, first=True)
+        if sols and np.linalg.norm(pose_error(chain.fk(sols[0]), T)) < 1e-9:
+            solved += 1
+    assert solved >= 198, solved
+
+
+# ---------------------------------------------------------------------------- bad input
+def _cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "sim", "ik", *args, "500", "0", "500"],
+                          capture_output=True, text=True, timeout=120)
+
+
+def _urdf_with(joint_type: str = "revolute", lower: str = "-1", upper: str = "1") -> str:
+    return (f'<robot name="bad"><link name="a"/><link name="b"/>'
+            f'<joint name="j1" type="{joint_type}"><parent link="a"/><child link="b"/>'
+            f'<axis xyz="0 0 1"/><limit lower="{lower}" upper="{upper}" velocity="1"/></joint>'
+            "</robot>")
+
+
+@pytest.mark.parametrize("case,content,needle", [
+    ("dh_row", 'name = "x"\n[kinematics]\nconvention = "dh"\ndh = [[1, 2, 3]]\n',
+     "kinematics.dh[0]: 3 values"),
+    ("range", robot_toml(OPW_DH[:2], "x").replace("[-170, 170]", "[170, -170]", 1),
+     "joints.range_deg[0]: lower 170 > upper -170"),
+    ("prismatic", _urdf_with("prismatic"), "joint 'j1': type 'prismatic' is not supported"),
+    ("continuous", _urdf_with("continuous"), "joint 'j1': type 'continuous' is not supported"),
+    ("limits", _urdf_with(lower="2", upper="1"), "joint 'j1': limit lower 2 > upper 1"),
+    ("missing", None, "no such URDF file"),
+])
+def test_bad_robot_data_is_one_line_and_exit_2(case, content, needle, tmp_path):
+    if case in ("dh_row", "range"):
+        path = tmp_path / "robot.toml"
+    else:
+        path = tmp_path / "arm.urdf"
+    if content is not None:
+        path.write_text(content)
+    r = _cli(str(path))
+    assert r.returncode == 2, r.stdout + r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0] and "Traceback" not in r.stderr, r.stderr
+    with pytest.raises(KinematicsError, match="."):
+        load_arm(path)
+
+
+def test_cellsim_ik_of_a_urdf_lists_the_closed_form_solutions():
+    r = subprocess.run([sys.executable, "-m", "sim", "ik", str(DATA / "kuka_kr6r700sixx.urdf"),
+                        "500", "100", "600", "--all", "--json"], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    import json
+
+    doc = json.loads(r.stdout)
+    assert doc["solver"] == "opw" and len(doc["solutions"]) >= 8
+    arm = load_arm(DATA / "kuka_kr6r700sixx.urdf")
+    for s in doc["solutions"]:
+        T = arm.fk(np.deg2rad(s["joints_deg"]))
+        np.testing.assert_allclose(T[:3, 3], [0.5, 0.1, 0.6], atol=1e-9)
