@@ -249,3 +249,81 @@ def test_cellsim_ik_of_a_urdf_lists_the_closed_form_solutions():
     for s in doc["solutions"]:
         T = arm.fk(np.deg2rad(s["joints_deg"]))
         np.testing.assert_allclose(T[:3, 3], [0.5, 0.1, 0.6], atol=1e-9)
+
+
+# ---------------------------------------------------------------------------- MDH
+def test_a_modified_dh_table_equals_its_textbook_product(tmp_path):
+    """Craig's modified DH (the rows of the LR Mate 200iC-like arm written in MDH form):
+    the chain equals the textbook MDH product for 1000 random configurations."""
+    rows = np.array([[0.0, 0.0, 0.330, 0.0], [0.075, -np.pi / 2, 0.0, -np.pi / 2],
+                     [0.300, 0.0, 0.0, 0.0], [0.075, -np.pi / 2, 0.320, 0.0],
+                     [0.0, np.pi / 2, 0.0, 0.0], [0.0, -np.pi / 2, 0.080, 0.0]])
+    (tmp_path / "robot.toml").write_text(robot_toml(rows, "mdh_arm", convention="mdh"))
+    arm = load_arm(tmp_path)
+    for q in random_q(arm.chain, 1000, seed=5):
+        assert np.abs(arm.fk(q) - dh_product(rows, q, "mdh")).max() < 1e-9
+
+
+# ---------------------------------------------------------------------------- maker's joints
+@pytest.mark.parametrize("robot", ["lrmate100ib", "lrmate200ic5l"])
+def test_fanuc_j3_is_measured_from_the_horizontal(robot):
+    """The J2/J3 interaction, checked on the arm itself: with the maker's J3 fixed, the
+    forearm's elevation (J3 axis to the wrist, in the arm plane) does not change with J2, and a
+    change of the maker's J3 turns it by that much; maps both ways are inverse."""
+    from sim.robots.maker import from_maker, to_maker
+    from sim.robots.model import closed_form_model
+    from sim.robots.registry import ROBOTS
+
+    spec = ROBOTS[robot]
+    km = closed_form_model(spec)
+    wrist = 3 if spec.n_joints == 5 else 4
+
+    def elevation(maker_deg):
+        q = from_maker(spec, np.deg2rad(maker_deg))
+        axes, points, _ = km.joint_frames(q)
+        v = points[wrist] - points[2]
+        v = v - (v @ axes[2]) * axes[2]
+        return np.degrees(np.arctan2(v[2], np.hypot(v[0], v[1])))
+
+    rng = np.random.default_rng(4)
+    for _ in range(50):
+        m = rng.uniform(-40, 40, spec.n_joints)
+        e0 = elevation(m)
+        for j2 in rng.uniform(-40, 40, 5):
+            m2 = m.copy()
+            m2[1] = j2
+            assert elevation(m2) == pytest.approx(e0, abs=1e-9)
+        m3 = m.copy()
+        m3[2] += 7.0
+        assert abs(elevation(m3) - e0) == pytest.approx(7.0, abs=1e-9)
+        np.testing.assert_allclose(to_maker(spec, from_maker(spec, m)), m, atol=1e-12)
+
+
+def test_joints_maker_deg_in_a_scenario_are_the_controllers_values():
+    """A scenario written with FANUC's joint values loads as the seed's joint values, and is
+    refused (one line) for the 5R robot, which has no maker's convention."""
+    from sim.errors import ScenarioError
+    from sim.robots.maker import to_maker
+    from sim.scenario.loader import parse_scenario
+
+    text = """
+name = "maker"
+description = "x"
+robot = "lrmate200ic5l"
+[[phases]]
+name = "p"
+planner = "434"
+time_s = [0, 1, 2]
+joints_maker_deg = [[0, 0, 0, 0, -90, 0], [10, 20, -30, 0, -60, 0], [20, 10, -10, 5, -45, 5]]
+"""
+    sc = parse_scenario(text, source="m.toml")
+    q = sc.phases[0].q
+    np.testing.assert_allclose(np.rad2deg(to_maker(sc.robot, q)),
+                               [[0, 0, 0, 0, -90, 0], [10, 20, -30, 0, -60, 0],
+                                [20, 10, -10, 5, -45, 5]], atol=1e-12)
+    # FANUC J2 = 20, J3 = -30: seed theta2 = -20 (sign), theta3 = J3 + J2 = -10
+    np.testing.assert_allclose(np.rad2deg(q[1, 1:3]), [-20.0, -10.0], atol=1e-12)
+    bad = text.replace('robot = "lrmate200ic5l"', 'robot = "robot_5r"').replace(
+        ", 0], [10", "], [10").replace("0, -60, 0]", "0, -60]").replace("5, -45, 5]", "5, -45]")
+    with pytest.raises(ScenarioError, match="no maker's joint convention"):
+        parse_scenario(bad, source="m.toml")

@@ -108,7 +108,7 @@ def _err(text: str) -> str:
     (('planner = "434"', 'planner = "434"\nstart_velocity_deg_s = [0,0]'),
      "phases[0].start_velocity_deg_s", "5 joints"),
     (('joints_deg', 'joints_rad = [[0,0,0,0,0],[0,0,0,0,0],[0,0,0,0,0]]\njoints_deg'),
-     "phases[0]", "exactly one of joints_deg or joints_rad"),
+     "phases[0]", "exactly one of joints_deg, joints_rad or joints_maker_deg"),
 ])
 def test_bad_input_names_the_key(mutation, key, fragment):
     old, new = mutation

@@ -49,6 +49,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tool", metavar="NAME", default=None,
                    help="the tcp is this tool's tip: a shipped tool (see `cellsim list`) or a "
                         "tool file (docs/cell-format.md); default: the flange centre (no tool)")
+    p.add_argument("--maker", action="store_true",
+                   help="also print the joint values in the maker's convention (FANUC: J3 from "
+                        "the horizontal, FANUC's signs), as the controller shows them")
     p.add_argument("--all", action="store_true", help="print every solution, not only the best")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)
@@ -65,9 +68,9 @@ def _run_arm(args: argparse.Namespace) -> int:
     arm's base frame (a DH table's frame 0, a URDF's root link)."""
     from sim.robots.arm import load_arm
 
-    if args.tool not in (None, "none"):
-        raise KinematicsError("--tool is for the shipped robots; an arm given as data solves for "
-                              "its flange")
+    if args.tool not in (None, "none") or args.maker:
+        raise KinematicsError("--tool and --maker are for the shipped robots; an arm given as "
+                              "data solves for its flange in its own joint values")
     arm = load_arm(args.robot)
     p = np.asarray([args.x, args.y, args.z], dtype=float) / 1000.0
     if args.euler_zyx_deg is None:
@@ -129,12 +132,20 @@ def run(args: argparse.Namespace) -> int:
     for w in caught:
         print(f"cellsim: warning: {w.message}", file=sys.stderr)
     shown = sols if args.all else sols[:1]
+    from sim.robots.maker import maker_joint_names, to_maker
+
     if args.json:
         doc = {"robot": spec.name, "tool": args.tool,
                "solutions": [{"joints_deg": [float(v) for v in np.rad2deg(s.q)],
                               "within_limits": bool(s.within_limits)} for s in shown]}
+        if args.maker:
+            doc["maker_joints"] = list(maker_joint_names(spec))
+            for d, s in zip(doc["solutions"], shown, strict=True):
+                d["joints_maker_deg"] = [float(v) for v in np.rad2deg(to_maker(spec, s.q))]
         print(json.dumps(doc))
         return 0
+    from sim.robots.maker import maker_joint_names, to_maker
+
     with_tool = f" with tool {args.tool}" if args.tool not in (None, "none") else ""
     print(f"{spec.title} ({spec.name}){with_tool}: {len(sols)} solution(s), best first; "
           f"joints {' '.join(spec.joints)} in deg")
@@ -142,6 +153,9 @@ def run(args: argparse.Namespace) -> int:
         joints = " ".join(f"{v:9.3f}" for v in np.rad2deg(s.q))
         flag = "within limits" if s.within_limits else "OUTSIDE joint limits"
         print(f"  {i:2d}: {joints}   {flag}  [{s.branch}]")
+        if args.maker:
+            maker = " ".join(f"{v:9.3f}" for v in np.rad2deg(to_maker(spec, s.q)))
+            print(f"      {maker}   maker's {' '.join(maker_joint_names(spec))}")
     if not args.all and len(sols) > 1:
         print(f"  ({len(sols) - 1} more with --all)")
     return 0

@@ -38,6 +38,7 @@ from sim.robots import opw
 from sim.robots.chain import Chain, chain_from_dh, chain_from_urdf
 from sim.robots.numeric_ik import solve_ik as numeric_solve
 
+
 class KinematicsBlock(Strict):
     convention: Literal["dh", "mdh", "urdf"]
     dh: list[list[float]] | None = None

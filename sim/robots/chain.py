@@ -146,10 +146,11 @@ def chain_from_dh(rows: ArrayLike, convention: str = "dh", *, name: str = "arm",
                 rot_axis(np.array([1.0, 0, 0]), alpha))
         end = prev
     else:
+        post = np.eye(4)
         for i, (a, alpha, d, off) in enumerate(rows_a):
             pre = _T(rot_axis(np.array([1.0, 0, 0]), alpha)) @ _T(None, [a, 0, 0])
             # Rz(q + off) Tz(d) = Rz(q) (Rz(off) Tz(d)): the constant part goes after the joint
-            origins[i] = pre if i == 0 else post @ pre
+            origins[i] = post @ pre
             post = _T(rot_axis(z, off)) @ _T(None, [0, 0, d])
         end = post
     fl = np.eye(4) if flange is None else np.asarray(flange, dtype=float)

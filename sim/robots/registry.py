@@ -111,6 +111,9 @@ class RobotSpec:
         max_accel: Joint acceleration limits, rad/s^2, shape (n_joints,): derived from the drive
             train with the rated payload (:mod:`sim.robots.accel_limits`, rounded down to two
             significant digits in deg/s^2; the model's README shows the derivation).
+        maker_joints: The maker's joint names (its controller's), when it has a convention.
+        maker_matrix: ``M`` with ``maker joint values = M @ seed joint values`` (rows of the
+            matrix); empty: the seed's convention is the maker's (:mod:`sim.robots.maker`).
     """
 
     name: str
@@ -124,6 +127,8 @@ class RobotSpec:
     joint_names: tuple[str, ...] = field(default=())
     payload_kg: float = 0.0
     max_accel: tuple[float, ...] = ()
+    maker_joints: tuple[str, ...] = ()
+    maker_matrix: tuple[tuple[float, ...], ...] = ()
 
     @property
     def n_joints(self) -> int:
@@ -176,6 +181,11 @@ for _spec in (
             ),
             payload_kg=5.0,
             max_accel=_deg(1800, 4500, 7500, 8700, 200000),
+            # FANUC's joints (J3 from the horizontal; the 5-axis wrist is J5, J6) from the
+            # RoboDK-derived table: theta = (J1, J2, -J2 - J3, -J5, -J6) (sim/robots/maker.py)
+            maker_joints=("J1", "J2", "J3", "J5", "J6"),
+            maker_matrix=((1, 0, 0, 0, 0), (0, 1, 0, 0, 0), (0, -1, -1, 0, 0),
+                          (0, 0, 0, -1, 0), (0, 0, 0, 0, -1)),
         ),
         RobotSpec(
             name="lrmate200ic5l",
@@ -196,6 +206,11 @@ for _spec in (
             ),
             payload_kg=5.0,
             max_accel=_deg(1400, 2300, 5200, 40000, 43000, 210000),
+            # FANUC's joints: U = s * theta (the URDF's), J3 from the horizontal:
+            # FANUC = (U1, U2, U3 - U2, U4, U5, U6) (sim/robots/maker.py)
+            maker_joints=("J1", "J2", "J3", "J4", "J5", "J6"),
+            maker_matrix=((1, 0, 0, 0, 0, 0), (0, -1, 0, 0, 0, 0), (0, 1, 1, 0, 0, 0),
+                          (0, 0, 0, -1, 0, 0), (0, 0, 0, 0, 1, 0), (0, 0, 0, 0, 0, -1)),
         ),
         RobotSpec(
             name="robot_5r",

@@ -235,18 +235,28 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
     if target is not None:
         n_rows -= 1  # the last knot comes from the pose target
     n = robot.n_joints
-    if spec.joints_deg is not None and spec.joints_rad is not None:
-        raise ScenarioError(f"{where}: give exactly one of joints_deg or joints_rad")
-    if spec.joints_deg is None and spec.joints_rad is None:
+    given = [k for k in ("joints_deg", "joints_rad", "joints_maker_deg")
+             if getattr(spec, k) is not None]
+    if len(given) > 1:
+        raise ScenarioError(f"{where}: give exactly one of joints_deg, joints_rad or "
+                            f"joints_maker_deg (got {' and '.join(given)})")
+    if spec.joints_maker_deg is not None and not robot.maker_matrix:
+        raise ScenarioError(f"{where}.joints_maker_deg: robot {robot.name} has no maker's joint "
+                            "convention of its own (its joint values are the seed's); use "
+                            "joints_deg")
+    if not given:
         if target is None:
-            raise ScenarioError(f"{where}: give joints_deg (or joints_rad), or a pose target "
+            raise ScenarioError(f"{where}: give joints_deg (or joints_rad, joints_maker_deg), or a pose target "
                                 "(to_mm or to_seam)")
         if times is not None:
             raise ScenarioError(f"{where}.joints_deg: required: its first row is the start knot")
         rows_q = np.zeros((0, n))
     else:
-        key, rows, scale = (("joints_deg", spec.joints_deg, math.pi / 180.0)
-                            if spec.joints_deg is not None else ("joints_rad", spec.joints_rad, 1.0))
+        key, rows, scale = {
+            "joints_deg": ("joints_deg", spec.joints_deg, math.pi / 180.0),
+            "joints_rad": ("joints_rad", spec.joints_rad, 1.0),
+            "joints_maker_deg": ("joints_maker_deg", spec.joints_maker_deg, math.pi / 180.0),
+        }[given[0]]
         assert rows is not None
         if len(rows) != n_rows:
             if target is not None:
@@ -263,6 +273,10 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
                     f"{where}.{key}[{r}]: {len(row)} values; robot {robot.name} has {n} joints "
                     f"({', '.join(robot.joints)})")
         rows_q = np.asarray(rows, dtype=float).reshape(-1, n) * scale
+        if key == "joints_maker_deg":  # the controller's joint values -> the seed's
+            from sim.robots.maker import from_maker
+
+            rows_q = from_maker(robot, rows_q)
     if target is None and rows_q.shape[0] == 0:
         raise ScenarioError(f"{where}: no knots")
     blocks = []

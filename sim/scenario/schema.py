@@ -49,6 +49,8 @@ class JointPhaseSpec(_Strict):
     durations_s: list[float] | None = Field(None, description="segment durations, s")
     joints_deg: list[list[float]] | None = Field(None, description="one row per knot, deg")
     joints_rad: list[list[float]] | None = Field(None, description="one row per knot, rad")
+    joints_maker_deg: list[list[float]] | None = Field(
+        None, description="one row per knot, deg, in the maker's joint convention")
     start_velocity_deg_s: list[float] | None = None
     start_velocity_rad_s: list[float] | None = None
     end_velocity_deg_s: list[float] | None = None
