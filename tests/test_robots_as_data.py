@@ -327,3 +327,110 @@ joints_maker_deg = [[0, 0, 0, 0, -90, 0], [10, 20, -30, 0, -60, 0], [20, 10, -10
         ", 0], [10", "], [10").replace("0, -60, 0]", "0, -60]").replace("5, -45, 5]", "5, -45]")
     with pytest.raises(ScenarioError, match="no maker's joint convention"):
         parse_scenario(bad, source="m.toml")
+
+
+# ---------------------------------------------------------------------------- robot folders
+def _former_specs():
+    """The three robots as sim/robots/registry.py defined them in Python before they became
+    folders (commit 34e77e9): the folders must hold the same values."""
+    from sim.robots.families import Fanuc6, FiveR
+    from sim.robots.registry import Drive, RobotSpec
+
+    def deg(*v):
+        return tuple(float(np.deg2rad(x)) for x in v)
+
+    return [
+        RobotSpec(name="lrmate100ib", title="FANUC LR Mate 100iB", folder="fanuc_lrmate100ib",
+                  robot_file="lrmate100ib.xml",
+                  family=FiveR({"l1": 0.150, "d1": 0.250, "l2": 0.220, "l3": 0.225}),
+                  max_speed=deg(240, 270, 270, 330, 480),
+                  description="5-axis FANUC LR Mate 100iB (seed 000), 5 kg payload",
+                  drives=(Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
+                          Drive(120, 0.75, 4.5e-5, 1.3, 4.5, 6000),
+                          Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
+                          Drive(80, 0.70, 5.0e-6, 0.32, 1.0, 5000),
+                          Drive(50, 0.70, 3.0e-6, 0.25, 0.8, 5000)),
+                  payload_kg=5.0, max_accel=deg(1800, 4500, 7500, 8700, 200000),
+                  maker_joints=("J1", "J2", "J3", "J5", "J6"),
+                  maker_matrix=((1, 0, 0, 0, 0), (0, 1, 0, 0, 0), (0, -1, -1, 0, 0),
+                                (0, 0, 0, -1, 0), (0, 0, 0, 0, -1))),
+        RobotSpec(name="lrmate200ic5l", title="FANUC LR Mate 200iC/5L",
+                  folder="fanuc_lrmate200ic", robot_file="lrmate200ic5l.xml",
+                  family=Fanuc6({"d2": 0.075, "d3": 0.400, "d4": 0.075, "R4": 0.410,
+                                 "R6": 0.080}),
+                  max_speed=deg(270, 270, 270, 450, 450, 720),
+                  description="6-axis FANUC LR Mate 200iC/5L (seed 004), 5 kg payload",
+                  drives=(Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
+                          Drive(120, 0.75, 4.5e-5, 1.3, 4.5, 6000),
+                          Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
+                          Drive(75, 0.70, 5.0e-6, 0.32, 1.0, 6000),
+                          Drive(75, 0.70, 5.0e-6, 0.32, 1.0, 6000),
+                          Drive(48, 0.70, 3.0e-6, 0.25, 0.8, 6000)),
+                  payload_kg=5.0, max_accel=deg(1400, 2300, 5200, 40000, 43000, 210000),
+                  maker_joints=("J1", "J2", "J3", "J4", "J5", "J6"),
+                  maker_matrix=((1, 0, 0, 0, 0, 0), (0, -1, 0, 0, 0, 0), (0, 1, 1, 0, 0, 0),
+                                (0, 0, 0, -1, 0, 0), (0, 0, 0, 0, 1, 0),
+                                (0, 0, 0, 0, 0, -1))),
+        RobotSpec(name="robot_5r", title="5R welding robot", folder="robot_5r",
+                  robot_file="robot_5r.xml",
+                  family=FiveR({"l1": 0.250, "d1": 1.000, "l2": 0.600, "l3": 0.400}),
+                  max_speed=deg(150, 150, 180, 300, 450),
+                  description="5-axis welding robot for large cylindrical parts (seed 001)",
+                  drives=(Drive(160, 0.80, 1.2e-3, 8.0, 32.0, 4000),
+                          Drive(160, 0.80, 2.3e-3, 12.0, 46.0, 4000),
+                          Drive(150, 0.80, 5.2e-4, 4.0, 15.0, 5000),
+                          Drive(90, 0.75, 2.9e-4, 2.0, 7.8, 5000),
+                          Drive(60, 0.75, 1.0e-4, 1.0, 4.0, 5000)),
+                  payload_kg=10.0, max_accel=deg(1200, 1700, 3700, 6900, 28000)),
+    ]
+
+
+@pytest.mark.parametrize("former", _former_specs(), ids=lambda s: s.name)
+def test_the_shipped_robot_folders_hold_the_former_values(former):
+    """models/<folder>/robot.toml, scanned by the registry, gives exactly the RobotSpec the
+    Python registry held (every field, every float): results are unchanged."""
+    from sim.robots.registry import ROBOTS
+
+    assert ROBOTS[former.name] == former
+    for f in former.__dataclass_fields__:
+        assert getattr(ROBOTS[former.name], f) == getattr(former, f), f
+
+
+BARE_SCENARIO = """
+name = "folder_robot"
+description = "a robot folder of one's own"
+robot = "{robot}"
+payload_kg = 2.0
+[[phases]]
+name = "move"
+planner = "434"
+time_s = [0.0, 0.8, 1.6]
+joints_deg = [[0, 0, 0, 0, -90, 0], [20, 10, -20, 10, -70, 20], [40, 20, -30, 0, -60, 0]]
+"""
+
+
+def test_a_robot_folder_of_ones_own_runs_a_scenario(tmp_path):
+    """A copy of the 200iC folder under another name, named by path in a scenario, runs and
+    gives the shipped robot's torques (same data); a folder without its MJCF is one line."""
+    import shutil
+
+    from sim.errors import ScenarioError
+    from sim.pipeline.run import evaluate_scenario
+    from sim.scenario import load_scenario
+
+    src = Path(__file__).resolve().parents[1] / "models" / "fanuc_lrmate200ic"
+    dst = tmp_path / "robots" / "my_arm"
+    shutil.copytree(src, dst)
+    toml = dst / "robot.toml"
+    toml.write_text(toml.read_text().replace('name = "lrmate200ic5l"', 'name = "my_arm"'))
+    (tmp_path / "mine.toml").write_text(BARE_SCENARIO.format(robot="robots/my_arm"))
+    (tmp_path / "shipped.toml").write_text(BARE_SCENARIO.format(robot="lrmate200ic5l"))
+    mine = load_scenario(tmp_path / "mine.toml")
+    assert mine.robot.name == "my_arm" and Path(mine.robot.robot_path).is_file()
+    a = evaluate_scenario(mine)
+    b = evaluate_scenario(load_scenario(tmp_path / "shipped.toml"))
+    np.testing.assert_array_equal(a.record.arrays["tau"], b.record.arrays["tau"])
+    assert a.summary["verdict"] == "pass"
+    (dst / "lrmate200ic5l.xml").unlink()
+    with pytest.raises(ScenarioError, match=r"robot: .*robot.toml: mjcf: no such file"):
+        load_scenario(tmp_path / "mine.toml")

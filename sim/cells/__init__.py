@@ -87,6 +87,8 @@ class CellSpec:
         needs_tool: The cell's work needs a tool (welding, picking): "no tool" is refused.
         source: The cell file (None for a cell built in Python).
         any_tool: The cell takes any tool (cell files: the scenario chooses).
+        any_robot: The cell takes any robot, a robot folder of one's own included (the bare
+            scene, a cell file without ``[robot] model``).
     """
 
     name: str
@@ -99,6 +101,7 @@ class CellSpec:
     needs_tool: bool = True
     source: Path | None = None
     any_tool: bool = False
+    any_robot: bool = False
 
 
 _TORCHES = (TOOLS["mig_torch"], TOOLS["mig_torch_long"])
@@ -172,7 +175,7 @@ CELLS: Registry[CellSpec] = _shipped_cells()
 
 #: The bare scene's entry (``cell=None``): every robot, any tool or none, both mounts.
 BARE = CellSpec("bare", "the robot alone: floor, lights, cameras", tuple(ROBOTS), None,
-                tuple(TOOLS.values()), MOUNTS, bare.build, needs_tool=False)
+                tuple(TOOLS.values()), MOUNTS, bare.build, needs_tool=False, any_robot=True)
 
 
 @dataclass
@@ -309,7 +312,8 @@ def load_cell(path: str | Path) -> CellSpec:
     needs = bool(spec.seams) or any(o.role == "part" for o in spec.objects)
     return CellSpec(spec.name, spec.description or f"cell file {path.name}", robots,
                     default_tool, tools, (spec.robot.mount,), make_builder(cf), needs_tool=needs,
-                    source=path.resolve(), any_tool=spec.tools is None)
+                    source=path.resolve(), any_tool=spec.tools is None,
+                    any_robot=spec.robot.model is None)
 
 
 def resolve_cell(ref: str, base: Path | None = None) -> CellSpec:
@@ -402,7 +406,7 @@ def build_cell(cell: CellSpec | None, robot: RobotSpec, *,
     """
     cspec = BARE if cell is None else cell
     spec_r = robot
-    if spec_r.name not in cspec.robots:
+    if not cspec.any_robot and spec_r.name not in cspec.robots:
         raise CellError(f"cell {cspec.name!r} is not built for robot {spec_r.name!r}; "
                         f"robots: {', '.join(cspec.robots)}")
     if mount not in MOUNTS:

@@ -26,7 +26,7 @@ from sim.core.rotations import euler_zyx_to_matrix, make_transform
 from sim.errors import KinematicsError
 from sim.robots.ik import solve_ik
 from sim.robots.model import kinematic_model
-from sim.robots.registry import get_robot
+from sim.robots.registry import resolve_robot
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -106,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
         _check_finite("A B G", args.euler_zyx_deg)
     if is_arm_path(args.robot):
         return _run_arm(args)
-    spec = get_robot(args.robot)
+    spec = resolve_robot(args.robot)
     if args.tool is None or args.tool == "none":
         model = kinematic_model(spec)
     else:

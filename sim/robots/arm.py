@@ -213,9 +213,23 @@ def load_arm(path: str | Path) -> Arm:
 
 
 def is_arm_path(ref: str) -> bool:
-    """A robot reference that names a file or folder rather than a shipped robot."""
+    """A robot reference that names an arm given as data (a URDF, or a robot.toml with a DH
+    table or a URDF) rather than a shipped robot or a robot folder with one of the seeds' closed
+    forms (``[kinematics] family``, :mod:`sim.robots.robotfile`)."""
+    import tomllib
+
     p = Path(ref)
-    return ref.endswith((".urdf", ".toml")) or "/" in ref or p.is_dir()
+    if not (ref.endswith((".urdf", ".toml")) or "/" in ref or p.is_dir()):
+        return False
+    toml = p / "robot.toml" if p.is_dir() else p
+    if toml.suffix == ".toml" and toml.is_file():
+        try:
+            raw = tomllib.loads(toml.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+            return True  # load_arm reports it
+        kin = raw.get("kinematics")
+        return not (isinstance(kin, dict) and "family" in kin)
+    return True
 
 
 __all__ = ["Arm", "Solution", "arm_from_chain", "is_arm_path", "load_arm"]

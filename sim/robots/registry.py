@@ -1,10 +1,12 @@
 """Registry of the robots cellsim models.
 
-Each :class:`RobotSpec` names the robot's MJCF file (under ``models/``), its kinematic family
-and the dimensions its closed-form kinematics use, in metres. Joint position ranges live in
-the MJCF files (single source of truth, read back with :func:`joint_ranges`); joint speed
-limits, which MJCF has no field for, live here. Sources of every number: the README of each
-model folder and ``../shared/reference/robots.md``.
+A robot is a folder under ``models/``: its MJCF, ``scene.xml``, a README deriving each number
+and a ``robot.toml`` with what the code needs (:mod:`sim.robots.robotfile`: kinematic family and
+dimensions, speed and acceleration limits, drive trains, payload, the maker's joint convention);
+:data:`ROBOTS` is built by scanning those folders, and :func:`resolve_robot` also takes a folder
+of one's own. Joint position ranges live in the MJCF files (single source of truth, read back
+with :func:`joint_ranges`). Sources of every number: the README of each model folder and
+``../shared/reference/robots.md``.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from planners.registry import Registry
 from sim.core.resources import models_dir
 from sim.errors import KinematicsError
-from sim.robots.families import Fanuc6, FiveR, KinematicFamily
+from sim.robots.families import KinematicFamily
 
 #: Joint speed (rad/s) from which a joint's Coulomb friction is its ``frictionloss`` in full;
 #: below it the friction torque ramps linearly through zero: ``F * clip(qd / COULOMB_SPEED, -1,
@@ -152,89 +154,19 @@ class RobotSpec:
         return models_dir() / self.folder / "scene.xml"
 
 
-def _deg(*values: float) -> tuple[float, ...]:
-    return tuple(float(np.deg2rad(v)) for v in values)
+def _shipped_robots() -> Registry[RobotSpec]:
+    """The robot folders of ``models/`` (each with a ``robot.toml``, :mod:`sim.robots.robotfile`)."""
+    from sim.robots.robotfile import load_robot_folder
+
+    reg: Registry[RobotSpec] = Registry("robot")
+    for path in sorted(models_dir().glob("*/robot.toml")):
+        spec = load_robot_folder(path.parent)
+        reg.add(spec.name, spec)
+    return reg
 
 
-#: The shipped robots by name.
-ROBOTS: Registry[RobotSpec] = Registry("robot")
-for _spec in (
-        RobotSpec(
-            name="lrmate100ib",
-            title="FANUC LR Mate 100iB",
-            folder="fanuc_lrmate100ib",
-            robot_file="lrmate100ib.xml",
-            # seed 000 Table 2 point 0 fixes d1 and l1+l2+l3; split after the RoboDK table
-            # (../shared/reference/robots.md); l3 = 80 mm flange + 145 mm torch.
-            family=FiveR({"l1": 0.150, "d1": 0.250, "l2": 0.220, "l3": 0.225}),
-            # as commonly quoted for the LR Mate 100iB/200iB family (estimate, see model README)
-            max_speed=_deg(240, 270, 270, 330, 480),
-            description="5-axis FANUC LR Mate 100iB (seed 000), 5 kg payload",
-            # estimated beta-iS class motors (0.2-0.75 kW) + harmonic reducers; the README of
-            # the model lists the sizing criteria (speed, gravity torque with 5 kg payload)
-            drives=(
-                Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
-                Drive(120, 0.75, 4.5e-5, 1.3, 4.5, 6000),
-                Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
-                Drive(80, 0.70, 5.0e-6, 0.32, 1.0, 5000),
-                Drive(50, 0.70, 3.0e-6, 0.25, 0.8, 5000),
-            ),
-            payload_kg=5.0,
-            max_accel=_deg(1800, 4500, 7500, 8700, 200000),
-            # FANUC's joints (J3 from the horizontal; the 5-axis wrist is J5, J6) from the
-            # RoboDK-derived table: theta = (J1, J2, -J2 - J3, -J5, -J6) (sim/robots/maker.py)
-            maker_joints=("J1", "J2", "J3", "J5", "J6"),
-            maker_matrix=((1, 0, 0, 0, 0), (0, 1, 0, 0, 0), (0, -1, -1, 0, 0),
-                          (0, 0, 0, -1, 0), (0, 0, 0, 0, -1)),
-        ),
-        RobotSpec(
-            name="lrmate200ic5l",
-            title="FANUC LR Mate 200iC/5L",
-            folder="fanuc_lrmate200ic",
-            robot_file="lrmate200ic5l.xml",
-            family=Fanuc6({"d2": 0.075, "d3": 0.400, "d4": 0.075, "R4": 0.410, "R6": 0.080}),
-            max_speed=_deg(270, 270, 270, 450, 450, 720),  # ROS-Industrial URDF
-            description="6-axis FANUC LR Mate 200iC/5L (seed 004), 5 kg payload",
-            # estimated beta-iS class motors (0.2-0.75 kW) + harmonic reducers (model README)
-            drives=(
-                Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
-                Drive(120, 0.75, 4.5e-5, 1.3, 4.5, 6000),
-                Drive(120, 0.75, 2.0e-5, 0.65, 2.4, 6000),
-                Drive(75, 0.70, 5.0e-6, 0.32, 1.0, 6000),
-                Drive(75, 0.70, 5.0e-6, 0.32, 1.0, 6000),
-                Drive(48, 0.70, 3.0e-6, 0.25, 0.8, 6000),
-            ),
-            payload_kg=5.0,
-            max_accel=_deg(1400, 2300, 5200, 40000, 43000, 210000),
-            # FANUC's joints: U = s * theta (the URDF's), J3 from the horizontal:
-            # FANUC = (U1, U2, U3 - U2, U4, U5, U6) (sim/robots/maker.py)
-            maker_joints=("J1", "J2", "J3", "J4", "J5", "J6"),
-            maker_matrix=((1, 0, 0, 0, 0, 0), (0, -1, 0, 0, 0, 0), (0, 1, 1, 0, 0, 0),
-                          (0, 0, 0, -1, 0, 0), (0, 0, 0, 0, 1, 0), (0, 0, 0, 0, 0, -1)),
-        ),
-        RobotSpec(
-            name="robot_5r",
-            title="5R welding robot",
-            folder="robot_5r",
-            robot_file="robot_5r.xml",
-            # chosen for seed 001's cell (models/robot_5r/README.md): l3 = 100 mm flange +
-            # 300 mm torch; long upper arm, short forearm for a large seam radius
-            family=FiveR({"l1": 0.250, "d1": 1.000, "l2": 0.600, "l3": 0.400}),
-            max_speed=_deg(150, 150, 180, 300, 450),  # estimate for the 1.8-2 m reach class
-            description="5-axis welding robot for large cylindrical parts (seed 001)",
-            # estimated alpha-iS class motors (1-3 kW) + cycloidal/harmonic reducers
-            drives=(
-                Drive(160, 0.80, 1.2e-3, 8.0, 32.0, 4000),
-                Drive(160, 0.80, 2.3e-3, 12.0, 46.0, 4000),
-                Drive(150, 0.80, 5.2e-4, 4.0, 15.0, 5000),
-                Drive(90, 0.75, 2.9e-4, 2.0, 7.8, 5000),
-                Drive(60, 0.75, 1.0e-4, 1.0, 4.0, 5000),
-            ),
-            payload_kg=10.0,
-            max_accel=_deg(1200, 1700, 3700, 6900, 28000),
-        ),
-):
-    ROBOTS.add(_spec.name, _spec)
+#: The shipped robots by name, read from ``models/*/robot.toml``.
+ROBOTS: Registry[RobotSpec] = _shipped_robots()
 
 
 @lru_cache(maxsize=None)
@@ -272,3 +204,21 @@ def get_robot(name: str) -> RobotSpec:
         UnknownNameError: The name is not registered; the message lists the known robots.
     """
     return ROBOTS.get(name)
+
+
+def resolve_robot(ref: str, base: Path | None = None) -> RobotSpec:
+    """A shipped robot by name, or a robot folder of one's own (a path, relative to ``base``,
+    the scenario's folder, holding a ``robot.toml``).
+
+    Raises:
+        UnknownNameError: Unknown name (the message lists the robots).
+        KinematicsError: A folder without a valid ``robot.toml`` (one line naming file and key).
+    """
+    if "/" in ref or "\\" in ref or ref.endswith(".toml"):
+        from sim.robots.robotfile import load_robot_folder
+
+        path = Path(ref) if base is None else base / ref
+        if not (path.is_dir() and (path / "robot.toml").is_file()) and not path.is_file():
+            raise KinematicsError(f"{path}: no robot folder (a folder with a robot.toml)")
+        return load_robot_folder(path)
+    return ROBOTS.get(ref)

@@ -27,8 +27,8 @@ from pydantic import BaseModel, ValidationError
 from planners.errors import PlannerError
 from planners.registry import get_planner
 from sim.core.resources import shipped_scenarios
-from sim.errors import CellsimError, ScenarioError, UnknownNameError
-from sim.robots.registry import RobotSpec, get_robot
+from sim.errors import CellsimError, ScenarioError
+from sim.robots.registry import RobotSpec, resolve_robot
 from sim.scenario.model import (
     Action,
     CartesianPhase,
@@ -99,8 +99,9 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
     except ValidationError as exc:
         raise ScenarioError(f"{where}: {_describe_validation_error(exc, raw)}") from None
     try:
-        robot = get_robot(spec.robot)
-    except UnknownNameError as exc:
+        robot = resolve_robot(
+            spec.robot, Path(source).parent if str(source) != "<scenario>" else None)
+    except CellsimError as exc:  # unknown name, or a robot folder's own error
         raise ScenarioError(f"{where}: robot: {exc}") from None
 
     phases: list[Phase] = []
@@ -153,7 +154,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
                                 f"mounts the robot on the {file_mount} ([robot] mount); leave "
                                 "mount out or make the two agree")
         mount = file_mount
-        if robot.name not in cell.robots:
+        if not cell.any_robot and robot.name not in cell.robots:
             raise ScenarioError(f"{where}: robot: cell file {cell.source.name} is laid out for "
                                 f"{cell.robots[0]} ([robot] model), not {robot.name}")
     try:
