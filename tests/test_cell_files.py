@@ -393,6 +393,81 @@ def test_a_seam_stickout_moves_the_tool_point_back_along_the_torch():
     np.testing.assert_allclose(arc.pose(arc.length())[:3, 3], ctrl[-1], atol=1e-12)
 
 
+# ---------------------------------------------------------------------------- ring distance
+def test_the_ring_sector_distance_is_exact_at_its_cut_faces():
+    """Solid.distance of a ring sector against a brute-force distance to a dense sampling of
+    its surface (outside points) and to its nearest face (inside points)."""
+    from sim.cells.cellfile import ObjectBlock, _ring_distance
+
+    b = ObjectBlock(name="r", shape="ring", radius_mm=300.0, inner_radius_mm=200.0,
+                    length_mm=100.0, arc_deg=[10.0, 100.0])
+    a0, a1 = np.deg2rad([10.0, 100.0])
+    # the sector's boundary, sampled: outer/inner cylinders, top/bottom, two cut faces
+    g = np.linspace(0, 1, 121)
+    A, Z, R = np.meshgrid(a0 + g * (a1 - a0), -0.05 + 0.1 * g, 0.2 + 0.1 * g, indexing="ij")
+    surf = []
+    for r in (0.2, 0.3):
+        surf.append(np.stack([r * np.cos(A[:, :, 0]), r * np.sin(A[:, :, 0]), Z[:, :, 0]], -1))
+    for z in (-0.05, 0.05):
+        surf.append(np.stack([R[:, 0] * np.cos(A[:, 0]), R[:, 0] * np.sin(A[:, 0]),
+                              np.full_like(A[:, 0], z)], -1))
+    for a in (a0, a1):
+        surf.append(np.stack([R[0] * np.cos(a), R[0] * np.sin(a), Z[0]], -1))
+    S = np.concatenate([x.reshape(-1, 3) for x in surf])
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        p = rng.uniform([-0.4, -0.4, -0.15], [0.4, 0.4, 0.15])
+        d = _ring_distance(p, b)
+        brute = float(np.min(np.linalg.norm(S - p, axis=1)))
+        assert abs(abs(d) - brute) < 3e-3, (p, d, brute)  # the sampling's resolution
+        rho, phi = np.hypot(p[0], p[1]), np.mod(np.arctan2(p[1], p[0]), 2 * np.pi)
+        inside = 0.2 <= rho <= 0.3 and abs(p[2]) <= 0.05 and a0 <= phi <= a1
+        assert (d < 0) == inside
+    # 0.24 mm inside a cut face is 0.24 mm deep, not the distance to the walls
+    p = np.array([0.25 * np.cos(a0 + 0.00024 / 0.25), 0.25 * np.sin(a0 + 0.00024 / 0.25), 0.0])
+    assert _ring_distance(p, b) == pytest.approx(-0.00024, abs=1e-6)
+
+
+def test_start_deg_is_checked_for_the_cells_own_tool_file(tmp_path):
+    """start_deg given for a cell whose tool is a tool file is checked against that tool: a
+    configuration 0.9 m off the seam start is one line."""
+    cell = CELL.replace('tool = "mig_torch"', 'tool = "mytorch.toml"').replace(
+        f"base_euler_zyx_deg = [{BASE_YAW_DEG}, 0, 0]",
+        f"base_euler_zyx_deg = [{BASE_YAW_DEG}, 0, 0]\nstart_deg = [0, 0, 0, 0, 0, 0]")
+    path = make_cell(tmp_path, cell=cell)
+    (tmp_path / "cells" / "mytorch.toml").write_text(
+        'name = "mytorch"\nmass_kg = 1\ntcp_mm = [0, 0, 145]\n[[shapes]]\nshape = "sphere"\n'
+        "radius_mm = 20\n")
+    with pytest.raises(CellError, match=r"robot.start_deg: puts the tool point .* mm from the "
+                                        r"start of seam 'bead'"):
+        build_cell(load_scenario(path).cell, load_scenario(path).robot,
+                   tool=load_scenario(path).tool)
+
+
+def test_a_stickout_on_a_tilted_arc_is_refused(tmp_path):
+    """The stand-off path of an arc is a coaxial arc only with the normal along its axis."""
+    cell = CELL.replace(
+        'kind = "line"\npoints_mm = [[40.0, 70.0, 10.0], [160.0, 70.0, 10.0]]\nnormal = [0, 0, 1]',
+        'kind = "arc"\npoints_mm = [[40.0, 70.0, 10.0], [100.0, 100.0, 10.0], [160.0, 70.0, 10.0]]'
+        '\nnormal = [0, 1, 1]\nstickout_mm = 20')
+    (tmp_path / "cells" / "parts").mkdir(parents=True)
+    write_bracket(tmp_path / "cells" / "parts" / "bracket.stl")
+    (tmp_path / "cells" / "user_cell.toml").write_text(cell)
+    with pytest.raises(CellError, match=r"seams\[0\].stickout_mm: on an arc"):
+        load_cell(tmp_path / "cells" / "user_cell.toml")
+
+
+def test_a_tool_files_mesh_is_checked_when_the_file_is_read(tmp_path):
+    from sim.cells.toolfile import load_tool_file
+
+    (tmp_path / "m.stl").write_text("not a mesh\n")
+    (tmp_path / "t.toml").write_text('name = "t"\nmass_kg = 1\ntcp_mm = [0, 0, 100]\n'
+                                     'mesh = "m.stl"\n[[shapes]]\nshape = "sphere"\n'
+                                     "radius_mm = 20\n")
+    with pytest.raises(CellError, match=r"t.toml: mesh: "):
+        load_tool_file(tmp_path / "t.toml")
+
+
 # ---------------------------------------------------------------------------- bad input
 BAD = {
     "unknown object": (("object = \"bracket\"", "object = \"brackt\""),
@@ -406,6 +481,21 @@ BAD = {
                           "robot.base_pos_mm: the robot base"),
     "unknown key": (("work_angle_deg = 90", "work_angel_deg = 90"),
                     "seams[0].work_angel_deg: unknown key (did you mean 'work_angle_deg'?)"),
+    "a generated name clashes": (('name = "table"', 'name = "bracket_c0"'),
+                                 "gives a geom named 'bracket_c0', which clashes"),
+    "a huge base position": ((f"base_pos_mm = {list(BASE_MM)}", "base_pos_mm = [1e300, 0, 0]"),
+                             "robot.base_pos_mm[0]: must be less than or equal to 1000000"),
+    "a huge size": (("size_mm = [500, 700, 40]", "size_mm = [1e308, 700, 40]"),
+                    "objects[1].size_mm[0]: must be less than or equal to 1000000"),
+    "a part that is a ring": (('shape = "box"\nsize_mm = [500, 700, 40]',
+                               'shape = "ring"\nradius_mm = 50\ninner_radius_mm = 20\n'
+                               'length_mm = 40\nrole = "part"\nmass_kg = 1'),
+                              "objects[1].shape: a part cannot be a ring"),
+    "a polyline whose normal runs along a later segment": (
+        ('kind = "line"\npoints_mm = [[40.0, 70.0, 10.0], [160.0, 70.0, 10.0]]',
+         'kind = "polyline"\npoints_mm = [[40.0, 70.0, 10.0], [100.0, 70.0, 10.0], '
+         '[100.0, 70.0, 0.0]]'),
+        "seams[0].normal: [0.0, 0.0, 1.0] runs along the seam (segment 2)"),
 }
 
 

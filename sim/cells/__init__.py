@@ -157,6 +157,8 @@ def _shipped_cells() -> Registry[CellSpec]:
         groups.setdefault(cf.spec.name, []).append(cf)
     reg: Registry[CellSpec] = Registry("cell")
     for name, files in groups.items():
+        for cf in files:
+            cf.default_tool = None if cf.spec.tool is None else TOOLS[cf.spec.tool]
         build = _Variants(name, {(cf.spec.robot.model, cf.spec.robot.mount): make_builder(cf)
                                  for cf in files})
         first = files[0].spec
@@ -310,6 +312,7 @@ def load_cell(path: str | Path) -> CellSpec:
         except CellsimError as exc:
             raise CellError(f"{path}: tools[{i}]: {exc}") from None
     needs = bool(spec.seams) or any(o.role == "part" for o in spec.objects)
+    cf.default_tool = default_tool
     return CellSpec(spec.name, spec.description or f"cell file {path.name}", robots,
                     default_tool, tools, (spec.robot.mount,), make_builder(cf), needs_tool=needs,
                     source=path.resolve(), any_tool=spec.tools is None,

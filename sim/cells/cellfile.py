@@ -31,7 +31,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -67,6 +67,15 @@ DIM_UNITS = ("_mm", "_kg", "_deg")
 RESERVED = ("floor", "robot", "world", "frame0", "overview", "tool")
 
 
+#: Largest length a cell file takes, mm (1 km): a bigger one is a typo, and would only make
+#: MuJoCo's compiler or the closed forms fail later with less helpful words.
+MAX_MM = 1e6
+#: A length or coordinate in mm, bounded.
+Mm = Annotated[float, Field(ge=-MAX_MM, le=MAX_MM)]
+#: A size in mm: positive, bounded.
+Size = Annotated[float, Field(gt=0, le=MAX_MM)]
+
+
 def _vec3(default: list[float] | None = None):
     if default is None:
         return Field(min_length=3, max_length=3)
@@ -77,7 +86,7 @@ class RobotBlock(Strict):
     """``[robot]``: where the robot stands."""
 
     model: str | None = None
-    base_pos_mm: list[float] = _vec3([0.0, 0.0, 0.0])
+    base_pos_mm: list[Mm] = _vec3([0.0, 0.0, 0.0])
     base_euler_zyx_deg: list[float] = _vec3([0.0, 0.0, 0.0])
     mount: Literal["floor", "ceiling"] = "floor"
     home_deg: list[float] | None = None
@@ -89,15 +98,15 @@ class ObjectBlock(Strict):
 
     name: str = Field(pattern=_NAME)
     shape: Literal["box", "cylinder", "sphere", "mesh", "ring"]
-    size_mm: list[float] | None = Field(None, min_length=3, max_length=3)
-    radius_mm: float | None = Field(None, gt=0)
-    inner_radius_mm: float | None = Field(None, ge=0)
-    length_mm: float | None = Field(None, gt=0)
+    size_mm: list[Size] | None = Field(None, min_length=3, max_length=3)
+    radius_mm: float | None = Field(None, gt=0, le=MAX_MM)
+    inner_radius_mm: float | None = Field(None, ge=0, le=MAX_MM)
+    length_mm: float | None = Field(None, gt=0, le=MAX_MM)
     arc_deg: list[float] | None = Field(None, min_length=2, max_length=2)
     segments: int | None = Field(None, ge=3, le=720)
     file: str | None = None
     mesh_unit: Literal["mm", "m"] = "mm"
-    pos_mm: list[float] = _vec3([0.0, 0.0, 0.0])
+    pos_mm: list[Mm] = _vec3([0.0, 0.0, 0.0])
     euler_zyx_deg: list[float] = _vec3([0.0, 0.0, 0.0])
     role: Literal["fixture", "workpiece", "part"] = "fixture"
     mass_kg: float | None = Field(None, gt=0, le=1000)
@@ -113,7 +122,7 @@ class SeamBlock(Strict):
     name: str = Field(pattern=_NAME)
     object: str
     kind: Literal["line", "arc", "polyline"]
-    points_mm: list[list[float]]
+    points_mm: list[list[Mm]] = Field(max_length=10000)
     normal: list[float] = _vec3()
     work_angle_deg: float = Field(90.0, ge=0, le=90)
     travel_angle_deg: float = Field(0.0, gt=-90, lt=90)
@@ -127,7 +136,7 @@ class SlotBlock(Strict):
     """``[[slots]]``: where a part's centre goes (world, or an object's frame)."""
 
     name: str = Field(pattern=_NAME)
-    pos_mm: list[float] = _vec3()
+    pos_mm: list[Mm] = _vec3()
     object: str | None = None
 
 
@@ -135,8 +144,8 @@ class CameraBlock(Strict):
     """``[[cameras]]``: a fixed camera."""
 
     name: str = Field(pattern=_NAME)
-    pos_mm: list[float] = _vec3()
-    look_at_mm: list[float] | None = Field(None, min_length=3, max_length=3)
+    pos_mm: list[Mm] = _vec3()
+    look_at_mm: list[Mm] | None = Field(None, min_length=3, max_length=3)
     follow: Literal["tool"] | None = None
     fovy_deg: float = Field(45.0, gt=1, lt=170)
 
@@ -201,22 +210,66 @@ class Solid:
             return float(min(d.max(), 0.0) + np.linalg.norm(np.maximum(d, 0.0)))
         if b.shape == "sphere":
             return float(np.linalg.norm(p) - b.radius_mm * 1e-3)
-        if b.shape == "ring":  # annulus sector: radial, axial and angular distances
-            r_in, r_out = (b.inner_radius_mm or 0.0) * 1e-3, b.radius_mm * 1e-3
-            rho = float(np.hypot(p[0], p[1]))
-            a0, a1 = np.deg2rad(b.arc_deg or [0.0, 360.0])
-            phi = float(np.mod(np.arctan2(p[1], p[0]) - a0, 2 * np.pi))
-            out_ang = 0.0 if phi <= a1 - a0 + 1e-12 else rho * float(
-                np.sin(min(phi - (a1 - a0), 2 * np.pi - phi, np.pi / 2)))
-            d = np.array([max(r_in - rho, rho - r_out), abs(p[2]) - b.length_mm * 0.5e-3,
-                          out_ang if out_ang > 0 else -np.inf])
-            return float(min(d.max(), 0.0) + np.linalg.norm(np.maximum(d, 0.0)))
+        if b.shape == "ring":
+            return _ring_distance(p, b)
         from sim.cells.meshes import point_mesh_distance
 
         assert self.verts is not None and self.faces is not None
         surf = point_mesh_distance(p, self.verts, self.faces)
         inside = any(np.all(H[:, :3] @ p + H[:, 3] <= 1e-9) for H in self._halfspaces)
         return -surf if inside else surf
+
+
+def _volume(points: NDArray[np.float64]) -> float:
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        return float(ConvexHull(points).volume)
+    except (QhullError, ValueError):
+        return 0.0
+
+
+def _ring_distance(p: NDArray[np.float64], b: ObjectBlock) -> float:
+    """Signed distance from a ring sector (annulus r_in..r_out, |z| <= L/2, angles a0..a1 from
+    the object's x axis), m: exact for the cut faces too."""
+    r_in, r_out = (b.inner_radius_mm or 0.0) * 1e-3, b.radius_mm * 1e-3
+    half = b.length_mm * 0.5e-3
+    a0, a1 = np.deg2rad(b.arc_deg) if b.arc_deg is not None else (0.0, 2 * np.pi)
+    sweep = a1 - a0
+    rho = float(np.hypot(p[0], p[1]))
+    phi = float(np.mod(np.arctan2(p[1], p[0]) - a0, 2 * np.pi))
+    dz = abs(p[2]) - half
+    inside_angle = sweep >= 2 * np.pi - 1e-12 or phi <= sweep
+    if inside_angle:
+        d = [max(r_in - rho, rho - r_out), dz]
+        if sweep < 2 * np.pi - 1e-12:  # distance to the nearer cut face (a half-plane)
+            to_face = min(rho * np.sin(min(phi, np.pi / 2)),
+                          rho * np.sin(min(sweep - phi, np.pi / 2)))
+            d.append(-to_face)
+        dd = np.array(d)
+        return float(min(dd.max(), 0.0) + np.linalg.norm(np.maximum(dd, 0.0)))
+    # outside the angles: the distance to the nearer cut face (a rectangle r_in..r_out x z)
+    best = np.inf
+    for a in (a0, a1):
+        u = np.array([np.cos(a), np.sin(a)])
+        t = float(np.clip(p[:2] @ u, r_in, r_out))
+        d2 = float(np.linalg.norm(p[:2] - t * u))
+        best = min(best, float(np.hypot(d2, max(dz, 0.0))))
+    return best
+
+
+def _geom_names(b: ObjectBlock, pieces: int) -> list[str]:
+    """The names of the geoms an object becomes in the model."""
+    if b.shape == "ring":
+        return [f"{b.name}{k}" for k in range(b.segments or 72)]
+    if b.shape == "mesh":
+        return [f"{b.name}_visual", *(f"{b.name}_c{k}" for k in range(pieces))]
+    return [b.name]
+
+
+#: Convex pieces smaller than this are left out of a mesh's collision geoms, m^3 (1 mm^3:
+#: MuJoCo's compiler refuses a mesh whose volume is too small to compute its inertia).
+MIN_PIECE_VOLUME = 1e-9
 
 
 def _solid(block: ObjectBlock, index: int, base: Path, where: str) -> Solid:
@@ -242,6 +295,9 @@ def _solid(block: ObjectBlock, index: int, base: Path, where: str) -> Solid:
             raise CellError(f"{key}.arc_deg: [from, to] with 0 < to - from <= 360")
     if block.size_mm is not None and min(block.size_mm) <= 0:
         raise CellError(f"{key}.size_mm: full extents must be positive (mm)")
+    if block.role == "part" and shape == "ring":
+        raise CellError(f"{key}.shape: a part cannot be a ring (a part is one free body: a box, "
+                        "cylinder, sphere or mesh)")
     if block.role == "part" and block.mass_kg is None:
         raise CellError(f"{key}.mass_kg: required for a part (a free body)")
     if block.role != "part" and block.mass_kg is not None:
@@ -263,7 +319,12 @@ def _solid(block: ObjectBlock, index: int, base: Path, where: str) -> Solid:
 
         path = (base / str(block.file)).resolve()
         s.verts, s.faces = read_mesh(path, block.mesh_unit, where=f"{key}.file")
-        s.pieces = convex_pieces(path, block.mesh_unit, where=f"{key}.file")
+        pieces = convex_pieces(path, block.mesh_unit, where=f"{key}.file")
+        s.pieces = [pc for pc in pieces if _volume(pc) >= MIN_PIECE_VOLUME]
+        if not s.pieces:
+            raise CellError(f"{key}.file: {path.name}: the mesh encloses less than 1 mm^3 "
+                            "(check mesh_unit: the file's coordinates are read as "
+                            f"{block.mesh_unit})")
         s._halfspaces = [ConvexHull(pc).equations for pc in s.pieces]
         s.radius = float(np.max(np.linalg.norm(s.verts, axis=1)))
     return s
@@ -284,6 +345,7 @@ class CellFile:
     spec: CellFileSpec
     solids: dict[str, Solid]
     base_pose: NDArray[np.float64]
+    default_tool: object = None  # the resolved ``tool`` (a ToolSpec), set by sim.cells
 
     @property
     def where(self) -> str:
@@ -308,6 +370,15 @@ def read_cell_file(path: str | Path) -> CellFile:
                     if ob.name in solids else "is reserved")
             raise CellError(f"{where}: objects[{i}].name: {ob.name!r} {what}")
         solids[ob.name] = _solid(ob, i, path.parent, where)
+    owner: dict[str, int] = {}  # every geom name the objects become -> the object's index
+    for sd in solids.values():
+        for g in _geom_names(sd.block, len(sd.pieces)):
+            if g in owner or (g != sd.block.name and g in solids) or g in RESERVED:
+                other = owner.get(g, solids[g].index if g in solids else None)
+                clash = f"objects[{other}]" if other is not None else "a reserved name"
+                raise CellError(f"{where}: objects[{sd.index}].name: {sd.block.name!r} gives a "
+                                f"geom named {g!r}, which clashes with {clash}; rename one")
+            owner[g] = sd.index
 
     def known(name: str, key: str, static: bool = False) -> Solid:
         if name not in solids:
@@ -339,10 +410,33 @@ def read_cell_file(path: str | Path) -> CellFile:
                                 f"{SEAM_TOLERANCE_M * 1e3:g} mm); the points are in the "
                                 "object's frame")
         try:
-            _seam_in_world(sb, obj.pose, pts, tool_axis=2, world_from_frame0=np.eye(4),
-                           standoff=0.0).torch_axis(0.0)
+            seam = _seam_in_world(sb, obj.pose, pts, tool_axis=2, world_from_frame0=np.eye(4),
+                                  standoff=0.0)
         except CellsimError as exc:
             raise CellError(f"{key}: {exc}") from None
+        # the torch posture must exist all along (a polyline's every segment, an arc's every
+        # point): the normal may not run along the seam anywhere
+        if seam.kind == "polyline":  # each segment at its middle
+            cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(seam.points, axis=0),
+                                                                  axis=1))])
+            where_s = [(0.5 * (cum[k] + cum[k + 1]), f"segment {k + 1}")
+                       for k in range(len(cum) - 1)]
+        else:
+            where_s = [(x, f"{x * 1e3:.1f} mm from its start")
+                       for x in np.linspace(0.0, seam.length(), 65)]
+        for s_, label in where_s:
+            t = seam.tangent(float(s_))
+            n_w = seam.surface_normal
+            if np.linalg.norm(n_w - (n_w @ t) * t) < 1e-6:
+                raise CellError(f"{key}.normal: {np.round(sb.normal, 6).tolist()} runs along the "
+                                f"seam ({label}); the reference surface's normal must be across "
+                                "the seam")
+        if sb.kind == "arc" and sb.stickout_mm is not None:
+            axis = seam.normal
+            if abs(abs(axis @ seam.surface_normal) - 1.0) > 1e-6:
+                raise CellError(f"{key}.stickout_mm: on an arc a stick-out other than the tool's "
+                                "needs the normal along the arc's axis (the torch then keeps its "
+                                "posture to the circle, and the tool point runs a coaxial arc)")
     for i, sl in enumerate(spec.slots):
         if sl.object is not None:
             known(sl.object, f"slots[{i}].object")
@@ -602,7 +696,7 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
         home_q = np.deg2rad(np.asarray(rb.home_deg, dtype=float))
     first = next(iter(seams.values()), None)
     start_q = None
-    own_tool = spec.tool is None or (rig.tool is not None and rig.tool.name == spec.tool)
+    own_tool = rig.tool == cf.default_tool  # start_deg is given for the cell's own tool
     if rb.start_deg is not None and own_tool:  # (given for the cell's own tool)
         start_q = np.deg2rad(np.asarray(rb.start_deg, dtype=float))
         if first is not None:

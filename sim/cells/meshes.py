@@ -104,13 +104,24 @@ def convex_pieces(path: Path, unit: str = "mm", where: str = ""
     if not pieces:
         raise CellError(f"{where}: {Path(path).name}: the convex decomposition found no solid "
                         "pieces (is the mesh closed?)")
+    tmp = None
     try:  # atomically: a concurrent load never reads half a cache
         fd, tmp = tempfile.mkstemp(dir=cache.parent, prefix=f".{cache.name}.", suffix=".tmp")
         with os.fdopen(fd, "wb") as fh:
             np.savez(fh, **{f"p{i}": p for i, p in enumerate(pieces)})
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # as any file the user writes (mkstemp makes 0600)
         os.replace(tmp, cache)
+        tmp = None
     except OSError:
         pass
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
     return pieces
 
 

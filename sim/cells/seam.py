@@ -286,7 +286,10 @@ class Seam:
         """Unit torch axis at ``s``, pointing from the torch into the joint, world, (3,)."""
         t = self.tangent(s)
         n = self.surface_normal - (self.surface_normal @ t) * t
-        n = _unit(n, f"seam {self.name!r}: surface normal is parallel to the seam;")
+        if np.linalg.norm(n) < _EPS:
+            raise CellsimError(f"seam {self.name!r}: the surface normal runs along the seam at "
+                               f"{s * 1e3:.1f} mm from its start (it must be across the seam)")
+        n = n / np.linalg.norm(n)
         e = self.torch_side * np.cross(n, t)
         w = np.deg2rad(self.torch_work_angle_deg)
         tau = np.deg2rad(self.torch_travel_angle_deg)

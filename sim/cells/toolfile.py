@@ -30,7 +30,7 @@ mass (MuJoCo computes the centre of mass and inertia from their volumes).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from dm_control import mjcf
@@ -41,7 +41,8 @@ from sim.core.rotations import euler_zyx_to_matrix
 from sim.core.tomlschema import Strict, load_toml
 from sim.errors import CellError
 
-Vec3 = list[float]
+#: A length or coordinate in mm, bounded (10 m: a tool is not bigger).
+Mm = Annotated[float, Field(ge=-1e4, le=1e4)]
 _NAME = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*$"
 
 
@@ -50,11 +51,11 @@ class ShapeSpec(Strict):
 
     name: str | None = Field(None, pattern=_NAME)
     shape: Literal["box", "cylinder", "capsule", "sphere"]
-    size_mm: list[float] | None = Field(None, min_length=3, max_length=3)
-    radius_mm: float | None = Field(None, gt=0)
-    from_mm: list[float] | None = Field(None, min_length=3, max_length=3)
-    to_mm: list[float] | None = Field(None, min_length=3, max_length=3)
-    pos_mm: list[float] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
+    size_mm: list[Mm] | None = Field(None, min_length=3, max_length=3)
+    radius_mm: float | None = Field(None, gt=0, le=1e4)
+    from_mm: list[Mm] | None = Field(None, min_length=3, max_length=3)
+    to_mm: list[Mm] | None = Field(None, min_length=3, max_length=3)
+    pos_mm: list[Mm] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
     euler_zyx_deg: list[float] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
     color: list[float] | None = Field(None, min_length=3, max_length=4)
 
@@ -66,9 +67,10 @@ class ToolFileSpec(Strict):
     description: str = ""
     kind: Literal["torch", "gripper"] = "torch"
     mass_kg: float = Field(gt=0, le=100)
-    com_mm: list[float] | None = Field(None, min_length=3, max_length=3)
-    inertia_kg_m2: list[float] | None = Field(None, min_length=3, max_length=3)
-    tcp_mm: list[float] = Field(min_length=3, max_length=3)
+    com_mm: list[Mm] | None = Field(None, min_length=3, max_length=3)
+    inertia_kg_m2: list[Annotated[float, Field(gt=0, le=1e3)]] | None = Field(
+        None, min_length=3, max_length=3)
+    tcp_mm: list[Mm] = Field(min_length=3, max_length=3)
     tcp_euler_zyx_deg: list[float] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
     stickout_mm: float = Field(15.0, gt=0, le=100)
     wire_diameter_mm: float = Field(1.2, gt=0, le=5)
@@ -77,8 +79,19 @@ class ToolFileSpec(Strict):
     shapes: list[ShapeSpec] = Field(min_length=1)
 
 
+#: The keys each shape takes (besides name, shape, color).
+_SHAPE_KEYS = {"cylinder": ("radius_mm", "from_mm", "to_mm"),
+               "capsule": ("radius_mm", "from_mm", "to_mm"),
+               "box": ("size_mm", "pos_mm", "euler_zyx_deg"), "sphere": ("radius_mm", "pos_mm")}
+
+
 def _geom_kwargs(i: int, s: ShapeSpec, where: str) -> dict:
     key = f"{where}: shapes[{i}]"
+    unused = [k for k in ("size_mm", "radius_mm", "from_mm", "to_mm", "pos_mm", "euler_zyx_deg")
+              if k in s.model_fields_set and k not in _SHAPE_KEYS[s.shape]]
+    if unused:
+        raise CellError(f"{key}.{unused[0]}: not used with shape = {s.shape!r} (it takes "
+                        f"{', '.join(_SHAPE_KEYS[s.shape])})")
     kw: dict = {"name": s.name or f"shape{i}"}
     R = euler_zyx_to_matrix(*np.deg2rad(s.euler_zyx_deg))
     if s.shape in ("cylinder", "capsule"):
@@ -162,10 +175,10 @@ def load_tool_file(path: str | Path) -> ToolSpec:
     where = str(path)
     geoms = [_geom_kwargs(i, s, where) for i, s in enumerate(spec.shapes)]
     names = [g["name"] for g in geoms]
-    dup = {n for n in names if names.count(n) > 1} | ({"wire"} & set(names))
+    dup = {n for n in names if names.count(n) > 1} | ({"wire", "mesh"} & set(names))
     if dup:
         raise CellError(f"{where}: shapes: the name {sorted(dup)[0]!r} is used twice (or is "
-                        "the torch's own 'wire')")
+                        "reserved: 'wire' is the torch's wire, 'mesh' the visual mesh)")
     if (spec.com_mm is None) != (spec.inertia_kg_m2 is None):
         raise CellError(f"{where}: com_mm and inertia_kg_m2 go together (give both or neither)")
     if spec.inertia_kg_m2 is not None:
@@ -175,9 +188,10 @@ def load_tool_file(path: str | Path) -> ToolSpec:
                             "satisfy the triangle inequality")
     mesh_path = None
     if spec.mesh is not None:
+        from sim.cells.meshes import read_mesh
+
         mesh_path = (path.parent / spec.mesh).resolve()
-        if not mesh_path.is_file():
-            raise CellError(f"{where}: mesh: no such file {mesh_path}")
+        read_mesh(mesh_path, spec.mesh_unit, where=f"{where}: mesh")  # checked now, not later
     X = np.eye(4)
     X[:3, :3] = euler_zyx_to_matrix(*np.deg2rad(spec.tcp_euler_zyx_deg))
     X[:3, 3] = np.asarray(spec.tcp_mm) * 1e-3
