@@ -49,6 +49,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(ROOT))
 
+from sim.robots.generate import diag_inertia_range  # noqa: E402
 from sim.robots.registry import ROBOTS, RobotSpec  # noqa: E402
 
 MODELS = ROOT / "models"
@@ -632,26 +633,6 @@ def compute_inertials(rd: RobotDef, spec: RobotSpec) -> tuple[dict, float]:
         out[b.name] = (float(m.body_mass[bid]), m.body_ipos[bid].copy(), m.body_iquat[bid].copy(),
                        m.body_inertia[bid].copy())
     return out, rho
-
-
-def diag_inertia_range(model: mujoco.MjModel, n: int, lower, upper, samples: int = 2000,
-                       seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Smallest and largest diagonal of the joint-space inertia matrix (armature included),
-    per joint, over random configurations in the joint ranges, kg m^2."""
-    data = mujoco.MjData(model)
-    rng = np.random.default_rng(seed)
-    lo = np.full(n, np.inf)
-    hi = np.zeros(n)
-    M = np.zeros((model.nv, model.nv))
-    for _ in range(samples):
-        data.qpos[:n] = rng.uniform(lower, upper)
-        mujoco.mj_kinematics(model, data)
-        mujoco.mj_comPos(model, data)
-        mujoco.mj_crb(model, data)
-        mujoco.mj_fullM(model, data, M)
-        lo = np.minimum(lo, np.diag(M)[:n])
-        hi = np.maximum(hi, np.diag(M)[:n])
-    return lo, hi
 
 
 def compute_gains(rd: RobotDef, spec: RobotSpec, inertials: dict) -> dict:

@@ -434,3 +434,165 @@ def test_a_robot_folder_of_ones_own_runs_a_scenario(tmp_path):
     (dst / "lrmate200ic5l.xml").unlink()
     with pytest.raises(ScenarioError, match=r"robot: .*robot.toml: mjcf: no such file"):
         load_scenario(tmp_path / "mine.toml")
+
+
+# ---------------------------------------------------------------------------- DH robots in cells
+DRIVES_6 = "".join(f"""
+[[drives]]
+gear_ratio = {r}
+efficiency = 0.75
+rotor_inertia_kg_m2 = {i}
+rated_torque_nm = {t}
+peak_torque_nm = {p}
+max_speed_rpm = 6000
+""" for r, i, t, p in [(120, 2e-5, 0.65, 2.4), (120, 4.5e-5, 1.3, 4.5), (120, 2e-5, 0.65, 2.4),
+                       (75, 5e-6, 0.32, 1.0), (75, 5e-6, 0.32, 1.0), (48, 3e-6, 0.25, 0.8)])
+
+DH_ROBOT = """name = "dh_arm"
+description = "an OPW arm from its DH table"
+[kinematics]
+convention = "dh"
+dh = [[75, -90, 330, 0], [300, 0, 0, -90], [75, -90, 0, 0], [0, 90, 320, 0], [0, -90, 0, 0],
+      [0, 0, 80, 0]]
+[joints]
+range_deg = [[-170, 170], [-100, 140], [-150, 150], [-190, 190], [-120, 120], [-360, 360]]
+max_speed_deg_s = [270, 270, 270, 450, 450, 720]
+[mass]
+total_kg = 25
+payload_kg = 2
+""" + DRIVES_6
+
+DH_SCENARIO = """name = "dh_moves"
+description = "a robot from a DH table: a joint move and a straight line"
+robot = "robots/dh_arm"
+[[phases]]
+name = "move"
+planner = "434"
+time_s = [0.0, 1.0, 2.0]
+joints_deg = [[0, 0, 0, 0, 30, 0], [20, 10, -20, 10, 40, 20], [30, 20, -30, 0, 60, 0]]
+[[phases]]
+name = "line"
+kind = "linear"
+to_mm = [450, 150, 300]
+speed_mm_s = 100
+"""
+
+
+@pytest.fixture
+def dh_robot(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    folder = tmp_path / "robots" / "dh_arm"
+    folder.mkdir(parents=True)
+    (folder / "robot.toml").write_text(DH_ROBOT)
+    (tmp_path / "scn.toml").write_text(DH_SCENARIO)
+    return tmp_path
+
+
+def test_a_robot_from_a_dh_table_runs_with_no_self_collision(dh_robot):
+    """A robot folder with only a DH table, drives and a mass: cellsim writes its MJCF (into
+    its cache, not the folder), whose flange equals the DH product for 1000 configurations; a
+    joint move and a straight line run, tracked, with no collision and a passing verdict; the
+    straight line is solved by the arm's closed form."""
+    import mujoco
+
+    from sim.pipeline.run import evaluate_scenario
+    from sim.scenario import load_scenario
+
+    sc = load_scenario(dh_robot / "scn.toml")
+    spec = sc.robot
+    assert spec.family.arm.solver == "opw"
+    assert not (dh_robot / "robots" / "dh_arm" / "dh_arm.xml").exists()
+    assert str(spec.robot_path).startswith(str(dh_robot / "cache"))
+    m = mujoco.MjModel.from_xml_path(str(spec.robot_path))
+    d = mujoco.MjData(m)
+    rows = np.array([[0.075, -np.pi / 2, 0.330, 0.0], [0.300, 0.0, 0.0, -np.pi / 2],
+                     [0.075, -np.pi / 2, 0.0, 0.0], [0.0, np.pi / 2, 0.320, 0.0],
+                     [0.0, -np.pi / 2, 0.0, 0.0], [0.0, 0.0, 0.080, 0.0]])
+    fl = m.site("flange").id
+    lo, hi = m.jnt_range.T
+    for q in np.random.default_rng(8).uniform(lo, hi, size=(1000, 6)):
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        T = dh_product(rows, q)
+        np.testing.assert_allclose(d.site_xpos[fl], T[:3, 3], atol=1e-9)
+        np.testing.assert_allclose(d.site_xmat[fl].reshape(3, 3), T[:3, :3], atol=1e-9)
+    ev = evaluate_scenario(sc)
+    assert ev.summary["collisions"] == []
+    assert ev.summary["verdict"] == "pass", [c for c in ev.summary["checks"] if not c["ok"]]
+    rec = ev.record.arrays
+    k = [p["name"] for p in ev.summary["phases"]].index("line")
+    np.testing.assert_allclose(rec["tcp_pos_ref"][rec["phase"] == k][-1], [0.45, 0.15, 0.30],
+                               atol=1e-6)
+    assert max(ev.summary["max_tracking_error_deg"]) < 0.1
+
+
+@pytest.mark.parametrize("edit,needle", [
+    (("total_kg = 25", ""), "mass.total_kg: required"),
+    (("[[drives]]", "[[drive]]"), "unknown key"),
+])
+def test_a_dh_robot_without_its_data_is_one_line(dh_robot, edit, needle):
+    old, new = edit
+    (dh_robot / "robots" / "dh_arm" / "robot.toml").write_text(DH_ROBOT.replace(old, new, 1))
+    r = subprocess.run([sys.executable, "-m", "sim", "run", str(dh_robot / "scn.toml"),
+                        "--no-video", "--out", str(dh_robot / "out")], capture_output=True,
+                       text=True, timeout=300, env={**__import__("os").environ,
+                                                    "XDG_CACHE_HOME": str(dh_robot / "cache")})
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0] and "robot.toml" in lines[0], r.stderr
+    assert not (dh_robot / "out").exists()
+
+
+def test_a_robot_folder_naming_a_urdf_builds_the_urdf_arm(tmp_path, monkeypatch):
+    """robot.toml with convention = "urdf" (the KR 6 R700 sixx chain of ROS-Industrial): the
+    generated MJCF's flange is the URDF's tool0 for 200 configurations, the family's IK is the
+    OPW closed form, and the URDF's velocity limits are the joint speed limits."""
+    import shutil
+
+    import mujoco
+
+    from sim.robots.robotfile import load_robot_folder
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    folder = tmp_path / "kr6"
+    folder.mkdir()
+    shutil.copy(DATA / "kuka_kr6r700sixx.urdf", folder / "kr6.urdf")
+    (folder / "robot.toml").write_text('name = "kr6"\n[kinematics]\nconvention = "urdf"\n'
+                                       'urdf = "kr6.urdf"\n[mass]\ntotal_kg = 50\n' + DRIVES_6)
+    spec = load_robot_folder(folder)
+    chain = chain_from_urdf(DATA / "kuka_kr6r700sixx.urdf")
+    np.testing.assert_allclose(spec.max_speed, chain.max_speed)
+    assert spec.family.arm.solver == "opw"
+    m = mujoco.MjModel.from_xml_path(str(spec.robot_path))
+    d = mujoco.MjData(m)
+    fl = m.site("flange").id
+    for q in random_q(chain, 200, seed=9):
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        T = chain.fk(q)
+        np.testing.assert_allclose(d.site_xpos[fl], T[:3, 3], atol=1e-9)
+        np.testing.assert_allclose(d.site_xmat[fl].reshape(3, 3), T[:3, :3], atol=1e-9)
+
+
+def test_robot_format_reference_documents_every_key():
+    """docs/robot-format.md and the declared robot.toml schema name the same keys."""
+    import re
+
+    from sim.robots.robotfile import (
+        DriveBlock,
+        FamilyKinematics,
+        MakerBlock,
+        RobotFolderSpec,
+        RobotJoints,
+        RobotMass,
+    )
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "robot-format.md").read_text()
+    table_keys = set(re.findall(r"^\| `([a-z][a-z0-9_]*)`", doc, flags=re.M))
+    declared = set()
+    for model in (RobotFolderSpec, FamilyKinematics, RobotJoints, RobotMass, DriveBlock,
+                  MakerBlock):
+        for key in model.model_fields:
+            assert key in table_keys, f"{model.__name__}.{key} is not documented"
+            declared.add(key)
+    assert table_keys <= declared, f"documented but not accepted: {table_keys - declared}"

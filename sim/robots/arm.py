@@ -26,36 +26,15 @@ import itertools
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from pydantic import Field
 
-from sim.core.tomlschema import Strict, load_toml
+from sim.core.tomlschema import load_toml
 from sim.errors import KinematicsError
 from sim.robots import opw
 from sim.robots.chain import Chain, chain_from_dh, chain_from_urdf
 from sim.robots.numeric_ik import solve_ik as numeric_solve
-
-
-class KinematicsBlock(Strict):
-    convention: Literal["dh", "mdh", "urdf"]
-    dh: list[list[float]] | None = None
-    urdf: str | None = None
-
-
-class JointsBlock(Strict):
-    range_deg: list[list[float]] | None = None
-    max_speed_deg_s: list[float] | None = None
-    max_accel_deg_s2: list[float] | None = None
-
-
-class RobotFileSpec(Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*$")
-    description: str = ""
-    kinematics: KinematicsBlock
-    joints: JointsBlock = JointsBlock()
 
 
 @dataclass(frozen=True)
@@ -157,19 +136,15 @@ def arm_from_chain(chain: Chain, source: Path | None = None) -> Arm:
                source=source)
 
 
-def load_arm(path: str | Path) -> Arm:
-    """An arm from a URDF file, a ``robot.toml`` or a folder holding one.
+def chain_from_robot_file(spec, path: Path) -> Chain:
+    """The chain of a ``robot.toml`` (:class:`sim.robots.robotfile.RobotFolderSpec`) that gives
+    a DH table or a URDF.
 
     Raises:
-        KinematicsError: One line naming the file and the key or joint: missing file, a DH row
-            of the wrong length, an unsupported joint type, limits with lower > upper.
+        KinematicsError: One line naming the file and the key.
     """
-    path = Path(path)
-    if path.is_dir():
-        path = path / "robot.toml"
-    if path.suffix.lower() == ".urdf":
-        return arm_from_chain(chain_from_urdf(path), path)
-    spec, _ = load_toml(path, RobotFileSpec, KinematicsError)
+    import dataclasses
+
     k = spec.kinematics
     where = str(path)
     if k.convention == "urdf":
@@ -177,7 +152,7 @@ def load_arm(path: str | Path) -> Arm:
             raise KinematicsError(f"{where}: kinematics.urdf: required with convention = \"urdf\"")
         chain = chain_from_urdf(path.parent / k.urdf)
     else:
-        if k.dh is None or not k.dh:
+        if not k.dh:
             raise KinematicsError(f"{where}: kinematics.dh: required with convention = "
                                   f"\"{k.convention}\" (rows [a_mm, alpha_deg, d_mm, "
                                   "theta_offset_deg])")
@@ -186,8 +161,8 @@ def load_arm(path: str | Path) -> Arm:
                 raise KinematicsError(f"{where}: kinematics.dh[{i}]: {len(row)} values; a row is "
                                       "[a_mm, alpha_deg, d_mm, theta_offset_deg]")
         rows = np.array(k.dh, dtype=float)
-        rows[:, 0] *= 1e-3
-        rows[:, 2] *= 1e-3
+        rows[:, 0] /= 1000.0
+        rows[:, 2] /= 1000.0
         rows[:, 1] = np.deg2rad(rows[:, 1])
         rows[:, 3] = np.deg2rad(rows[:, 3])
         n = len(rows)
@@ -206,10 +181,28 @@ def load_arm(path: str | Path) -> Arm:
                                           f"upper {r[1]:g}")
             lo, hi = np.deg2rad(np.array(j.range_deg, dtype=float)).T
         chain = chain_from_dh(rows, k.convention, name=spec.name, lower=lo, upper=hi)
-    import dataclasses
+    return dataclasses.replace(chain, name=spec.name)
 
-    chain = dataclasses.replace(chain, name=spec.name)
-    return arm_from_chain(chain, path)
+
+def load_arm(path: str | Path) -> Arm:
+    """An arm from a URDF file, a ``robot.toml`` or a folder holding one.
+
+    Raises:
+        KinematicsError: One line naming the file and the key or joint: missing file, a DH row
+            of the wrong length, an unsupported joint type, limits with lower > upper.
+    """
+    from sim.robots.robotfile import RobotFolderSpec
+
+    path = Path(path)
+    if path.is_dir():
+        path = path / "robot.toml"
+    if path.suffix.lower() == ".urdf":
+        return arm_from_chain(chain_from_urdf(path), path)
+    spec, _ = load_toml(path, RobotFolderSpec, KinematicsError)
+    if spec.kinematics.convention is None:
+        raise KinematicsError(f"{path}: kinematics.convention: this robot uses one of the "
+                              "seeds' families; name it as a robot")
+    return arm_from_chain(chain_from_robot_file(spec, path), path)
 
 
 def is_arm_path(ref: str) -> bool:

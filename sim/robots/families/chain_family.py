@@ -1,0 +1,120 @@
+"""The kinematic family of an arm given as data (a DH table or a URDF, :mod:`sim.robots.arm`).
+
+The seed tool frame is the arm's flange frame (z out of the flange, the approach axis) moved
+``tool`` metres along its z axis: a straight tool, as for the seeds' families. Inverse
+kinematics is the arm's: the OPW closed form (all branches) when the arm is ortho-parallel with
+a spherical wrist, the numeric solver otherwise. Singular factors: for an OPW arm ``wrist`` =
+sin(theta5), ``elbow`` = sin(theta3 + atan2(a2, c3)) (upper arm and the line to the wrist centre
+aligned), ``shoulder`` = the wrist centre's distance from the J1 axis less ``|b|`` (m), in the
+model's angles (``theta = sign * q - offset``); a numeric arm has none beyond the Jacobian's
+smallest singular value.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.errors import KinematicsError, UnreachableError
+from sim.robots.families.base import KinematicFamily
+
+
+class ChainFamily(KinematicFamily):
+    """A 6-axis (or other) arm from its chain (module docstring)."""
+
+    name: ClassVar[str] = "chain"
+    dim_names: ClassVar[tuple[str, ...]] = ("tool",)
+    approach_column: ClassVar[int] = 2
+    joint_symbol: ClassVar[str] = "q"
+
+    def __init__(self, arm, tool: float = 0.0) -> None:  # arm: sim.robots.arm.Arm
+        self.arm = arm
+        self._dims = {"tool": float(tool)}
+        n = arm.chain.n
+        self.n_joints = n  # type: ignore[misc]
+        self.wrist_joint = max(n - 2, 0)  # type: ignore[misc]
+        self.wrist_centre_index = max(n - 2, 0)  # type: ignore[misc]
+        self.reach_free_joints = tuple(range(1, n - 1))  # type: ignore[misc]
+
+    def _state(self) -> dict:
+        return {"tool": self._dims["tool"], "arm": str(self.arm.source), "name": self.arm.name}
+
+    def __hash__(self) -> int:
+        return hash((type(self), self.arm.name, str(self.arm.source), self._dims["tool"]))
+
+    def _tool_T(self) -> NDArray[np.float64]:
+        T = np.eye(4)
+        T[2, 3] = self._dims["tool"]
+        return T
+
+    # ------------------------------------------------------------------ forward
+    def joint_frames(self, Q):
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        n = self.arm.chain.n
+        axes = np.empty((len(Q), n, 3))
+        points = np.empty((len(Q), n, 3))
+        T = np.empty((len(Q), 4, 4))
+        tool = self._tool_T()
+        for k, q in enumerate(Q):
+            a, p, F = self.arm.chain.frames(q)
+            axes[k], points[k], T[k] = a, p, F @ tool
+        return axes, points, T
+
+    def home_approach(self) -> NDArray[np.float64]:
+        return self.arm.chain.fk(np.zeros(self.arm.chain.n))[:3, 2].copy()
+
+    # ------------------------------------------------------------------ inverse
+    def ik(self, T, current):
+        flange = np.asarray(T, dtype=float) @ np.linalg.inv(self._tool_T())
+        sols = self.arm.ik(flange, current)
+        if not sols:
+            raise UnreachableError(f"{self.arm.name}: no inverse-kinematics solution "
+                                   f"({self.arm.solver} solver)", 0.0)
+        return [(s.q, s.branch) for s in sols]
+
+    # ------------------------------------------------------------------ Jacobian
+    def task_jacobian(self, J):
+        return J
+
+    def singular_factors(self, Q):
+        p = self.arm.opw
+        if p is None:
+            return {}
+        th = np.asarray(Q, dtype=float) * np.asarray(p.signs, dtype=float) - np.asarray(
+            p.offsets, dtype=float)
+        t2, t3, t5 = th[..., 1], th[..., 2], th[..., 4]
+        psi3 = np.arctan2(p.a2, p.c3)
+        k = np.hypot(p.a2, p.c3)
+        rho = p.a1 + p.c2 * np.sin(t2) + k * np.sin(t2 + t3 + psi3)
+        return {"wrist": np.sin(t5), "elbow": np.sin(t3 + psi3), "shoulder": np.abs(rho)}
+
+    def singular_curves(self, T2, T3):
+        raise KinematicsError(f"{self.arm.name}: the workspace map's singular curves are drawn "
+                              "for the seeds' families only")
+
+    # ------------------------------------------------------------------ tool and reach
+    def _flange_axial(self) -> float:
+        """Wrist (the ``wrist_joint`` axis anchor) to flange along the approach axis at q = 0."""
+        a, p, F = self.arm.chain.frames(np.zeros(self.arm.chain.n))
+        return float((F[:3, 3] - p[self.wrist_joint]) @ F[:3, 2])
+
+    @property
+    def wrist_to_tcp(self) -> float:
+        return self._flange_axial() + self._dims["tool"]
+
+    def with_tool(self, wrist_to_tcp: float) -> ChainFamily:
+        return ChainFamily(self.arm, wrist_to_tcp - self._flange_axial())
+
+    def tool_from_home_tcp(self, p: NDArray[np.float64]) -> ChainFamily:
+        F = self.arm.chain.fk(np.zeros(self.arm.chain.n))
+        return ChainFamily(self.arm, float((np.asarray(p, dtype=float) - F[:3, 3]) @ F[:3, 2]))
+
+    def reach(self) -> float:
+        c = self.arm.chain
+        return float(sum(np.linalg.norm(o[:3, 3]) for o in c.origins[1:])
+                     + np.linalg.norm(c.flange[:3, 3]) + abs(self._dims["tool"]))
+
+
+__all__ = ["ChainFamily"]
