@@ -39,15 +39,20 @@ def pose_error(T: NDArray[np.float64], target: NDArray[np.float64]) -> NDArray[n
     return e
 
 
+#: A seed still this far off after :data:`GIVE_UP_AFTER` steps is abandoned for the next one
+#: (it is caught in a local minimum or crawling along a singular direction).
+GIVE_UP_ERROR, GIVE_UP_AFTER = 1e-2, 12
+
+
 def solve_one(chain: Chain, target: NDArray[np.float64], q0: NDArray[np.float64], *,
-              tol: float = 1e-12, max_iter: int = 60) -> tuple[NDArray[np.float64], float]:
+              tol: float = 1e-12, max_iter: int = 40) -> tuple[NDArray[np.float64], float]:
     """Damped Newton from ``q0``; returns the last configuration and its error norm."""
     q = np.array(q0, dtype=float)
     J, T = chain.jacobian(q)
     e = pose_error(T, target)
     err = float(np.linalg.norm(e))
-    for _ in range(max_iter):
-        if err < tol:
+    for it in range(max_iter):
+        if err < tol or (it >= GIVE_UP_AFTER and err > GIVE_UP_ERROR):
             break
         lam2 = min(1e-2, err * err)
         dq = J.T @ np.linalg.solve(J @ J.T + lam2 * np.eye(6), e)
