@@ -596,3 +596,15 @@ def test_robot_format_reference_documents_every_key():
             assert key in table_keys, f"{model.__name__}.{key} is not documented"
             declared.add(key)
     assert table_keys <= declared, f"documented but not accepted: {table_keys - declared}"
+
+
+def test_the_wrist_centre_stays_within_the_reach_bound_of_a_data_arm(dh_arm):
+    """ChainFamily.reach() bounds the wrist centre's distance from frame 0 (all links count,
+    the first joint's offset from the base too)."""
+    from sim.robots.families.chain_family import ChainFamily
+
+    for arm in (*dh_arm, load_arm(DATA / "kuka_kr6r900_2.urdf")):
+        fam = ChainFamily(arm)
+        Q = random_q(arm.chain, 2000, seed=12)
+        _, points, _ = fam.joint_frames(Q)
+        assert np.linalg.norm(points[:, fam.wrist_centre_index], axis=1).max() <= fam.reach()

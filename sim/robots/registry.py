@@ -165,8 +165,6 @@ def _shipped_robots() -> Registry[RobotSpec]:
     return reg
 
 
-#: The shipped robots by name, read from ``models/*/robot.toml``.
-ROBOTS: Registry[RobotSpec] = _shipped_robots()
 
 
 @lru_cache(maxsize=None)
@@ -222,3 +220,8 @@ def resolve_robot(ref: str, base: Path | None = None) -> RobotSpec:
             raise KinematicsError(f"{path}: no robot folder (a folder with a robot.toml)")
         return load_robot_folder(path)
     return ROBOTS.get(ref)
+
+
+# built last: a robot given by a DH table or a URDF needs this module's functions to load
+#: The shipped robots by name, read from ``models/*/robot.toml``.
+ROBOTS: Registry[RobotSpec] = _shipped_robots()

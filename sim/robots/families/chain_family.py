@@ -113,7 +113,7 @@ class ChainFamily(KinematicFamily):
 
     def reach(self) -> float:
         c = self.arm.chain
-        return float(sum(np.linalg.norm(o[:3, 3]) for o in c.origins[1:])
+        return float(sum(np.linalg.norm(o[:3, 3]) for o in c.origins)
                      + np.linalg.norm(c.flange[:3, 3]) + abs(self._dims["tool"]))
 
 
