@@ -12,9 +12,11 @@ shipped robots (``models/build_models.py``):
   lengths (a uniform capsule each, MuJoCo's inertia), radius tapering from 6 % of the reach at
   J1 to 40 % of that at the wrist, at least 20 mm;
 * position actuators ``a1..an`` with ``forcerange`` the drive's peak torque at the joint
-  (``peak * ratio * efficiency``) and gains as the shipped models set them: ``kp = w^2 Imin``,
-  ``kv = 2 w sqrt(Imin Imax)`` with ``Imin``, ``Imax`` the extremes of the joint-space inertia
-  diagonal over 500 configurations and ``w`` = 40 rad/s (J1-J3) or 60 rad/s (wrist);
+  (``peak * ratio * efficiency``) and gains as the shipped models set them, ``kp = w^2 Imin``
+  with ``Imin``, ``Imax`` the extremes of the joint-space inertia diagonal over 500
+  configurations and ``w`` = 40 rad/s (J1-J3) or 60 rad/s (wrist), raised where needed so the
+  servo alone holds the arm and the rated payload within 1 mrad of sag, and
+  ``kv = 2 sqrt(kp Imax)``;
 * sites ``frame0`` (the chain's base frame), ``flange`` and ``tcp`` (the chain's end frame,
   z out of the flange); keyframe ``home`` (all joints at 0, or the nearest value in range);
 * ``<exclude>`` of each link with the link two further on when the link between is shorter
@@ -38,6 +40,8 @@ import numpy as np
 from sim.robots.chain import Chain
 
 OMEGA_ARM, OMEGA_WRIST = 40.0, 60.0  #: closed-loop natural frequencies, rad/s
+#: Largest sag of a joint held by its servo alone against gravity (rated payload), rad.
+SAG_RAD = 1e-3
 
 
 def _f(v) -> str:
@@ -156,21 +160,41 @@ def diag_inertia_range(model: mujoco.MjModel, n: int, lower, upper, samples: int
     return lo, hi
 
 
-def _gains(xml: str, chain: Chain) -> dict[int, tuple[float, float]]:
+def _gains(xml: str, chain: Chain, payload_kg: float) -> dict[int, tuple[float, float]]:
+    """``kp = max(w^2 Imin, G / SAG)`` with ``G`` the largest gravity torque on the joint (rated
+    payload at the flange) so that the servo alone holds the arm within :data:`SAG_RAD`;
+    ``kv = 2 sqrt(kp Imax)`` (critically damped where the joint is heaviest, over-damped
+    elsewhere)."""
     m = mujoco.MjModel.from_xml_string(xml)
     n = chain.n
     lo = np.where(np.isfinite(chain.lower), chain.lower, -np.pi)
     hi = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
     imin, imax = diag_inertia_range(m, n, lo, hi, samples=500)
+    # gravity torques over the same kind of sample, the payload as a point mass at the flange
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(1)
+    g_max = np.zeros(n)
+    for _ in range(500):
+        d.qpos[:n] = rng.uniform(lo, hi)
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_rne(m, d, 0, d.qfrc_bias)
+        tau = d.qfrc_bias[:n].copy()
+        if payload_kg > 0.0:
+            jac = np.zeros((3, m.nv))
+            mujoco.mj_jacSite(m, d, jac, None, m.site("flange").id)
+            tau += jac[:, :n].T @ np.array([0.0, 0.0, payload_kg * 9.81])
+        g_max = np.maximum(g_max, np.abs(tau))
     out = {}
     for i in range(n):
         w = OMEGA_ARM if i < 3 else OMEGA_WRIST
-        out[i] = (float(w * w * imin[i]), float(2.0 * w * np.sqrt(imin[i] * imax[i])))
+        kp = max(w * w * imin[i], g_max[i] / SAG_RAD)
+        out[i] = (float(kp), float(2.0 * np.sqrt(kp * imax[i])))
     return out
 
 
 def generated_model_path(chain: Chain, name: str, drives, total_mass_kg: float,
-                         key: str) -> Path:
+                         key: str, payload_kg: float = 0.0) -> Path:
     """Write (once) the arm's MJCF and ``scene.xml`` into a cache folder keyed by ``key`` (the
     robot file's content hash) and return the model's path."""
     root = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "cellsim" / "robots"
@@ -179,7 +203,7 @@ def generated_model_path(chain: Chain, name: str, drives, total_mass_kg: float,
     if path.is_file():
         return path
     first = mjcf_from_chain(chain, name, drives, total_mass_kg)
-    xml = mjcf_from_chain(chain, name, drives, total_mass_kg, _gains(first, chain))
+    xml = mjcf_from_chain(chain, name, drives, total_mass_kg, _gains(first, chain, payload_kg))
     folder.mkdir(parents=True, exist_ok=True)
     scene = (f'<mujoco model="{name} scene">\n  <include file="{name}.xml"/>\n  <worldbody>\n'
              '    <light pos="0 0 3" dir="0 0 -1" directional="true"/>\n'

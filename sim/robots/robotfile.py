@@ -210,7 +210,9 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     key = path.read_text(encoding="utf-8")
     if spec.kinematics.urdf is not None:
         key += (path.parent / spec.kinematics.urdf).read_text(encoding="utf-8", errors="replace")
-    model = generated_model_path(chain, spec.name, drives, spec.mass.total_kg, key)
+    model = generated_model_path(chain, spec.name, drives, spec.mass.total_kg,
+                                 key + f"|payload {spec.mass.payload_kg!r}",
+                                 payload_kg=spec.mass.payload_kg)
     maker_joints, maker_matrix = _maker(spec, n, where)
     robot = RobotSpec(
         name=spec.name, title=spec.title or spec.name, folder=str(model.parent),
