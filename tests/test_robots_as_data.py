@@ -1,8 +1,8 @@
 """Robots as data (issue 13, first slice): arms from a DH table or a URDF, their forward
 kinematics, the OPW closed form derived from the joint axes, and a numeric IK otherwise.
 
-Independent references: the textbook DH product (:func:`sim.robots.chain.dh_product`, written
-from the formulas, not from the chain code); the URDF's own joint chain; the OPW parameters that
+Independent references: the textbook DH product (:func:`dh_product` below, the explicit matrix
+entries of the formulas, not the chain code); the URDF's own joint chain; the OPW parameters that
 ROS-Industrial publishes for the KUKA KR 6 R700 sixx and KR 6 R900-2
 (``kuka_kr6_support/config/opw_kinematics_kr6r700sixx.yaml`` and
 ``opw_parameters_kr6r900_2.yaml``, github.com/ros-industrial/kuka_experimental, commit e78bbd1).
@@ -10,6 +10,7 @@ ROS-Industrial publishes for the KUKA KR 6 R700 sixx and KR 6 R900-2
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -20,7 +21,7 @@ import pytest
 from sim.errors import KinematicsError
 from sim.robots import opw
 from sim.robots.arm import load_arm
-from sim.robots.chain import chain_from_dh, chain_from_urdf, dh_product
+from sim.robots.chain import chain_from_dh, chain_from_urdf
 from sim.robots.numeric_ik import pose_error
 from sim.robots.numeric_ik import solve_ik as numeric_ik
 
@@ -43,6 +44,24 @@ OPW_DH = np.array([[0.075, -np.pi / 2, 0.330, 0.0], [0.300, 0.0, 0.0, -np.pi / 2
 UR5_DH = np.array([[0.0, np.pi / 2, 0.089159, 0.0], [-0.425, 0.0, 0.0, 0.0],
                    [-0.39225, 0.0, 0.0, 0.0], [0.0, np.pi / 2, 0.10915, 0.0],
                    [0.0, -np.pi / 2, 0.09465, 0.0], [0.0, 0.0, 0.0823, 0.0]])
+
+
+def dh_product(rows: np.ndarray, q: np.ndarray, convention: str = "dh") -> np.ndarray:
+    """The textbook DH (or Craig MDH) product for joint values ``q``: the explicit matrix
+    entries of each row, independent of sim.robots.chain and sim.robots.builder."""
+    T = np.eye(4)
+    for (a, alpha, d, off), qi in zip(np.asarray(rows, dtype=float), np.asarray(q, float),
+                                      strict=True):
+        th = qi + off
+        ct, st, ca, sa = math.cos(th), math.sin(th), math.cos(alpha), math.sin(alpha)
+        if convention == "dh":
+            A = np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
+                          [0, sa, ca, d], [0, 0, 0, 1.0]])
+        else:
+            A = np.array([[ct, -st, 0, a], [st * ca, ct * ca, -sa, -sa * d],
+                          [st * sa, ct * sa, ca, ca * d], [0, 0, 0, 1.0]])
+        T = T @ A
+    return T
 
 
 def random_q(chain, n: int, seed: int = 1) -> np.ndarray:

@@ -211,9 +211,4 @@ def load_tool_file(path: str | Path) -> ToolSpec:
         builder=_ToolBuilder(spec, mesh_path, X, wire_from, geoms))
 
 
-def is_tool_path(ref: str) -> bool:
-    """A tool reference that names a file (``*.toml`` or with a folder), not a shipped name."""
-    return ref.endswith(".toml") or "/" in ref or "\\" in ref
-
-
-__all__ = ["ToolFileSpec", "is_tool_path", "load_tool_file"]
+__all__ = ["ToolFileSpec", "load_tool_file"]

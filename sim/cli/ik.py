@@ -63,6 +63,19 @@ def _check_finite(label: str, values: list[float]) -> None:
             raise KinematicsError(f"{name} must be a finite number, got {v}")
 
 
+def _print_solutions(sols, shown, show_all: bool, maker=None) -> None:
+    """One line per solution shown (joint values in deg, limits, branch), the maker's joint
+    values under each when ``maker`` (q -> text) is given."""
+    for i, s in enumerate(shown, 1):
+        joints = " ".join(f"{v:9.3f}" for v in np.rad2deg(s.q))
+        flag = "within limits" if s.within_limits else "OUTSIDE joint limits"
+        print(f"  {i:2d}: {joints}   {flag}  [{s.branch}]")
+        if maker is not None:
+            print(f"      {maker(s.q)}")
+    if not show_all and len(sols) > 1:
+        print(f"  ({len(sols) - 1} more with --all)")
+
+
 def _run_arm(args: argparse.Namespace) -> int:
     """``cellsim ik`` of an arm given as data (:mod:`sim.robots.arm`): the flange pose in the
     arm's base frame (a DH table's frame 0, a URDF's root link)."""
@@ -88,12 +101,7 @@ def _run_arm(args: argparse.Namespace) -> int:
     how = "closed form (OPW)" if arm.opw is not None else f"numeric ({arm.why_numeric})"
     print(f"{arm.name} ({arm.source}): {len(sols)} solution(s), {how}; joints "
           f"{' '.join(arm.chain.joint_names)} in deg")
-    for i, s in enumerate(shown, 1):
-        joints = " ".join(f"{v:9.3f}" for v in np.rad2deg(s.q))
-        flag = "within limits" if s.within_limits else "OUTSIDE joint limits"
-        print(f"  {i:2d}: {joints}   {flag}  [{s.branch}]")
-    if not args.all and len(sols) > 1:
-        print(f"  ({len(sols) - 1} more with --all)")
+    _print_solutions(sols, shown, args.all)
     return 0
 
 
@@ -144,18 +152,14 @@ def run(args: argparse.Namespace) -> int:
                 d["joints_maker_deg"] = [float(v) for v in np.rad2deg(to_maker(spec, s.q))]
         print(json.dumps(doc))
         return 0
-    from sim.robots.maker import maker_joint_names, to_maker
 
     with_tool = f" with tool {args.tool}" if args.tool not in (None, "none") else ""
     print(f"{spec.title} ({spec.name}){with_tool}: {len(sols)} solution(s), best first; "
           f"joints {' '.join(spec.joints)} in deg")
-    for i, s in enumerate(shown, 1):
-        joints = " ".join(f"{v:9.3f}" for v in np.rad2deg(s.q))
-        flag = "within limits" if s.within_limits else "OUTSIDE joint limits"
-        print(f"  {i:2d}: {joints}   {flag}  [{s.branch}]")
-        if args.maker:
-            maker = " ".join(f"{v:9.3f}" for v in np.rad2deg(to_maker(spec, s.q)))
-            print(f"      {maker}   maker's {' '.join(maker_joint_names(spec))}")
-    if not args.all and len(sols) > 1:
-        print(f"  ({len(sols) - 1} more with --all)")
+    maker = None
+    if args.maker:
+        names = " ".join(maker_joint_names(spec))
+        maker = lambda q: (f"{' '.join(f'{v:9.3f}' for v in np.rad2deg(to_maker(spec, q)))}"  # noqa: E731
+                           f"   maker's {names}")
+    _print_solutions(sols, shown, args.all, maker)
     return 0

@@ -132,49 +132,25 @@ def chain_from_dh(rows: ArrayLike, convention: str = "dh", *, name: str = "arm",
     rows_a = np.asarray(R, dtype=float).reshape(-1, 4)
     if convention not in ("dh", "mdh"):
         raise KinematicsError(f"{name}: convention must be 'dh' or 'mdh', got {convention!r}")
+    # the table rows of sim.robots.builder (the MJCF chain builder) give each row's constant
+    # transform; the joint turns about the z axis before (dh) or after (mdh) it
+    from sim.robots.builder import DHRow, MDHRow
+
     n = len(rows_a)
     z = np.array([0.0, 0.0, 1.0])
-    origins = np.empty((n, 4, 4))
-    end = np.eye(4)
     if convention == "dh":
-        # T = prod Rz(q + off) Tz(d) Tx(a) Rx(alpha): joint i turns about the z of what
-        # precedes it, then its constant part (Rz(off) Tz(d) Tx(a) Rx(alpha)) follows
-        prev = np.eye(4)
-        for i, (a, alpha, d, off) in enumerate(rows_a):
-            origins[i] = prev
-            prev = _T(rot_axis(z, off)) @ _T(None, [0, 0, d]) @ _T(None, [a, 0, 0]) @ _T(
-                rot_axis(np.array([1.0, 0, 0]), alpha))
-        end = prev
+        fixed = [DHRow(theta=off, d=d, a=a, alpha=al).fixed() for a, al, d, off in rows_a]
+        origins = np.array([np.eye(4), *fixed[:-1]]).reshape(n, 4, 4)
+        end = fixed[-1] if n else np.eye(4)
     else:
-        post = np.eye(4)
-        for i, (a, alpha, d, off) in enumerate(rows_a):
-            pre = _T(rot_axis(np.array([1.0, 0, 0]), alpha)) @ _T(None, [a, 0, 0])
-            # Rz(q + off) Tz(d) = Rz(q) (Rz(off) Tz(d)): the constant part goes after the joint
-            origins[i] = post @ pre
-            post = _T(rot_axis(z, off)) @ _T(None, [0, 0, d])
-        end = post
+        origins = np.array([MDHRow(alpha=al, d=a, theta=off, r=d).fixed()
+                            for a, al, d, off in rows_a]).reshape(n, 4, 4)
+        end = np.eye(4)
     fl = np.eye(4) if flange is None else np.asarray(flange, dtype=float)
     lo = np.full(n, -np.inf) if lower is None else np.asarray(lower, dtype=float)
     hi = np.full(n, np.inf) if upper is None else np.asarray(upper, dtype=float)
     return Chain(name, origins, np.tile(z, (n, 1)), end @ fl, lo, hi,
                  tuple(f"j{i + 1}" for i in range(n)))
-
-
-def dh_product(rows: ArrayLike, q: ArrayLike, convention: str = "dh") -> NDArray[np.float64]:
-    """The textbook DH product for joint values ``q`` (independent of :class:`Chain`; tests)."""
-    T = np.eye(4)
-    for (a, alpha, d, off), qi in zip(np.asarray(rows, dtype=float), np.asarray(q, float),
-                                      strict=True):
-        th = qi + off
-        ct, st, ca, sa = math.cos(th), math.sin(th), math.cos(alpha), math.sin(alpha)
-        if convention == "dh":
-            A = np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
-                          [0, sa, ca, d], [0, 0, 0, 1.0]])
-        else:
-            A = np.array([[ct, -st, 0, a], [st * ca, ct * ca, -sa, -sa * d],
-                          [st * sa, ct * sa, ca, ca * d], [0, 0, 0, 1.0]])
-        T = T @ A
-    return T
 
 
 # ---------------------------------------------------------------------------- URDF
@@ -283,4 +259,4 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
                  np.array(lo), np.array(hi), tuple(names), np.array(vel))
 
 
-__all__ = ["Chain", "chain_from_dh", "chain_from_urdf", "dh_product", "rot_axis", "rpy_matrix"]
+__all__ = ["Chain", "chain_from_dh", "chain_from_urdf", "rot_axis", "rpy_matrix"]

@@ -135,16 +135,7 @@ def load_robot_folder(folder: str | Path):  # -> RobotSpec (imported lazily: no 
             raise KinematicsError(f"{where}: {key}: {len(values)} values for {n} joints")
     if spec.drives and len(spec.drives) != n:
         raise KinematicsError(f"{where}: drives: {len(spec.drives)} drives for {n} joints")
-    maker_joints: tuple[str, ...] = ()
-    maker_matrix: tuple[tuple[float, ...], ...] = ()
-    if spec.maker is not None:
-        M = np.array(spec.maker.matrix, dtype=float)
-        if M.shape != (n, n) or len(spec.maker.joints) != n:
-            raise KinematicsError(f"{where}: maker: {n} joint names and an {n} x {n} matrix")
-        if abs(np.linalg.det(M)) < 1e-9:
-            raise KinematicsError(f"{where}: maker.matrix: singular (the map must be invertible)")
-        maker_joints = tuple(spec.maker.joints)
-        maker_matrix = tuple(tuple(float(v) for v in row) for row in M)
+    maker_joints, maker_matrix = _maker(spec, n, where)
     from sim.core.resources import models_dir
 
     shipped = folder.resolve().parent == models_dir().resolve()
