@@ -19,7 +19,7 @@ from sim.cells.tools import (
 )
 from sim.errors import UnknownNameError
 from sim.robots.closed_form import fk_5r, fk_fanuc6
-from sim.robots.families import FiveR
+from sim.robots.families import Fanuc6, FiveR
 from sim.robots.registry import ROBOTS, get_robot
 
 RNG = np.random.default_rng(7)
@@ -121,7 +121,8 @@ def _pose(m, d, site):
 @pytest.mark.parametrize("tool", sorted(TOOLS))
 def test_tcp_on_tool_tip_matches_closed_form(robot, tool):
     """tcp = flange + tool length along the approach axis; MuJoCo vs seed 000 eq. 5 (5r, with
-    l3 = l3 - (bare tcp - flange) + length) or seed 004 eq. 6-7 (r = length)."""
+    l3 = l3 - (bare tcp - flange) + length), seed 004 eq. 6-7 (r = length) or, for an arm
+    given as data, its URDF joint product."""
     spec = get_robot(robot)
     tl = TOOLS[tool].length_m
     cell = build_cell(None, ROBOTS[robot], tool=TOOLS[tool])
@@ -151,9 +152,13 @@ def test_tcp_on_tool_tip_matches_closed_form(robot, tool):
             dims = {**spec.dims, "l3": spec.dims["l3"] - bare_offset + tl}
             Rcf, pcf = fk_5r(q, dims)
             axis = Rcf[:, 0]
-        else:
+        elif isinstance(spec.family, Fanuc6):
             Rcf, pcf = fk_fanuc6(q, spec.dims, tool_length=tl - bare_offset)
             axis = Rcf[:, 2]
+        else:  # an arm given as data: its URDF's joint product, the tool along the flange z
+            T = spec.family.arm.chain.fk(q)
+            axis = T[:3, 2]
+            pcf = T[:3, 3] + (tl - bare_offset) * axis
         np.testing.assert_allclose(rel, pcf, atol=1e-9)
         # the tcp lies on the flange axis, the tool length beyond the flange
         np.testing.assert_allclose(pt, pfl + tl * (R0 @ axis), atol=1e-9)

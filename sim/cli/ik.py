@@ -98,7 +98,8 @@ def _run_arm(args: argparse.Namespace) -> int:
                                          "within_limits": bool(s.within_limits),
                                          "branch": s.branch} for s in shown]}))
         return 0
-    how = "closed form (OPW)" if arm.opw is not None else f"numeric ({arm.why_numeric})"
+    how = {"opw": "closed form (OPW)", "five_r": "closed form (seed 000's 5R)"}.get(
+        arm.solver, f"numeric ({arm.why_numeric})")
     print(f"{arm.name} ({arm.source}): {len(sols)} solution(s), {how}; joints "
           f"{' '.join(arm.chain.joint_names)} in deg")
     _print_solutions(sols, shown, args.all)

@@ -3,7 +3,9 @@
 :func:`load_arm` reads ``*.urdf`` files and ``robot.toml`` files (or the folder holding one);
 :class:`Arm` solves inverse kinematics with the closed form when the arm is ortho-parallel with
 a spherical wrist (:mod:`sim.robots.opw`: all 8 branches, plus the whole-turn variants of
-joints whose range exceeds 360 deg) and numerically otherwise (:mod:`sim.robots.numeric_ik`).
+joints whose range exceeds 360 deg), with seed 000's 5R closed form when a 5-axis arm has its
+structure (:mod:`sim.robots.five_axis`: 4 branches), and numerically otherwise
+(:mod:`sim.robots.numeric_ik`).
 
 ``robot.toml`` (this slice reads its kinematics and joint tables)::
 
@@ -34,6 +36,7 @@ from sim.core.tomlschema import load_toml
 from sim.errors import KinematicsError
 from sim.robots import opw
 from sim.robots.chain import Chain, chain_from_dh, chain_from_urdf
+from sim.robots.five_axis import FiveAxisMap, five_axis_from_chain
 from sim.robots.numeric_ik import solve_ik as numeric_solve
 
 
@@ -60,10 +63,14 @@ class Arm:
     opw: opw.OPWParameters | None
     why_numeric: str = ""
     source: Path | None = None
+    five: FiveAxisMap | None = None
 
     @property
     def solver(self) -> str:
-        return "opw" if self.opw is not None else "numeric"
+        """``"opw"`` (6 axes), ``"five_r"`` (5 axes, seed 000's closed form) or ``"numeric"``."""
+        if self.opw is not None:
+            return "opw"
+        return "five_r" if self.five is not None else "numeric"
 
     def fk(self, q: ArrayLike) -> NDArray[np.float64]:
         """Flange pose in frame 0 (the chain's base), (4, 4)."""
@@ -88,6 +95,16 @@ class Arm:
                 if np.max(np.abs(self.chain.fk(q) - T)) > 1e-7:
                     continue  # a branch the arm's geometry makes spurious
                 label = opw.configuration(self.opw, q)
+                variants = [_turns(q[i], lo[i], hi[i]) for i in range(len(q))]
+                if all(variants):
+                    for combo in itertools.product(*variants):
+                        out.append(Solution(np.array(combo), label, True))
+                else:
+                    out.append(Solution(q, label, False))
+        elif self.five is not None:
+            for q, label in self.five.inverse(T):
+                if np.abs(self.chain.fk(q)[:3, 3] - T[:3, 3]).max() > 1e-7:
+                    continue
                 variants = [_turns(q[i], lo[i], hi[i]) for i in range(len(q))]
                 if all(variants):
                     for combo in itertools.product(*variants):
@@ -132,8 +149,13 @@ def arm_from_chain(chain: Chain, source: Path | None = None) -> Arm:
                        source=source)
         except KinematicsError as exc:
             return Arm(chain.name, chain, None, why_numeric=str(exc), source=source)
-    return Arm(chain.name, chain, None, why_numeric=f"{chain.n} joints (the closed form is for 6)",
-               source=source)
+    if chain.n == 5:
+        try:
+            return Arm(chain.name, chain, None, source=source, five=five_axis_from_chain(chain))
+        except KinematicsError as exc:
+            return Arm(chain.name, chain, None, why_numeric=str(exc), source=source)
+    return Arm(chain.name, chain, None, why_numeric=f"{chain.n} joints (the closed forms are "
+               "for 5 and 6)", source=source)
 
 
 def chain_from_robot_file(spec, path: Path) -> Chain:

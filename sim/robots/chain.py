@@ -65,6 +65,12 @@ class Chain:
         lower, upper: Joint limits, rad, (n,) (+-inf where none).
         joint_names: Joint names, in order.
         max_speed: Joint speed limits, rad/s, (n,) (inf where none given).
+        max_effort: Joint torque limits, N m, (n,) (a URDF's ``effort``; 0 where none given).
+        inertials: Per moving body (joint i's frame): ``(mass kg, centre of mass (3,) m,
+            inertia about the centre of mass (3, 3) kg m^2)``, with everything attached to it
+            off the chain fused in (fixed links, a gripper past the tip; joints off the chain
+            at zero); None when the source gives no inertials (a DH table, a URDF without),
+            and ``no_inertials_why`` says which.
     """
 
     name: str
@@ -75,6 +81,9 @@ class Chain:
     upper: NDArray[np.float64]
     joint_names: tuple[str, ...]
     max_speed: NDArray[np.float64] | None = None
+    max_effort: NDArray[np.float64] | None = None
+    inertials: tuple[tuple[float, NDArray[np.float64], NDArray[np.float64]], ...] | None = None
+    no_inertials_why: str = ""
 
     @property
     def n(self) -> int:
@@ -216,7 +225,77 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
             raise KinematicsError(f"{path}: {what}: needs {n} finite numbers, got {text!r}")
         return out
 
-    origins, axes, names, lo, hi, vel = [], [], [], [], [], []
+    link_el = {ln.get("name"): ln for ln in root.findall("link")}
+
+    def inertial(link: str, where: NDArray[np.float64]):
+        """The link's inertial in the moving body's frame (``where``: the link's frame in it),
+        or None when it has none."""
+        el = link_el.get(link)
+        el = None if el is None else el.find("inertial")
+        if el is None:
+            return None
+        o = el.find("origin")
+        xyz = num(None if o is None else o.get("xyz"), 3, f"link {link!r} inertial origin xyz")
+        rpy = num(None if o is None else o.get("rpy"), 3, f"link {link!r} inertial origin rpy")
+        m_el, i_el = el.find("mass"), el.find("inertia")
+        mass = num(None if m_el is None else m_el.get("value"), 1, f"link {link!r} mass")[0]
+        if mass < 0:
+            raise KinematicsError(f"{path}: link {link!r}: mass {mass:g} < 0")
+        if mass > 0 and i_el is None:
+            raise KinematicsError(f"{path}: link {link!r}: <inertial> has a mass but no <inertia>")
+        keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+        vals = [num(None if i_el is None else i_el.get(k), 1, f"link {link!r} inertia {k}")[0]
+                for k in keys]
+        ixx, ixy, ixz, iyy, iyz, izz = vals
+        Ic = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        ev = np.sort(np.linalg.eigvalsh(Ic))
+        scale = max(float(np.abs(ev).max()), 1e-300)
+        if ev[0] < -1e-9 * scale or ev[0] + ev[1] < ev[2] * (1 - 1e-9):
+            raise KinematicsError(
+                f"{path}: link {link!r}: inertia is not physical (principal moments "
+                f"{', '.join(f'{v:.4g}' for v in ev)} kg m^2: each must be >= 0 and no one "
+                "larger than the sum of the other two)")
+        T = where @ _T(rpy_matrix(*rpy), xyz)
+        return mass, T[:3, 3], T[:3, :3] @ Ic @ T[:3, :3].T
+
+    children: dict[str, list] = {}
+    for jn, j in joints.items():
+        children.setdefault(j.find("parent").get("link"), []).append(jn)
+    on_path = set(path_joints)
+
+    def hanging(link: str, where: NDArray[np.float64], seen: frozenset = frozenset()) -> list:
+        """The inertials of ``link`` and of everything attached to it off the chain (fixed
+        links, a gripper past the tip, side branches; joints off the chain held at zero), in
+        the moving body's frame (``where``: the link's frame in it)."""
+        if link in seen:
+            raise KinematicsError(f"{path}: link {link!r} is in a loop")
+        parts = [inertial(link, where)]
+        for jn in children.get(link, []):
+            if jn in on_path:
+                continue
+            j = joints[jn]
+            o = j.find("origin")
+            xyz = num(None if o is None else o.get("xyz"), 3, f"joint {jn!r} origin xyz")
+            rpy = num(None if o is None else o.get("rpy"), 3, f"joint {jn!r} origin rpy")
+            parts += hanging(j.find("child").get("link"), where @ _T(rpy_matrix(*rpy), xyz),
+                             seen | {link})
+        return parts
+
+    def fuse(parts):
+        parts = [p for p in parts if p is not None and p[0] > 0]
+        if not parts:
+            return None
+        m = sum(p[0] for p in parts)
+        c = sum(p[0] * p[1] for p in parts) / m
+        Itot = np.zeros((3, 3))
+        for mk, ck, Ik in parts:
+            r = ck - c
+            Itot += Ik + mk * (r @ r * np.eye(3) - np.outer(r, r))
+        return m, c, Itot
+
+    origins, axes, names, lo, hi, vel, eff = [], [], [], [], [], [], []
+    bodies: list[list] = []  # per moving body: the inertials of its links
+    has_inertial: list[bool] = []
     pending = np.eye(4)
     for jname in path_joints:
         j = joints[jname]
@@ -225,8 +304,13 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
         rpy = num(None if o is None else o.get("rpy"), 3, f"joint {jname!r} origin rpy")
         T = pending @ _T(rpy_matrix(*rpy), xyz)
         jtype = j.get("type")
+        child = j.find("child").get("link")
         if jtype == "fixed":
             pending = T
+            if bodies:  # a link fixed to the last moving body, with what hangs off it
+                parts = hanging(child, T)
+                bodies[-1] += parts
+                has_inertial[-1] = has_inertial[-1] or any(p is not None for p in parts)
             continue
         if jtype != "revolute":
             raise KinematicsError(f"{path}: joint {jname!r}: type {jtype!r} is not supported "
@@ -246,6 +330,11 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
             raise KinematicsError(f"{path}: joint {jname!r}: limit lower {lower:g} > upper "
                                   f"{upper:g}")
         v = lim.get("velocity")
+        e = lim.get("effort")
+        eff.append(num(e, 1, f"joint {jname!r} limit effort")[0] if e else 0.0)
+        parts = hanging(child, np.eye(4))
+        bodies.append(parts)
+        has_inertial.append(any(p is not None for p in parts))
         origins.append(T)
         axes.append(axis / np.linalg.norm(axis))
         names.append(jname)
@@ -255,8 +344,16 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
         pending = np.eye(4)
     if not names:
         raise KinematicsError(f"{path}: no revolute joint between the root and {tip!r}")
+    fused = [fuse(b) for b in bodies]
+    inertials = tuple(fused) if all(has_inertial) and all(f is not None for f in fused) else None
+    note = "the moving links have no <inertial> (mass and inertia)"
+    if any(has_inertial) and inertials is None:
+        i = next(k for k, f in enumerate(fused) if f is None)
+        note = (f"joint {names[i]!r}: the links it moves (up to the next joint) have no mass "
+                "(no <inertial>, or mass 0)")
     return Chain(root.get("name", path.stem), np.array(origins), np.array(axes), pending,
-                 np.array(lo), np.array(hi), tuple(names), np.array(vel))
+                 np.array(lo), np.array(hi), tuple(names), np.array(vel), np.array(eff),
+                 inertials, "" if inertials is not None else note)
 
 
 __all__ = ["Chain", "chain_from_dh", "chain_from_urdf", "rot_axis", "rpy_matrix"]

@@ -205,13 +205,20 @@ def get_robot(name: str) -> RobotSpec:
 
 
 def resolve_robot(ref: str, base: Path | None = None) -> RobotSpec:
-    """A shipped robot by name, or a robot folder of one's own (a path, relative to ``base``,
-    the scenario's folder, holding a ``robot.toml``).
+    """A shipped robot by name, a robot folder of one's own (a path, relative to ``base``, the
+    scenario's folder, holding a ``robot.toml``), or a URDF file (``*.urdf``:
+    :func:`sim.robots.robotfile.load_urdf_robot`).
 
     Raises:
         UnknownNameError: Unknown name (the message lists the robots).
-        KinematicsError: A folder without a valid ``robot.toml`` (one line naming file and key).
+        KinematicsError: A folder without a valid ``robot.toml``, or a URDF that cannot run as
+            it is (one line naming the file and the key, joint or link).
     """
+    if ref.lower().endswith(".urdf"):
+        from sim.robots.robotfile import load_urdf_robot
+
+        path = Path(ref) if base is None else base / ref
+        return load_urdf_robot(path)
     if "/" in ref or "\\" in ref or ref.endswith(".toml"):
         from sim.robots.robotfile import load_robot_folder
 

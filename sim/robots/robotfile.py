@@ -60,6 +60,7 @@ class FamilyKinematics(Strict):
 
 class RobotJoints(Strict):
     range_deg: list[list[float]] | None = None
+    home_deg: list[float] | None = None
     max_speed_deg_s: list[float] | None = None
     max_accel_deg_s2: list[float] | None = None
 
@@ -171,10 +172,8 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     MJCF (:mod:`sim.robots.generate`) and acceleration limits derived from the drives."""
     import dataclasses
 
-    from sim.robots.accel_limits import derive_accel_limits
     from sim.robots.arm import arm_from_chain, chain_from_robot_file
     from sim.robots.families.chain_family import ChainFamily
-    from sim.robots.generate import generated_model_path
     from sim.robots.registry import Drive, RobotSpec
 
     where = str(path)
@@ -183,9 +182,10 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     if len(spec.drives) != n:
         raise KinematicsError(f"{where}: drives: {len(spec.drives)} drives for {n} joints (a "
                               "robot given by a DH table or a URDF needs one [[drives]] per joint)")
-    if spec.mass.total_kg is None:
+    if spec.mass.total_kg is None and chain.inertials is None:
         raise KinematicsError(f"{where}: mass.total_kg: required for a robot given by a DH table "
-                              "or a URDF (the link inertias are estimated from it)")
+                              "or a URDF without <inertial> on every moving link (the link "
+                              "inertias are estimated from it)")
     if spec.joints.max_speed_deg_s is not None:
         if len(spec.joints.max_speed_deg_s) != n:
             raise KinematicsError(f"{where}: joints.max_speed_deg_s: "
@@ -198,15 +198,33 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
                               "velocity limits)")
     drives = tuple(Drive(d.gear_ratio, d.efficiency, d.rotor_inertia_kg_m2, d.rated_torque_nm,
                          d.peak_torque_nm, d.max_speed_rpm) for d in spec.drives)
-    key = path.read_text(encoding="utf-8")
-    if spec.kinematics.urdf is not None:
-        key += (path.parent / spec.kinematics.urdf).read_text(encoding="utf-8", errors="replace")
-    model = generated_model_path(chain, spec.name, drives, spec.mass.total_kg,
-                                 key + f"|payload {spec.mass.payload_kg!r}",
-                                 payload_kg=spec.mass.payload_kg)
+    home = _home(spec, chain, where)
+    if spec.mjcf is not None:
+        # a shipped robot keeps its generated model in its folder (models/build_data_robots.py)
+        model = path.parent / spec.mjcf
+        if not model.is_file():
+            raise KinematicsError(f"{where}: mjcf: no such file {model} (leave mjcf out and "
+                                  "cellsim generates the model into its cache)")
+        _check_kept_model(model, chain, home, where)
+    else:
+        # (imported here: it imports mujoco, which a shipped robot's load must not, so that
+        # the CLI can still choose the GL backend after loading the registry)
+        from sim.robots.generate import generated_model_path
+
+        key = path.read_text(encoding="utf-8")
+        if spec.kinematics.urdf is not None:
+            key += (path.parent / spec.kinematics.urdf).read_text(encoding="utf-8",
+                                                                   errors="replace")
+        model = generated_model_path(chain, spec.name, drives, spec.mass.total_kg,
+                                     key + f"|payload {spec.mass.payload_kg!r}",
+                                     payload_kg=spec.mass.payload_kg, home=home)
     maker_joints, maker_matrix = _maker(spec, n, where)
+    from sim.core.resources import models_dir
+
+    shipped = model.parent.resolve().parent == models_dir().resolve()
     robot = RobotSpec(
-        name=spec.name, title=spec.title or spec.name, folder=str(model.parent),
+        name=spec.name, title=spec.title or spec.name,
+        folder=model.parent.name if shipped else str(model.parent),
         robot_file=model.name, family=ChainFamily(arm_from_chain(chain, path)),
         max_speed=tuple(float(v) for v in speed),
         description=spec.description or f"robot from {path}", drives=drives,
@@ -214,6 +232,8 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     if spec.joints.max_accel_deg_s2 is not None:
         accel = np.deg2rad(spec.joints.max_accel_deg_s2)
     else:
+        from sim.robots.accel_limits import derive_accel_limits
+
         try:
             accel = derive_accel_limits(robot, spec.mass.payload_kg, samples=500)
         except KinematicsError as exc:
@@ -221,4 +241,137 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     return dataclasses.replace(robot, max_accel=tuple(float(v) for v in accel))
 
 
-__all__ = ["RobotFolderSpec", "load_robot_folder"]
+def load_urdf_robot(path: str | Path):  # -> RobotSpec
+    """A robot straight from a URDF file (``robot = "arm.urdf"`` in a scenario): the chain from
+    the root link to ``tool0`` (else the last link), the URDF's own ``<inertial>`` elements as
+    the link masses, and its ``<limit effort velocity>`` as the drives: a direct drive per
+    joint (gear ratio 1, efficiency 1, no rotor inertia, rated = peak torque = ``effort``, the
+    speed limit ``velocity``). No payload; acceleration limits derived from the efforts. For
+    real drive trains, a payload or a maker's joint convention, write a robot folder
+    (``docs/robot-format.md``).
+
+    Raises:
+        KinematicsError: One line naming the file and the joint or link: a URDF that cannot
+            run as it is (no inertials, no effort or velocity limits) says which robot.toml
+            keys supply what is missing.
+    """
+    import dataclasses
+    import math
+
+    from sim.robots.arm import arm_from_chain
+    from sim.robots.chain import chain_from_urdf
+    from sim.robots.families.chain_family import ChainFamily
+    from sim.robots.registry import Drive, RobotSpec
+
+    path = Path(path)
+    chain = chain_from_urdf(path)
+    if chain.inertials is None:
+        raise KinematicsError(f"{path}: {chain.no_inertials_why or 'no inertials'}; give it a "
+                              "robot folder with [mass] total_kg and [[drives]] "
+                              "(docs/robot-format.md)")
+    for i, name in enumerate(chain.joint_names):
+        if not chain.max_effort[i] > 0:
+            raise KinematicsError(f"{path}: joint {name!r}: <limit effort> is missing or 0; give "
+                                  "it a robot folder with [[drives]] (docs/robot-format.md)")
+        if not (math.isfinite(chain.max_speed[i]) and chain.max_speed[i] > 0):
+            raise KinematicsError(f"{path}: joint {name!r}: <limit velocity> is missing or 0; "
+                                  "give it a robot folder with joints.max_speed_deg_s")
+    drives = tuple(Drive(1.0, 1.0, 0.0, float(e), float(e), float(v) * 60.0 / (2.0 * math.pi))
+                   for e, v in zip(chain.max_effort, chain.max_speed, strict=True))
+    import re
+
+    from sim.robots.generate import generated_model_path
+
+    # the model's file and MJCF name: the URDF's robot name where it is a plain name
+    name = chain.name if re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9_.-]*", chain.name or "") else \
+        re.sub(r"[^A-Za-z0-9_.-]", "_", path.stem).lstrip(".") or "robot"
+    model = generated_model_path(chain, name, drives, None,
+                                 "urdf|" + path.read_text(encoding="utf-8", errors="replace"))
+    robot = RobotSpec(
+        name=name, title=name, folder=str(model.parent), robot_file=model.name,
+        family=ChainFamily(arm_from_chain(chain, path)),
+        max_speed=tuple(float(v) for v in chain.max_speed),
+        description=f"robot from {path}", drives=drives, payload_kg=0.0)
+    from sim.robots.accel_limits import derive_accel_limits
+
+    try:
+        accel = derive_accel_limits(robot, 0.0, samples=500)
+    except KinematicsError as exc:
+        raise KinematicsError(f"{path}: {exc}") from None
+    return dataclasses.replace(robot, max_accel=tuple(float(v) for v in accel))
+
+
+def _check_kept_model(model: Path, chain, home, where: str) -> None:
+    """A generated model kept in the folder (``mjcf``) must still be the chain's: its joint
+    ranges and ``home`` keyframe are compared (read as XML: mujoco is not imported here)."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(model).getroot()
+    except (ET.ParseError, OSError) as exc:
+        raise KinematicsError(f"{where}: mjcf: {model} is not readable MJCF ({exc})") from None
+    joints = [j for j in root.iter("joint") if j.get("range")]
+    key = next((k for k in root.iter("key") if k.get("name") == "home"), None)
+    try:
+        ranges = np.array([[float(v) for v in j.get("range").split()] for j in joints])
+        qhome = None if key is None else np.array([float(v) for v in key.get("qpos").split()])
+    except (ValueError, AttributeError):
+        ranges, qhome = np.zeros((0, 2)), None
+    want_home = np.clip(0.0, chain.lower, chain.upper) if home is None else home
+    if (ranges.shape != (chain.n, 2)
+            or np.abs(ranges - np.c_[chain.lower, chain.upper]).max() > 1e-8
+            or qhome is None or qhome.shape != (chain.n,)
+            or np.abs(qhome - want_home).max() > 1e-8):
+        raise KinematicsError(f"{where}: mjcf: {model.name} is not the model of this robot.toml "
+                              "(its joint ranges or home keyframe differ): regenerate it "
+                              "(models/build_data_robots.py) or leave mjcf out")
+
+
+def _home(spec: RobotFolderSpec, chain, where: str):
+    """``[joints] home_deg`` in rad (None when not given), checked against the ranges."""
+    h = spec.joints.home_deg
+    if h is None:
+        return None
+    if len(h) != chain.n:
+        raise KinematicsError(f"{where}: joints.home_deg: {len(h)} values for {chain.n} joints")
+    q = np.deg2rad(h)
+    for i, (v, lo, hi) in enumerate(zip(q, chain.lower, chain.upper, strict=True)):
+        if not lo - 1e-12 <= v <= hi + 1e-12:
+            raise KinematicsError(f"{where}: joints.home_deg: {h[i]:g} deg for "
+                                  f"{chain.joint_names[i]} is outside its range "
+                                  f"{np.rad2deg(lo):g} .. {np.rad2deg(hi):g} deg")
+    return q
+
+
+def generated_files(folder: str | Path) -> dict[Path, str]:
+    """The model files cellsim generates for a robot folder given by a DH table or a URDF with
+    ``mjcf`` set: ``{folder/mjcf: MJCF text, folder/scene.xml: scene}`` (written and checked by
+    ``models/build_data_robots.py``)."""
+    from types import SimpleNamespace
+
+    from sim.robots.arm import chain_from_robot_file
+    from sim.robots.generate import model_text, scene_text
+
+    path = Path(folder) / "robot.toml"
+    spec, _ = load_toml(path, RobotFolderSpec, KinematicsError)
+    if spec.kinematics.convention is None or spec.mjcf is None:
+        raise KinematicsError(f"{path}: generated_files needs a DH/URDF robot with mjcf")
+    stem = Path(spec.mjcf).stem
+    if stem != spec.name:
+        raise KinematicsError(f"{path}: mjcf: must be {spec.name}.xml (the model is named "
+                              "after the robot)")
+    chain = chain_from_robot_file(spec, path)
+    if len(spec.drives) != chain.n:
+        raise KinematicsError(f"{path}: drives: {len(spec.drives)} drives for {chain.n} joints")
+    if spec.mass.total_kg is None and chain.inertials is None:
+        raise KinematicsError(f"{path}: mass.total_kg: required (no URDF inertials)")
+    # the registry's Drive fields (not imported: the registry loads this very folder)
+    drives = tuple(SimpleNamespace(gear_ratio=d.gear_ratio, efficiency=d.efficiency,
+                                   rotor_inertia=d.rotor_inertia_kg_m2,
+                                   peak_torque=d.peak_torque_nm) for d in spec.drives)
+    xml = model_text(chain, spec.name, drives, spec.mass.total_kg, spec.mass.payload_kg,
+                     home=_home(spec, chain, str(path)))
+    return {path.parent / spec.mjcf: xml, path.parent / "scene.xml": scene_text(spec.name)}
+
+
+__all__ = ["RobotFolderSpec", "generated_files", "load_robot_folder", "load_urdf_robot"]

@@ -3,7 +3,8 @@
 The seed tool frame is the arm's flange frame (z out of the flange, the approach axis) moved
 ``tool`` metres along its z axis: a straight tool, as for the seeds' families. Inverse
 kinematics is the arm's: the OPW closed form (all branches) when the arm is ortho-parallel with
-a spherical wrist, the numeric solver otherwise. Singular factors: for an OPW arm ``wrist`` =
+a spherical wrist, seed 000's 5R closed form for a 5-axis arm of that structure, the numeric
+solver otherwise. Singular factors: for an OPW arm ``wrist`` =
 sin(theta5), ``elbow`` = sin(theta3 + atan2(a2, c3)) (upper arm and the line to the wrist centre
 aligned), ``shoulder`` = the wrist centre's distance from the J1 axis less ``|b|`` (m), in the
 model's angles (``theta = sign * q - offset``); a numeric arm has none beyond the Jacobian's
