@@ -25,6 +25,7 @@ from sim.scenario import (
     SimulationSpec,
     SizingSpec,
     VideoSpec,
+    WeaveSpec,
     load_scenario,
     parse_scenario,
 )
@@ -249,7 +250,7 @@ def test_format_reference_documents_every_key():
     doc = DOC.read_text()
     documented = set(re.findall(r"`([a-z][a-z0-9_]*)`", doc))
     models = (ScenarioSpec, JointPhaseSpec, LinearPhaseSpec, CircularPhaseSpec, HoldPhaseSpec,
-              ActionSpec, SimulationSpec, VideoSpec, DriveOverrideSpec, SizingSpec)
+              ActionSpec, SimulationSpec, VideoSpec, DriveOverrideSpec, SizingSpec, WeaveSpec)
     declared = set()
     for model in models:
         for key in model.model_fields:

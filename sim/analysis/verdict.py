@@ -41,6 +41,10 @@ from numpy.typing import NDArray
 from sim.analysis.sizing import SizingResult
 from sim.robots.registry import RobotSpec
 
+#: Largest deviation of a measured weave amplitude / frequency from the set value (warning), %.
+WEAVE_AMPLITUDE_PCT = 2.0
+WEAVE_FREQUENCY_PCT = 1.0
+
 
 @dataclass(frozen=True)
 class RunCheck:
@@ -98,6 +102,16 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
         checks.append(RunCheck("cartesian_speed", "", dev, 1.0, "% off the set speed",
                                dev <= 1.0, subject=f"{c['phase']}: {c['cruise_mm_s']:.4g} mm/s "
                                f"for {c['set_mm_s']:.4g} mm/s"))
+    for w in summary.get("weave", ()):
+        # a weave the arm does not reproduce (too fast for the joints' polynomial or the
+        # servos): warnings, the weld still ran
+        for key, err, lim in (("weave_amplitude", w["amplitude_error_pct"], WEAVE_AMPLITUDE_PCT),
+                              ("weave_frequency", w["frequency_error_pct"], WEAVE_FREQUENCY_PCT)):
+            checks.append(RunCheck(key, "", abs(float(err)), lim, "% off the set value",
+                                   abs(float(err)) <= lim, severity="warning",
+                                   subject=f"{w['phase']}: {w['amplitude_mm']:.3f} mm at "
+                                   f"{w['frequency_hz']:.3f} Hz for {w['set_amplitude_mm']:.3f} "
+                                   f"mm at {w['set_frequency_hz']:.3f} Hz"))
     if selection is not None:
         for j in selection.joints:
             pair = j.chosen or j.closest

@@ -95,6 +95,10 @@ def run(args: argparse.Namespace) -> int:
             f"(x{summary['realtime_factor']:.1f} real time); max tracking error {track:.4f} deg; "
             f"max tcp deviation {summary['max_tcp_deviation_mm']:.3f} mm")
     print(line)
+    for w in summary.get("weave", []):
+        print(f"  weave {w['phase']} ({w['pattern']}): {w['amplitude_mm']:.3f} mm at "
+              f"{w['frequency_hz']:.3f} Hz (set {w['set_amplitude_mm']:.3f} mm at "
+              f"{w['set_frequency_hz']:.3f} Hz), centre line {w['centre_line_mm']:+.4f} mm")
     for weld in summary.get("weld", []):
         print(f"  weld {weld['phase']}: {weld['seam_length_mm']:.1f} mm at "
               f"{weld['travel_speed_mm_s']:.2f} mm/s (cv {weld['travel_speed_cv']:.4f}), path "

@@ -36,11 +36,12 @@ from sim.scenario.schema import (
     SimulationSpec,
     SizingSpec,
     VideoSpec,
+    WeaveSpec,
 )
 
 __all__ = [
     "Action", "ActionSpec", "CartesianPhase", "CircularPhaseSpec", "DriveOverrideSpec",
     "HoldPhase", "HoldPhaseSpec", "JointPhase", "JointPhaseSpec", "LinearPhaseSpec", "Phase",
     "PlannedPhase", "PoseTarget", "Scenario", "ScenarioSpec", "SimulationSpec", "SizingSpec", "VideoSpec",
-    "load_scenario", "parse_scenario", "plan_phase", "plan_scenario", "resolve_scenario",
+    "WeaveSpec", "load_scenario", "parse_scenario", "plan_phase", "plan_scenario", "resolve_scenario",
 ]

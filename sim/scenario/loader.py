@@ -312,8 +312,12 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
             raise ScenarioError(
                 f"{where}.{bkey}: {len(values)} values; robot {robot.name} has {n} joints")
         boundary[kw] = np.asarray(values, dtype=float) * bscale
+    if spec.blend_deg and ("vf" in boundary or "af" in boundary):
+        raise ScenarioError(f"{where}.blend_deg: not with end_velocity/end_acceleration (the "
+                            "blend sets them)")
     return JointPhase(index=index, name=spec.name, planner=spec.planner, times=times,
-                      durations=durations, q=q, boundary=boundary, target=target)
+                      durations=durations, q=q, boundary=boundary, target=target,
+                      blend=math.radians(spec.blend_deg or 0.0))
 
 
 def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
@@ -338,6 +342,22 @@ def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
                       frame=spec.frame)
 
 
+def _weave(spec: LinearPhaseSpec | CircularPhaseSpec, where: str):
+    """The phase's :class:`planners.weave.Weave` (SI), or None."""
+    w = spec.weave
+    if w is None:
+        return None
+    from planners.weave import Weave
+
+    if (w.frequency_hz is None) == (w.wavelength_mm is None):
+        raise ScenarioError(f"{where}.weave: give exactly one of frequency_hz or wavelength_mm")
+    freq = w.frequency_hz if w.frequency_hz is not None else spec.speed_mm_s / w.wavelength_mm
+    try:
+        return Weave(w.pattern, w.amplitude_mm * 1e-3, freq, w.dwell_s)
+    except PlannerError as exc:
+        raise ScenarioError(f"{where}.{exc}") from None
+
+
 def _build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec,
                            where: str) -> CartesianPhase:
     def vec_m(v: list[float] | None) -> NDArray[np.float64] | None:
@@ -354,7 +374,8 @@ def _build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec
                   ramp=spec.ramp_s, orientation=spec.orientation, seam=spec.seam,
                   euler_zyx=None if spec.euler_zyx_deg is None
                   else np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)),
-                  frame=spec.frame)
+                  frame=spec.frame, blend=(spec.blend_mm or 0.0) * 1e-3,
+                  weave=_weave(spec, where))
     if spec.seam is not None and spec.frame != "frame0":
         raise ScenarioError(f"{where}.frame: not used with seam (a seam is in its cell)")
     if isinstance(spec, LinearPhaseSpec):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,6 +34,7 @@ class JointPhase:
             ``NaN`` until the previous phase's end fills it in (see :meth:`with_start`).
         boundary: Planner keywords (``v0``, ``vf``, ``a0``, ``af``, ``j0``, ``jf``) with arrays
             of shape (n_joints,) in rad/s^k; absent keys default to 0 in the planner.
+        blend: Blend radius into the next joint phase, rad (0: stop at the last knot).
     """
 
     index: int
@@ -45,6 +46,7 @@ class JointPhase:
     boundary: dict[str, NDArray[np.float64]] = field(default_factory=dict)
     kind: str = "joint"
     target: "PoseTarget | None" = None
+    blend: float = 0.0
 
     @property
     def t0(self) -> float:
@@ -118,6 +120,8 @@ class CartesianPhase:
         center, axis, sweep: Circular only: centre (m), axis (unit), sweep (rad).
         speed: Travel speed, m/s. sample_period: ADNIA sampling period, s. ramp: ramp time, s.
         orientation: ``keep``, ``follow``, ``seam`` or ``euler``; ``euler``: R = Rz Ry Rx (rad).
+        blend: Corner zone radius into the next Cartesian phase, m (0: stop at the end).
+        weave: A :class:`planners.weave.Weave` across the path, or ``None``.
     """
 
     index: int
@@ -136,6 +140,8 @@ class CartesianPhase:
     sweep: float | None = None
     euler_zyx: NDArray[np.float64] | None = None
     frame: str = "frame0"
+    blend: float = 0.0
+    weave: Any = None
 
 
 @dataclass(frozen=True)

@@ -68,7 +68,19 @@ class JointPhaseSpec(_Strict):
     euler_zyx_deg: Vec3 | None = None
     frame: str = Field("frame0", description='frame of to_mm and euler_zyx_deg: "frame0", '
                        '"world" or a cell object')
+    blend_deg: float | None = Field(None, ge=0, description="pass the last knot without "
+                                    "stopping into the next joint phase, deg")
     note: str | None = Field(None, description="free text (e.g. which seed value was chosen)")
+
+
+class WeaveSpec(_Strict):
+    """A weave across the seam over a Cartesian phase (:mod:`planners.weave`)."""
+
+    pattern: Literal["sine", "zigzag", "triangle", "circle"]
+    amplitude_mm: float = Field(gt=0)
+    frequency_hz: float | None = Field(None, gt=0)
+    wavelength_mm: float | None = Field(None, gt=0)
+    dwell_s: float = Field(0.0, ge=0)
 
 
 class _CartesianSpec(_Strict):
@@ -82,6 +94,9 @@ class _CartesianSpec(_Strict):
     euler_zyx_deg: Vec3 | None = None
     frame: str = Field("frame0", description='frame of the points, axis and euler_zyx_deg: '
                        '"frame0", "world" or a cell object')
+    blend_mm: float | None = Field(None, ge=0, description="corner zone radius into the next "
+                                   "Cartesian phase, mm (the tool does not stop)")
+    weave: WeaveSpec | None = None
     note: str | None = None
 
 

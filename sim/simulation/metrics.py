@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
+from planners.weave import WeavingTrajectory
 from sim.core.intervals import true_runs
 from sim.scenario import Scenario
 from sim.simulation.compile import BuiltCell
@@ -40,6 +41,73 @@ def _distance_to_path(p: NDArray[np.float64], cart: Any, T: NDArray[np.float64])
     return best
 
 
+def _weave_offset(cart: Any, ts: NDArray[np.float64], T: NDArray[np.float64]
+                  ) -> NDArray[np.float64]:
+    """The planned weave displacement (world, m) of a phase at its own times ``ts``; zero for
+    a phase without weave."""
+    if not isinstance(cart, WeavingTrajectory):
+        return np.zeros((len(ts), 3))
+    return cart.offset(np.clip(ts, 0.0, cart.duration)) @ T[:3, :3].T
+
+
+def _woven_travel_speed(cart: Any, ts: NDArray[np.float64], p: NDArray[np.float64],
+                        T: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Travel speed along the path of a weaving phase, m/s: the tool point's velocity along the
+    travel direction, the weave's planned longitudinal motion taken out (the lateral motion,
+    which the joints' polynomial rounds between its samples, does not count)."""
+    lon = cart.frame(np.clip(ts, 0.0, cart.duration))[1] @ T[:3, :3].T
+    travel = p - _weave_offset(cart, ts, T)
+    return np.einsum("ij,ij->i", np.gradient(travel, ts, axis=0), lon)
+
+
+def _woven_cruise(cart: Any, ts: NDArray[np.float64], p: NDArray[np.float64],
+                  T: NDArray[np.float64]) -> float:
+    """A weaving phase's travel speed between its ramps, m/s: the mean of the travel-direction
+    velocity (progress over time, so the rounding of the pattern's corners averages out)."""
+    v = _woven_travel_speed(cart, ts, p, T)
+    ramp = float(cart.profile.ramp_time)
+    mid = (ts >= ramp) & (ts <= cart.duration - ramp)
+    return float(np.mean(v[mid] if np.count_nonzero(mid) > 2 else v))
+
+
+def weave_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell
+                  ) -> list[dict[str, Any]]:
+    """Per weaving phase: the tool point's lateral offset from the phase's own path (seam),
+    measured on the simulated tcp over the full-amplitude part: amplitude (half the peak to
+    peak), frequency (FFT peak, :func:`planners.weave.measure_weave`), centre line (mean
+    offset over whole cycles), against the set values."""
+    from planners.weave import measure_weave
+
+    t = arrays["t"]
+    T = built.context.world_from_frame0
+    out = []
+    for k, pm in enumerate(motion.phases):
+        cart = pm.cartesian
+        if not isinstance(cart, WeavingTrajectory):
+            continue
+        sel = arrays["phase"] == k
+        tl = t[sel] - pm.t0
+        full = (tl >= cart.fade) & (tl <= cart.duration - cart.fade)
+        if np.count_nonzero(full) < 16:
+            continue
+        tl = tl[full]
+        p = arrays["tcp_pos"][sel][full]
+        base = cart.base.at(tl).position @ T[:3, :3].T + T[:3, 3]
+        lat, lon = cart.frame(tl)
+        lateral = np.einsum("ij,ij->i", p - base, lat @ T[:3, :3].T)
+        m = measure_weave(tl, lateral)
+        w = cart.weave
+        out.append({
+            "phase": pm.name, "pattern": w.pattern,
+            "set_amplitude_mm": w.amplitude * 1e3, "amplitude_mm": m["amplitude_m"] * 1e3,
+            "amplitude_error_pct": (m["amplitude_m"] / w.amplitude - 1.0) * 100.0,
+            "set_frequency_hz": w.frequency, "frequency_hz": m["frequency_hz"],
+            "frequency_error_pct": (m["frequency_hz"] / w.frequency - 1.0) * 100.0,
+            "centre_line_mm": m["centre_m"] * 1e3,
+        })
+    return out
+
+
 def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell,
                  torch_axis: int) -> list[dict[str, Any]]:
     """Per weld phase (a Cartesian phase with the arc on): seam length, travel speed and its
@@ -60,8 +128,15 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
         ramp = float(cart.profile.ramp_time)
         tc0, tc1 = pm.t0 + ramp, pm.t1 - ramp
         cs = (ts >= tc0 + 1e-9) & (ts <= tc1 - 1e-9)
-        v = np.linalg.norm(np.gradient(p, ts, axis=0), axis=1)
-        vc = v[cs] if np.count_nonzero(cs) > 2 else v
+        if isinstance(cart, WeavingTrajectory):
+            # progress along the seam over whole cycles (the pattern's corners average out)
+            v = _woven_travel_speed(cart, ts - pm.t0, p, T)
+            vc = v[cs] if np.count_nonzero(cs) > 2 else v
+            cycles = max(1, int(len(vc) * (ts[1] - ts[0]) * cart.weave.frequency))
+            vc = np.array([c.mean() for c in np.array_split(vc, cycles)])
+        else:
+            v = np.linalg.norm(np.gradient(p, ts, axis=0), axis=1)
+            vc = v[cs] if np.count_nonzero(cs) > 2 else v
         dev = _distance_to_path(p, cart, T)
         R_act = Rotation.from_quat(arrays["tcp_quat"][sel], scalar_first=True).as_matrix()
         R_ref = T[:3, :3] @ cart.at(np.clip(ts - pm.t0, 0.0, cart.duration)).rotation
@@ -123,7 +198,8 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
                                         for d, p in zip(rms_diff, peak_id)],
         "actions": [{"t": t, "action": act} for t, act in motion.actions],
         "weld": weld_metrics(a, motion, built, torch_axis),
-        "cartesian_speed": cartesian_speeds(a, motion),
+        "cartesian_speed": cartesian_speeds(a, motion, built.context.world_from_frame0),
+        "weave": weave_metrics(a, motion, built),
     }
     summary["saturation"] = saturation_intervals(a, motion, built, feedforward=feedforward)
     summary["singularity"] = singularity_summary(a, motion, built, rec.timestep)
@@ -138,13 +214,17 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
 SPEED_TOLERANCE = 0.01
 
 
-def cartesian_speeds(arrays: dict[str, NDArray[Any]], motion: Motion) -> list[dict[str, Any]]:
+def cartesian_speeds(arrays: dict[str, NDArray[Any]], motion: Motion,
+                     world_from_frame0: NDArray[np.float64] | None = None
+                     ) -> list[dict[str, Any]]:
     """Per Cartesian phase: the set travel speed and the reference tool point's cruise speed,
     mm/s (the median speed over the samples faster than 95 % of the phase's peak, so the ramps
     are left out), and the deviation in percent. A phase sampled too coarsely for its move
     (``sample_period_s`` near the move's duration) misses its set speed: the verdict fails it
-    past :data:`SPEED_TOLERANCE`."""
+    past :data:`SPEED_TOLERANCE`. A weaving phase's travel speed is that of the tool point
+    with the weave's planned displacement taken out."""
     t, p = arrays["t"], arrays["tcp_pos_ref"]
+    T = np.eye(4) if world_from_frame0 is None else world_from_frame0
     out = []
     for pm in motion.phases:
         if pm.cartesian is None:
@@ -153,9 +233,12 @@ def cartesian_speeds(arrays: dict[str, NDArray[Any]], motion: Motion) -> list[di
         if sel.size < 3:
             speed = 0.0
         else:
-            v = np.linalg.norm(np.diff(p[sel], axis=0), axis=1) / np.diff(t[sel])
-            cruise = v[v >= 0.95 * v.max()] if v.max() > 0 else v
-            speed = float(np.median(cruise))
+            if isinstance(pm.cartesian, WeavingTrajectory):
+                speed = _woven_cruise(pm.cartesian, t[sel] - pm.t0, p[sel], T)
+            else:
+                v = np.linalg.norm(np.diff(p[sel], axis=0), axis=1) / np.diff(t[sel])
+                cruise = v[v >= 0.95 * v.max()] if v.max() > 0 else v
+                speed = float(np.median(cruise))
         want = float(pm.phase.speed)
         out.append({"phase": pm.name, "set_mm_s": want * 1e3, "cruise_mm_s": speed * 1e3,
                     "deviation_pct": (speed - want) / want * 100.0 if want > 0 else 0.0})

@@ -237,14 +237,43 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     phases: list[PhaseMotion] = []
     t = 0.0
     q = None
-    for phase in scenario.phases:
+    todo = list(scenario.phases)
+    pending: tuple[NDArray[np.float64], dict[str, NDArray[np.float64]]] | None = None
+    while todo:
+        phase = todo.pop(0)
         label = f"{where}: phases[{phase.index}] ({phase.name})"
+        if isinstance(phase, CartesianPhase) and (phase.blend > 0
+                                                  or _is_polyline(phase, context)):
+            if context is None:
+                raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
+            group = [phase]
+            while group[-1].blend > 0 and todo and isinstance(todo[0], CartesianPhase):
+                group.append(todo.pop(0))
+            if len(group) == 1 and phase.blend > 0 and not _is_polyline(phase, context):
+                raise ScenarioError(f"{label}.blend_mm: the next phase is not a linear or "
+                                    "circular move to blend into (leave blend_mm out)")
+            labels = [f"{where}: phases[{ph.index}] ({ph.name})" for ph in group]
+            for pm in _plan_blended(group, t, q, context, labels):
+                if phases:
+                    _check_phase_continuity(phases[-1], pm, label, scenario.robot.joints)
+                phases.append(pm)
+            t = phases[-1].t1
+            q = phases[-1].trajectory.at(phases[-1].t1).q
+            continue
         if isinstance(phase, JointPhase):
             placed = phase.with_start(t, q)
+            if pending is not None:  # the previous joint phase blends into this one
+                qs = placed.q.copy()
+                qs[0] = pending[0]
+                placed = dataclasses.replace(placed, q=qs,
+                                             boundary={**placed.boundary, **pending[1]})
+                pending = None
             if phase.target is not None:
                 if context is None:
                     raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
                 placed = placed.with_end(_solve_target(phase, placed.q[0], context, label))
+            if phase.blend > 0:
+                placed, pending = _joint_blend(placed, todo[0] if todo else None, context, label)
             traj = plan_phase(placed, where)
             pm = PhaseMotion(placed, placed.t0, placed.t1, traj, knot_times=placed.times.copy())
         elif isinstance(phase, HoldPhase):
@@ -264,6 +293,45 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     motion = Motion(phases=phases, actions=[], n_joints=scenario.robot.n_joints)
     motion.actions = _resolve_actions(scenario, motion)
     return motion
+
+
+def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | None,
+                 label: str) -> tuple[JointPhase, tuple[NDArray[np.float64], dict]]:
+    """A joint phase that blends into the next joint phase (``blend_deg``): instead of stopping
+    at its last knot ``q_c`` it passes the corner without stopping. The incoming and outgoing
+    chords are cut where each has moved ``r`` (the largest joint change, at most half the
+    chord) from the corner, at ``a`` and ``b``; the phases meet at their midpoint (within ``r``
+    of ``q_c`` on every joint) with the velocity ``(b - a) / (t_b - t_a)`` and no acceleration.
+
+    Returns:
+        The phase with its new end, and the next phase's start (knot and boundary values).
+    """
+    if not isinstance(nxt, JointPhase):
+        raise ScenarioError(f"{label}.blend_deg: the next phase is not a joint phase to blend "
+                            "into (leave blend_deg out)")
+    nq = nxt.with_start(placed.t1, placed.q[-1])
+    if nxt.target is not None:
+        if ctx is None:
+            raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
+        nq = nq.with_end(_solve_target(nxt, nq.q[0], ctx, label))
+    q_p, q_c, q_n = placed.q[-2], placed.q[-1], nq.q[1]
+    t_p, t_c, t_n = placed.times[-2], placed.times[-1], nq.times[1]
+    d_in, d_out = np.abs(q_c - q_p).max(), np.abs(q_n - q_c).max()
+    if d_in < 1e-12 or d_out < 1e-12:
+        raise ScenarioError(f"{label}.blend_deg: the corner knot repeats its neighbour (nothing "
+                            "to blend)")
+    r = min(placed.blend, 0.5 * d_in, 0.5 * d_out)
+    a = q_c - r / d_in * (q_c - q_p)
+    b = q_c + r / d_out * (q_n - q_c)
+    t_a = t_c - r / d_in * (t_c - t_p)
+    t_b = t_c + r / d_out * (t_n - t_c)
+    q_b = 0.5 * (a + b)
+    v_b = (b - a) / (t_b - t_a)
+    zero = np.zeros_like(v_b)
+    q = placed.q.copy()
+    q[-1] = q_b
+    out = dataclasses.replace(placed, q=q, boundary={**placed.boundary, "vf": v_b, "af": zero})
+    return out, (q_b, {"v0": v_b, "a0": zero})
 
 
 #: Most inverse-kinematics samples of one Cartesian phase.
@@ -432,14 +500,12 @@ def default_ramp(phase: CartesianPhase, p0: NDArray[np.float64], seam: Any,
     return min(max(3.0 * phase.sample_period, 0.3), 0.5 * length / phase.speed)
 
 
-def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
-                    ctx: CartesianContext, label: str) -> PhaseMotion:
+def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.float64],
+                ctx: CartesianContext, label: str) -> tuple[Any, Any]:
+    """The phase's ADNIA move (``CartesianTrajectory``, frame 0) from the tool pose ``p0``,
+    ``R0``, with its seam (or ``None``)."""
     from planners import adnia
-    from sim.robots.ik import ik_path
 
-    kin = ctx.kinematics
-    T0 = np.asarray(kin.fk(q0), dtype=float)
-    p0, R0 = T0[:3, 3], T0[:3, :3]
     F = ctx.frame0_from(phase.frame, label)  # the phase's points are in this frame
 
     def pt(v: Any) -> Any:
@@ -490,21 +556,48 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
             cart = adnia.circle_move(center, axis, p0, phase.sweep, phase.speed, **kw)
     except PlannerError as exc:
         raise ScenarioError(f"{label}: {exc}") from None
+    return cart, seam
 
-    count = cart.duration / phase.sample_period
+
+#: Least number of inverse-kinematics samples per weave cycle and per corner blend. Patterns
+#: with corners (zigzag, triangle, dwells) get twice as many: the joint polynomial rounds a
+#: corner over about one sample spacing, overshooting by about 1 % of the amplitude at 48.
+SAMPLES_PER_WEAVE_CYCLE = 24
+SAMPLES_PER_BLEND = 8
+
+
+def _weave_period(weave: Any) -> float:
+    """Sample spacing for a weave, s."""
+    smooth = weave.pattern in ("sine", "circle") and weave.dwell == 0.0
+    return weave.period / (SAMPLES_PER_WEAVE_CYCLE * (1 if smooth else 2))
+
+
+def _sample_times(duration: float, period: float, extra: NDArray[np.float64],
+                  label: str) -> NDArray[np.float64]:
+    """Sample times over ``[0, duration]``: every ``period`` and at the ``extra`` times (the
+    corners of a pattern, phase ends), points closer than a quarter period to one of those
+    dropped."""
+    count = duration / period
     if not np.isfinite(count) or count > MAX_PHASE_SAMPLES:
         raise ScenarioError(
-            f"{label}: the move lasts {cart.duration:.4g} s; sampled every "
-            f"{phase.sample_period:.4g} s (sample_period_s) that is "
+            f"{label}: the move lasts {duration:.4g} s; sampled every {period:.4g} s that is "
             f"{count:.3g} inverse-kinematics samples, more than {MAX_PHASE_SAMPLES:,} "
             "(raise speed_mm_s or sample_period_s)")
     n = max(2, int(np.ceil(count - 1e-9)))
-    ts = np.linspace(0.0, cart.duration, n + 1)
-    st = cart.at(ts)
-    poses = np.zeros((n + 1, 4, 4))
-    poses[:, :3, :3] = st.rotation
-    poses[:, :3, 3] = st.position
-    poses[:, 3, 3] = 1.0
+    ts = np.linspace(0.0, duration, n + 1)
+    extra = np.asarray(extra, dtype=float)
+    extra = extra[(extra > 1e-9) & (extra < duration - 1e-9)]
+    if extra.size:
+        near = np.min(np.abs(ts[:, None] - extra[None, :]), axis=1) < 0.25 * duration / n
+        near[[0, -1]] = False
+        ts = np.unique(np.r_[ts[~near], extra])
+    return ts
+
+
+def _ik_knots(kin: Any, ts: NDArray[np.float64], poses: NDArray[np.float64],
+              q0: NDArray[np.float64], label: str) -> NDArray[np.float64]:
+    from sim.robots.ik import ik_path
+
     try:
         q_via = np.asarray(ik_path(kin, poses, q_start=q0), dtype=float)
     except CellsimError as exc:
@@ -516,9 +609,201 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
                             f"by {np.rad2deg(jump[j]):.3g} deg (another branch); check the "
                             "previous phase's end pose")
     q_via[0] = q0
+    return q_via
+
+
+def _poses(states: Any) -> NDArray[np.float64]:
+    n = states.position.shape[0]
+    poses = np.zeros((n, 4, 4))
+    poses[:, :3, :3] = states.rotation
+    poses[:, :3, 3] = states.position
+    poses[:, 3, 3] = 1.0
+    return poses
+
+
+def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
+                    ctx: CartesianContext, label: str) -> PhaseMotion:
+    kin = ctx.kinematics
+    T0 = np.asarray(kin.fk(q0), dtype=float)
+    cart, seam = _phase_cart(phase, T0[:3, 3], T0[:3, :3], ctx, label)
+    extra = np.zeros(0)
+    period = phase.sample_period
+    if phase.weave is not None:
+        from planners.weave import WeavingTrajectory
+
+        cart = WeavingTrajectory(cart, phase.weave, kin.family.approach_column)
+        extra = cart.breakpoints()
+        period = min(period, _weave_period(phase.weave))
+    ts = _sample_times(cart.duration, period, extra, label)
+    q_via = _ik_knots(kin, ts, _poses(cart.at(ts)), q0, label)
     times = t0 + ts
     placed = JointPhase(index=phase.index, name=phase.name, planner=phase.planner, times=times,
                         durations=np.diff(times), q=q_via)
     traj = plan_phase(placed, "")
     return PhaseMotion(phase, float(times[0]), float(times[-1]), traj, cartesian=cart, seam=seam,
                        knot_times=times)
+
+
+#: Corner blend of a polyline seam welded without ``blend_mm``, m.
+POLYLINE_BLEND = 0.002
+
+
+def _is_polyline(phase: CartesianPhase, ctx: CartesianContext | None) -> bool:
+    seam = None if ctx is None or phase.seam is None else ctx.seams.get(phase.seam)
+    return phase.kind == "linear" and seam is not None and seam.kind == "polyline"
+
+
+def _segments(phase: CartesianPhase, ctx: CartesianContext, label: str
+              ) -> list[CartesianPhase]:
+    """A linear phase along a polyline seam as one linear move per segment (the seam's
+    ``<name>/<i>`` line seams), blended at the corners by ``blend_mm`` (default
+    :data:`POLYLINE_BLEND`, at most 45 % of the shorter segment at each corner); the last keeps
+    the phase's own blend into the next phase."""
+    seam = ctx.seams[phase.seam]
+    segs = seam.segments()
+    corner = phase.blend if phase.blend > 0 else POLYLINE_BLEND
+    out = []
+    for i, sg in enumerate(segs):
+        if i + 1 < len(segs):
+            short = min(sg.length(), segs[i + 1].length())
+            r = min(corner, 0.45 * short)
+        else:
+            r = phase.blend
+        out.append(dataclasses.replace(phase, seam=sg.name, blend=r, weave=None))
+    return out
+
+
+def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float64],
+                  ctx: CartesianContext, labels: list[str]) -> list[PhaseMotion]:
+    """Consecutive Cartesian phases that blend into each other (``blend_mm``) as one tool path
+    (:mod:`planners.blend`): one speed law without stops, one joint polynomial through the
+    inverse kinematics of the whole path, each phase a time window of it (ending where its
+    corner blend joins the next phase). A phase along a polyline seam is one window over its
+    segments, blended at the corners (:func:`_segments`)."""
+    outer, outer_labels = phases, labels
+    phases, labels, of = [], [], []
+    for j, (ph, lb) in enumerate(zip(outer, outer_labels, strict=True)):
+        parts = _segments(ph, ctx, lb) if _is_polyline(ph, ctx) else [ph]
+        phases += parts
+        labels += [lb] * len(parts)
+        of += [j] * len(parts)
+    ctx_seams = dict(ctx.seams)
+    for ph in outer:
+        if _is_polyline(ph, ctx):
+            for sg in ctx.seams[ph.seam].segments():
+                ctx_seams[sg.name] = sg
+    ctx = dataclasses.replace(ctx, seams=ctx_seams)
+    from planners import adnia
+    from planners.blend import (
+        BlendCurve,
+        CompositeOrientation,
+        CompositePath,
+        PiecewiseProfile,
+        SubOrientation,
+        SubPath,
+        TimeWindow,
+    )
+    from planners.rotations import GeodesicOrientation
+
+    kin = ctx.kinematics
+    T0 = np.asarray(kin.fk(q0), dtype=float)
+    p, R = T0[:3, 3], T0[:3, :3]
+    carts, seams = [], []
+    for phase, label in zip(phases, labels, strict=True):
+        cart, seam = _phase_cart(phase, p, R, ctx, label)
+        carts.append(cart)
+        seams.append(seam)
+        p = cart.path.evaluate(np.array([cart.length]))[0][0]
+        R = cart.orientation.evaluate(np.array([1.0]))[0][0]
+    n = len(phases)
+    radii = [phases[k].blend if k < n - 1 else 0.0 for k in range(n)]
+    pieces, laws, owner = [], [], []
+    for k, cart in enumerate(carts):
+        L = cart.length
+        r_in = radii[k - 1] if k else 0.0
+        r_out = radii[k]
+        for r, who in ((r_in, k - 1), (r_out, k)):
+            if r > 0 and r > 0.5 * L + 1e-12:
+                raise ScenarioError(
+                    f"{labels[who]}.blend_mm: {r * 1e3:.4g} mm is more than half of "
+                    f"{phases[k].name!r} ({L * 1e3:.4g} mm long)")
+        pieces.append(SubPath(cart.path, r_in, L - r_out))
+        laws.append(SubOrientation(cart.orientation, r_in / L, (L - r_out) / L))
+        owner.append(k)
+        if r_out > 0:
+            nxt = carts[k + 1]
+            pa, ta = (v[0] for v in cart.path.evaluate(np.array([L - r_out]))[:2])
+            pb, tb = (v[0] for v in nxt.path.evaluate(np.array([r_out]))[:2])
+            try:
+                pieces.append(BlendCurve(pa, ta, pb, tb, r_out / 4))
+            except PlannerError as exc:
+                raise ScenarioError(f"{labels[k]}.blend_mm: {exc}") from None
+            Ra = cart.orientation.evaluate(np.array([(L - r_out) / L]))[0][0]
+            Rb = nxt.orientation.evaluate(np.array([r_out / nxt.length]))[0][0]
+            laws.append(GeodesicOrientation(Ra, Rb))
+            owner.append(k)
+    path = CompositePath(pieces)
+    lengths = [pc.length for pc in pieces]
+    changes = [(0.0, 0.0, phases[0].speed, float(carts[0].profile.ramp_time))]
+    for i, pc in enumerate(pieces):
+        if pc.kind == "blend":
+            k = owner[i]
+            va, vb = phases[k].speed, phases[k + 1].speed
+            if va != vb:
+                changes.append((float(path.starts[i] + pc.length / 2), va, vb,
+                                2.0 * pc.length / (va + vb)))
+    changes.append((path.length, phases[-1].speed, 0.0, float(carts[-1].profile.ramp_time)))
+    try:
+        profile = PiecewiseProfile(changes, path.length)
+        traj = adnia.CartesianTrajectory(path, CompositeOrientation(laws, path.starts[:-1],
+                                                                   lengths), profile)
+    except PlannerError as exc:
+        raise ScenarioError(f"{labels[0]}: {exc}") from None
+    # each (outer) phase's window ends where its last piece ends
+    m = len(outer)
+    ends_s = [float(path.starts[max(i for i in range(len(pieces)) if of[owner[i]] == j) + 1])
+              for j in range(m)]
+    bounds = [0.0] + [profile.time_at(s) for s in ends_s[:-1]] + [profile.duration]
+    windows = []
+    for j in range(m):
+        ramp_in = float(carts[0].profile.ramp_time) if j == 0 else 0.0
+        ramp_out = float(carts[-1].profile.ramp_time) if j == m - 1 else 0.0
+        win = TimeWindow(traj, bounds[j], bounds[j + 1], outer[j].speed, ramp_in, ramp_out)
+        if outer[j].weave is not None:
+            from planners.weave import WeavingTrajectory
+
+            win = WeavingTrajectory(win, outer[j].weave, kin.family.approach_column)
+        windows.append(win)
+    n = m
+    seams = [ctx.seams.get(ph.seam) if ph.seam is not None else None for ph in outer]
+    phases, labels = outer, outer_labels
+    # samples: every period, at the phase ends, and at the weaves' turns
+    period = min(ph.sample_period for ph in phases)
+    extra = [np.array(bounds[1:-1])]
+    for i, pc in enumerate(pieces):
+        if pc.kind == "blend":
+            period = min(period, (profile.time_at(path.starts[i + 1])
+                                  - profile.time_at(path.starts[i])) / SAMPLES_PER_BLEND)
+    for k, win in enumerate(windows):
+        if phases[k].weave is not None:
+            period = min(period, _weave_period(phases[k].weave))
+            extra.append(bounds[k] + win.breakpoints())
+    ts = _sample_times(profile.duration, period, np.concatenate(extra), labels[0])
+    which = np.clip(np.searchsorted(np.array(bounds), ts, side="right") - 1, 0, n - 1)
+    poses = np.zeros((len(ts), 4, 4))
+    for k, win in enumerate(windows):
+        sel = which == k
+        if np.any(sel):
+            poses[sel] = _poses(win.at(ts[sel] - bounds[k]))
+    q_via = _ik_knots(kin, ts, poses, q0, labels[0])
+    times = t0 + ts
+    placed = JointPhase(index=phases[0].index, name=phases[0].name, planner=phases[0].planner,
+                        times=times, durations=np.diff(times), q=q_via)
+    joint = plan_phase(placed, "")
+    out = []
+    for k in range(n):
+        ta, tb = t0 + bounds[k], t0 + bounds[k + 1]
+        knots = times[(times >= ta - 1e-12) & (times <= tb + 1e-12)]
+        out.append(PhaseMotion(phases[k], float(ta), float(tb), joint, cartesian=windows[k],
+                               seam=seams[k], knot_times=knots))
+    return out
