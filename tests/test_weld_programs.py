@@ -383,3 +383,243 @@ def test_a_polyline_seam_is_welded_in_one_pass_with_blended_corners(tmp_path):
     assert np.abs(v[cruise] / 0.010 - 1).max() < 0.01
     assert np.linalg.norm(p[-1] - P[2]) < 0.05e-3
     assert len(ev.summary["weld"]) == 1 and ev.summary["weld"][0]["phase"] == "weld"
+
+
+# ---------------------------------------------------------------------------- FANUC TP programs
+DATA = Path(__file__).resolve().parent / "data"
+TP_SCENARIO = """
+name = "tp_weld1"
+description = "a TP program"
+robot = "lrmate200ic5l"
+tool = "mig_torch"
+program = "weld1.ls"
+"""
+
+
+@pytest.fixture(scope="module")
+def tp_run(tmp_path_factory):
+    root = tmp_path_factory.mktemp("tp")
+    (root / "weld1.ls").write_text((DATA / "weld1.ls").read_text())
+    (root / "s.toml").write_text(TP_SCENARIO)
+    scenario = load_scenario(root / "s.toml")
+    return scenario, evaluate_scenario(scenario)
+
+
+def phase_end(ev, name):
+    names = [p["name"] for p in ev.summary["phases"]]
+    return ev.summary["phases"][names.index(name)]
+
+
+def test_a_tp_program_runs_its_moves_speeds_blends_and_arc(tp_run):
+    """tests/data/weld1.ls: J to a Cartesian and to a joint position, L FINE, L CNT50 into a
+    C move, Arc Start/End, WAIT, and an instruction cellsim does not run (listed with its line
+    number). FINE points are reached within 0.1 mm (simulated tcp); L and C moves run at their
+    mm/sec (1 %); the CNT50 corner is passed without slowing below 90 % of the speed; the J
+    move at 50 % has its slowest joint's peak speed at 50 % of its limit."""
+    scenario, ev = tp_run
+    a = ev.record.arrays
+    names = [p["name"] for p in ev.summary["phases"]]
+    assert names == ["line009_J", "line010_L", "line012_L", "line013_C", "line016_wait",
+                     "line018_J"]
+    assert ev.summary["program_warnings"] == ["weld1.ls: line 17: instruction not simulated: "
+                                              "DO[1]=ON"]
+    t = a["t"]
+    for name, P in (("line009_J", [450, -50, 50]), ("line010_L", [450, -50, 0]),
+                    ("line013_C", [550, 50, 0])):
+        j = int(np.argmin(np.abs(t - phase_end(ev, name)["t1"])))
+        assert np.linalg.norm(a["tcp_pos"][j] - (np.array(P) * 1e-3 + F0)) < 0.1e-3, name
+    # the joint position P[6] (FANUC J5 = -90: the home posture)
+    np.testing.assert_allclose(a["q"][-1], np.deg2rad([0, 0, 0, 0, -90, 0]), atol=1e-4)
+    speeds = {c["phase"]: c for c in ev.summary["cartesian_speed"]}
+    assert speeds["line010_L"]["cruise_mm_s"] == pytest.approx(100.0, rel=0.01)
+    assert speeds["line012_L"]["cruise_mm_s"] == pytest.approx(10.0, rel=0.01)
+    assert speeds["line013_C"]["cruise_mm_s"] == pytest.approx(10.0, rel=0.01)
+    tb = phase_end(ev, "line012_L")["t1"]
+    near = np.abs(t - tb) < 1.0
+    v = np.linalg.norm(np.gradient(a["tcp_pos"], t, axis=0), axis=1)
+    assert v[near].min() > 0.009
+    # the arc: on from the start of the L after P[2] to the end of the C move
+    acts = [(x["action"], x["t"]) for x in ev.summary["actions"]]
+    assert acts == [("arc_on", pytest.approx(phase_end(ev, "line012_L")["t0"])),
+                    ("arc_off", pytest.approx(phase_end(ev, "line013_C")["t1"]))]
+    # J at 50 %: the joint that takes longest peaks at half its limit
+    sel = a["phase"] == 0
+    ratio = np.abs(a["qd_ref"][sel]).max(axis=0) / np.asarray(scenario.robot.max_speed)
+    assert ratio.max() == pytest.approx(0.5, rel=0.01)
+    assert ev.summary["verdict"] == "pass"
+
+
+def test_a_cartesian_tp_position_takes_the_branch_its_config_names(tmp_path):
+    """P[1] with CONFIG 'N U T' ends with FANUC J5 >= 0 (no flip); the same point with 'F U T'
+    ends flipped (J5 < 0), same tcp pose."""
+    from sim.robots.maker import to_maker
+
+    ends = {}
+    for flip in ("N", "F"):
+        text = (DATA / "weld1.ls").read_text().replace("CONFIG : 'N U T, 0, 0, 0',\n\tX =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000",
+                                                     f"CONFIG : '{flip} U T, 0, 0, 0',\n\tX =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000")
+        (tmp_path / f"{flip}.ls").write_text(text)
+        (tmp_path / f"{flip}.toml").write_text(TP_SCENARIO.replace("weld1.ls", f"{flip}.ls"))
+        sc = load_scenario(tmp_path / f"{flip}.toml")
+        from sim.simulation.compile import build
+        from sim.simulation.motion import build_motion
+
+        built = build(sc)
+        motion = build_motion(sc, built.context)
+        pm = motion.phases[0]
+        q = motion.at(pm.t1).q[0]
+        ends[flip] = (np.rad2deg(to_maker(sc.robot, q)), built.context.kinematics.fk(q))
+    assert ends["N"][0][4] >= 0 and ends["F"][0][4] < 0
+    np.testing.assert_allclose(ends["N"][1], ends["F"][1], atol=1e-9)
+
+
+def test_export_then_import_reproduces_the_tool_path_at_every_programmed_point(tmp_path):
+    """cellsim export of the shipped line-then-arc weld, run back as program = "prog.ls": at
+    every Cartesian position of the program the two reference tool paths come equally close
+    (within 0.1 mm), FINE positions are on both paths (0.1 mm), and each L and C move of the
+    program runs at the original phase's speed."""
+    from sim.core.resources import shipped_scenarios
+
+    r = subprocess.run([sys.executable, "-m", "sim", "export", "lrmate200ic_weld_plate",
+                        "--out", str(tmp_path / "prog.ls")], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    from sim.scenario.fanuc_ls import read_ls
+
+    prog = read_ls(tmp_path / "prog.ls")
+    (tmp_path / "back.toml").write_text(
+        'name = "back"\ndescription = "exported and imported"\nrobot = "lrmate200ic5l"\n'
+        'cell = "weld_table"\ntool = "mig_torch"\nprogram = "prog.ls"\n')
+    orig = evaluate_scenario(load_scenario(shipped_scenarios()["lrmate200ic_weld_plate"]))
+    back = evaluate_scenario(load_scenario(tmp_path / "back.toml"))
+    T = orig.built.context.world_from_frame0
+    po, pb = orig.record.arrays["tcp_pos_ref"], back.record.arrays["tcp_pos_ref"]
+    from sim.scenario.fanuc_ls import LSMotion
+
+    fine = {m.target[1] for m in prog.instructions if isinstance(m, LSMotion) and m.cnt is None}
+    checked = 0
+    for k, pos in prog.positions.items():
+        if pos.xyzwpr is None:
+            continue
+        p = T[:3, :3] @ (np.array(pos.xyzwpr[:3]) * 1e-3) + T[:3, 3]
+        do, db = np.linalg.norm(po - p, axis=1).min(), np.linalg.norm(pb - p, axis=1).min()
+        assert abs(do - db) < 0.1e-3, (k, do, db)
+        if k in fine:
+            assert db < 0.1e-3, (k, db)
+        checked += 1
+    assert checked >= 5
+    so = {c["phase"]: c["set_mm_s"] for c in orig.summary["cartesian_speed"]}
+    sb = [c for c in back.summary["cartesian_speed"]]
+    assert sorted(round(c["cruise_mm_s"], 1) for c in sb) == sorted(round(v, 1)
+                                                                   for v in so.values())
+    assert back.summary["verdict"] == "pass"
+
+
+def test_export_never_replaces_a_file(tmp_path):
+    (tmp_path / "prog.ls").write_text("mine")
+    r = subprocess.run([sys.executable, "-m", "sim", "export", "lrmate200ic_weld_plate",
+                        "--out", str(tmp_path / "prog.ls")], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 2 and "exists" in r.stderr
+    assert (tmp_path / "prog.ls").read_text() == "mine"
+
+
+BAD_PROGRAMS = {
+    "a malformed motion line": (lambda t: t.replace("L P[2] 100mm/sec FINE", "L P[2] fast FINE"),
+                                "line 10: malformed motion instruction"),
+    "a position not in /POS": (lambda t: t.replace("L P[3] 10mm/sec", "L P[33] 10mm/sec"),
+                               "line 12: P[33] is not in the /POS section"),
+    "a position register without a value": (
+        lambda t: t.replace("L P[3] 10mm/sec", "L PR[4] 10mm/sec"), "line 12: PR[4]: no value"),
+    "% on an L move": (lambda t: t.replace("L P[2] 100mm/sec", "L P[2] 50%"),
+                       "line 10: an L move's speed is in mm/sec"),
+    "a user frame without a mapping": (
+        lambda t: t.replace("UFRAME_NUM=0", "UFRAME_NUM=3"), "UF 0, UT 1 but the program runs "
+        "UFRAME_NUM = 3"),
+    "an unreachable CONFIG": (lambda t: t.replace("'N U T, 0, 0, 0',\n\tX =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000",
+                                                  "'N D B, 0, 0, 0',\n\tX =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000"),
+                              "CONFIG 'N D B, 0, 0, 0'"),
+    "a missing circular second line": (lambda t: t.replace("    :  P[5] 10mm/sec FINE    ;\n", ""),
+                                       "line 14: a circular move's second line"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_PROGRAMS))
+def test_a_bad_program_is_one_line_with_its_line_number_and_exit_2(case, tmp_path):
+    edit, needle = BAD_PROGRAMS[case]
+    (tmp_path / "weld1.ls").write_text(edit((DATA / "weld1.ls").read_text()))
+    (tmp_path / "s.toml").write_text(TP_SCENARIO)
+    r = subprocess.run([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
+                        str(tmp_path / "out")], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 2, r.stderr
+    err = [ln for ln in r.stderr.splitlines() if "error" in ln]
+    assert len(err) == 1 and needle in err[0], r.stderr
+    assert "weld1.ls" in err[0] or "s.toml" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_position_registers_and_user_frames_come_from_the_scenario(tmp_path):
+    """PR[1] from program_registers, and UFRAME_NUM = 1 mapped to a cell object: the L move
+    ends where the object's frame puts the point."""
+    (tmp_path / "cells").mkdir()
+    (tmp_path / "cells" / "plate.toml").write_text(POLY_CELL)
+    prog = """/PROG  FRAMES
+/MN
+   1:  UFRAME_NUM=0 ;
+   2:  UTOOL_NUM=1 ;
+   3:  J PR[1] 30% FINE ;
+   4:  UFRAME_NUM=1 ;
+   5:  L P[2] 20mm/sec FINE ;
+/POS
+P[2]{
+   GP1:
+	UF : 1, UT : 1,		CONFIG : 'N U T, 0, 0, 0',
+	X =   -60.000  mm,	Y =   -80.000  mm,	Z =    30.000  mm,
+	W =   180.000 deg,	P =     0.000 deg,	R =     0.000 deg
+};
+/END
+"""
+    (tmp_path / "frames.ls").write_text(prog)
+    (tmp_path / "s.toml").write_text(
+        'name = "frames"\ndescription = "frames"\nrobot = "lrmate200ic5l"\n'
+        'cell = "cells/plate.toml"\nprogram = "frames.ls"\n'
+        'program_frames = { "1" = "plate" }\n'
+        'program_registers = { "1" = [450.0, 0.0, 200.0, 180.0, 0.0, 0.0] }\n')
+    ev, a = run(tmp_path, (tmp_path / "s.toml").read_text())
+    t, p = window(a, ev, "line007_L")
+    plate = np.array([0.5, 0.0, 0.305])
+    np.testing.assert_allclose(p[-1], plate + np.array([-0.060, -0.080, 0.030]), atol=0.1e-3)
+    t0, p0 = window(a, ev, "line005_J")
+    np.testing.assert_allclose(p0[-1], np.array([0.45, 0.0, 0.2 + 0.33]), atol=0.1e-3)
+
+
+def test_ut0_positions_are_flange_poses(tmp_path):
+    """The same point taught with UT 0 (the flange) and, moved by the torch's flange-to-tcp
+    offset, with UT 1 (the torch): the two programs give the same tool path."""
+    from sim.simulation.compile import build
+
+    sc1 = load_scenario_text(tmp_path, "ut1", TP_SCENARIO)
+    off = build(sc1).context.flange_to_tcp
+    R = np.diag([1.0, -1.0, -1.0])  # W = 180: the torch points down
+    flange = np.array([450.0, -50.0, 50.0]) - (R @ off[:3, 3]) * 1e3
+    text = (DATA / "weld1.ls").read_text().replace("UTOOL_NUM=1", "UTOOL_NUM=0")
+    text = text.replace("UF : 0, UT : 1", "UF : 0, UT : 0").replace(
+        "X =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000",
+        f"X = {flange[0]:.6f}  mm,\tY = {flange[1]:.6f}  mm,\tZ = {flange[2]:.6f}")
+    # only P[1] is re-taught for the flange: the others keep tcp values, so stop after it
+    lines = text.split("/MN\n")[1].split("/POS")[0].splitlines()
+    body = "\n".join(ln for ln in lines if ln.strip().startswith(("1:", "2:", "3:")))
+    (tmp_path / "ut0.ls").write_text("/PROG UT0\n/MN\n" + body + "\n/POS" + text.split("/POS")[1])
+    body1 = body.replace("UTOOL_NUM=0", "UTOOL_NUM=1")
+    (tmp_path / "ut1.ls").write_text("/PROG UT1\n/MN\n" + body1 + "\n/POS"
+                                     + (DATA / "weld1.ls").read_text().split("/POS")[1])
+    ev0, a0 = run(tmp_path, TP_SCENARIO.replace("weld1.ls", "ut0.ls"), "a.toml")
+    ev1, a1 = run(tmp_path, TP_SCENARIO.replace("weld1.ls", "ut1.ls"), "b.toml")
+    np.testing.assert_allclose(a0["tcp_pos"][-1], a1["tcp_pos"][-1], atol=1e-6)
+    np.testing.assert_allclose(a1["tcp_pos"][-1], np.array([0.45, -0.05, 0.05]) + F0, atol=1e-4)
+
+
+def load_scenario_text(tmp_path: Path, name: str, text: str):
+    (tmp_path / "weld1.ls").write_text((DATA / "weld1.ls").read_text())
+    (tmp_path / f"{name}.toml").write_text(text)
+    return load_scenario(tmp_path / f"{name}.toml")

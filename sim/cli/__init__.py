@@ -19,7 +19,7 @@ from sim import __version__
 from sim.errors import CellsimError, InternalError
 
 #: Sub-command modules, in the order ``--help`` lists them.
-COMMANDS = ("list", "plan", "ik", "workspace", "check", "run", "size", "render")
+COMMANDS = ("list", "plan", "ik", "workspace", "check", "run", "size", "render", "export")
 
 
 def build_parser() -> argparse.ArgumentParser:

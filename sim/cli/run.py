@@ -95,6 +95,8 @@ def run(args: argparse.Namespace) -> int:
             f"(x{summary['realtime_factor']:.1f} real time); max tracking error {track:.4f} deg; "
             f"max tcp deviation {summary['max_tcp_deviation_mm']:.3f} mm")
     print(line)
+    for line in summary.get("program_warnings", []):
+        print(f"  program: {line}")
     for w in summary.get("weave", []):
         print(f"  weave {w['phase']} ({w['pattern']}): {w['amplitude_mm']:.3f} mm at "
               f"{w['frequency_hz']:.3f} Hz (set {w['set_amplitude_mm']:.3f} mm at "

@@ -106,6 +106,12 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
 
     phases: list[Phase] = []
     seen: dict[str, int] = {}
+    if (spec.program is None) == (not spec.phases):
+        raise ScenarioError(f"{where}: give phases (at least one) or program (a FANUC TP "
+                            "program), not both" if spec.phases else
+                            f"{where}: phases: at least one phase (or program = \"prog.ls\")")
+    if spec.program is None and (spec.program_frames or spec.program_registers):
+        raise ScenarioError(f"{where}: program_frames and program_registers go with program")
     for i, pspec in enumerate(spec.phases):
         key = f"{where}: phases[{i}]"
         if pspec.name in seen:
@@ -170,7 +176,32 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
             raise ScenarioError(f"{where}: drives.{joint}: unknown joint{hint}; robot "
                                 f"{robot.name} has {', '.join(robot.joints)}")
         drives[joint] = {k: v for k, v in override.model_dump().items() if v is not None}
+    program_warnings: tuple[str, ...] = ()
     actions = []
+    if spec.program is not None:
+        if spec.actions:
+            raise ScenarioError(f"{where}: actions: not with program (the program's Arc "
+                                "Start/End are its actions)")
+        from sim.scenario.fanuc_ls import read_ls
+        from sim.scenario.program import (
+            frames_from_scenario,
+            program_phases,
+            registers_from_scenario,
+        )
+
+        try:
+            prog = read_ls(base / spec.program)
+        except ScenarioError as exc:  # names the program file and line
+            raise ScenarioError(f"{where}: program: {exc}") from None
+        frames = frames_from_scenario(spec.program_frames, where)
+        registers = registers_from_scenario(spec.program_registers, where)
+        # the program starts at the cell's home (the compiled cell's, filled in when the
+        # motion is planned: CartesianContext.home_q); the robot's own home keyframe until then
+        phases, actions, warns = program_phases(
+            prog, robot, np.full(robot.n_joints, np.nan), frames, registers, where,
+            has_tool=tool_kind == "torch")
+        program_warnings = tuple(warns)
+        seen = {ph.name: k for k, ph in enumerate(phases)}
     for i, a in enumerate(spec.actions):
         if (a.time_s is None) == (a.phase is None):
             raise ScenarioError(f"{where}: actions[{i}]: give exactly one of time_s or phase")
@@ -198,6 +229,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         simulation=spec.simulation,
         video=spec.video,
         drives=drives,
+        program_warnings=program_warnings,
         actions=tuple(actions),
         sizing=spec.sizing,
     )

@@ -35,6 +35,11 @@ class JointPhase:
         boundary: Planner keywords (``v0``, ``vf``, ``a0``, ``af``, ``j0``, ``jf``) with arrays
             of shape (n_joints,) in rad/s^k; absent keys default to 0 in the planner.
         blend: Blend radius into the next joint phase, rad (0: stop at the last knot).
+        blend_fraction: Or the blend radius as a share of half the shorter chord at the
+            corner (a TP program's CNT / 100).
+        speed_pct: Timed by speed (a TP program's ``J ... x%``): the duration makes the peak
+            speed of the joint that takes longest ``speed_pct`` times its limit (the knot times
+            are then set when the phase is planned).
     """
 
     index: int
@@ -47,6 +52,8 @@ class JointPhase:
     kind: str = "joint"
     target: "PoseTarget | None" = None
     blend: float = 0.0
+    blend_fraction: float = 0.0
+    speed_pct: float | None = None
 
     @property
     def t0(self) -> float:
@@ -99,12 +106,17 @@ class PoseTarget:
         seam: A cell seam whose start (and torch posture) is the target.
         frame: Frame of ``position`` and ``rotation``: ``frame0`` (the robot's), ``world`` or a
             cell object's name.
+        config: A TP program's configuration ``(flip, up, front, turn4, turn5, turn6)``: the
+            IK branch to take (:mod:`sim.scenario.program`); None: the nearest.
+        flange: The pose is the flange's (a TP program's UT 0), not the tcp's.
     """
 
     position: NDArray[np.float64] | None = None
     rotation: NDArray[np.float64] | None = None
     seam: str | None = None
     frame: str = "frame0"
+    config: tuple | None = None
+    flange: bool = False
 
 
 @dataclass(frozen=True)
@@ -122,6 +134,11 @@ class CartesianPhase:
         orientation: ``keep``, ``follow``, ``seam`` or ``euler``; ``euler``: R = Rz Ry Rx (rad).
         blend: Corner zone radius into the next Cartesian phase, m (0: stop at the end).
         weave: A :class:`planners.weave.Weave` across the path, or ``None``.
+        blend_fraction: Or the blend as a share of 0.45 x the shorter of the two moves (a TP
+            program's CNT / 100).
+        move_time: The move's time, s (a TP program's ``sec`` speed): the speed is then its
+            length over that time.
+        flange: ``to``/``via``/``euler_zyx`` are flange poses (a TP program's UT 0).
     """
 
     index: int
@@ -142,6 +159,9 @@ class CartesianPhase:
     frame: str = "frame0"
     blend: float = 0.0
     weave: Any = None
+    blend_fraction: float = 0.0
+    move_time: float | None = None
+    flange: bool = False
 
 
 @dataclass(frozen=True)
@@ -185,6 +205,8 @@ class Scenario:
         drives: Drive-train overrides by joint name: {field: value}, SI units.
         sizing: Actuator-selection settings (``[sizing]``; ``catalog`` relative to ``source``).
         actions: Tool actions in file order.
+        program_warnings: For a scenario running a TP program: what the program holds that is
+            not simulated, one line each with its line number.
     """
 
     name: str
@@ -202,6 +224,7 @@ class Scenario:
     drives: dict[str, dict[str, float]] = field(default_factory=dict)
     actions: tuple[Action, ...] = ()
     sizing: SizingSpec = SizingSpec()
+    program_warnings: tuple[str, ...] = ()
 
     @property
     def sha256(self) -> str:

@@ -220,4 +220,9 @@ class ScenarioSpec(_Strict):
     drives: dict[str, DriveOverrideSpec] = {}
     sizing: SizingSpec = SizingSpec()
     actions: list[ActionSpec] = []
-    phases: list[PhaseSpec] = Field(min_length=1, description="the work cycle, in order")
+    phases: list[PhaseSpec] = Field([], description="the work cycle, in order")
+    program: str | None = Field(None, description="a FANUC TP program (.ls) to run instead "
+                                "of phases, relative to the scenario file")
+    program_frames: dict[str, str] = Field({}, description="user frame number -> cell object")
+    program_registers: dict[str, list[float]] = Field(
+        {}, description="position register number -> [X, Y, Z, W, P, R] (mm, deg)")

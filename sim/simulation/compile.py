@@ -123,9 +123,21 @@ def build(scenario: Scenario) -> BuiltCell:
                            robot_qpos,
                            None if cell.tool is None or cell.tool.straight
                            else model.site(cell.flange_site).id)
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    fl = model.site(cell.flange_site).id
+
+    def site_T(i: int) -> NDArray[np.float64]:
+        T = np.eye(4)
+        T[:3, :3] = data.site_xmat[i].reshape(3, 3)
+        T[:3, 3] = data.site_xpos[i]
+        return T
+
     ctx = CartesianContext(kinematics=kin, seams=dict(cell.seams),
                            world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float),
-                           frames=dict(cell.frames))
+                           frames=dict(cell.frames), home_q=np.asarray(cell.home_q, float),
+                           flange_to_tcp=np.linalg.inv(site_T(fl)) @ site_T(tcp_site),
+                           robot=scenario.robot)
     limits = np.where(model.actuator_forcelimited[robot_act, None].astype(bool),
                       model.actuator_forcerange[robot_act] * model.actuator_gear[robot_act, :1],
                       np.array([-np.inf, np.inf]))

@@ -119,7 +119,8 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
         if pm.cartesian is None:
             continue
         sel = (arrays["phase"] == k)
-        if not np.any(arrays["arc_on"][sel]):
+        inside = sel & (t > pm.t0 + 1e-9) & (t < pm.t1 - 1e-9)  # not just a boundary sample
+        if not np.any(arrays["arc_on"][inside]):
             continue
         cart = pm.cartesian
         p = arrays["tcp_pos"][sel]
@@ -200,6 +201,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "weld": weld_metrics(a, motion, built, torch_axis),
         "cartesian_speed": cartesian_speeds(a, motion, built.context.world_from_frame0),
         "weave": weave_metrics(a, motion, built),
+        "program_warnings": list(scenario.program_warnings),
     }
     summary["saturation"] = saturation_intervals(a, motion, built, feedforward=feedforward)
     summary["singularity"] = singularity_summary(a, motion, built, rec.timestep)

@@ -77,6 +77,8 @@ class PhaseMotion:
             starts at 0, i.e. at ``t0``); ``None`` otherwise.
         seam: The cell seam the phase follows, or ``None``.
         knot_times: Knot times of the joint polynomial, s.
+        programmed: Cartesian phases: the moves as programmed, one per move (a polyline seam
+            has one per segment): :class:`ProgrammedMove`.
     """
 
     phase: Phase
@@ -86,6 +88,7 @@ class PhaseMotion:
     cartesian: Any = None
     seam: Any = None
     knot_times: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    programmed: list = field(default_factory=list)
 
     @property
     def name(self) -> str:
@@ -94,6 +97,32 @@ class PhaseMotion:
     @property
     def kind(self) -> str:
         return self.phase.kind
+
+
+@dataclass(frozen=True)
+class ProgrammedMove:
+    """A Cartesian move as programmed (frame 0): its end pose (and via point for an arc), the
+    blend radius into the next move (m, 0: it stops there), its length and the next move's.
+    What ``cellsim export`` writes as a TP motion line."""
+
+    kind: str
+    end: NDArray[np.float64]
+    via: NDArray[np.float64] | None
+    speed: float
+    blend: float = 0.0
+    length: float = 0.0
+    next_length: float = 0.0
+
+
+def _programmed(cart: Any, kind: str, speed: float, blend: float = 0.0,
+                next_length: float = 0.0) -> ProgrammedMove:
+    L = cart.length
+    p, _, _, _ = cart.path.evaluate(np.array([L, 0.5 * L]))
+    R = cart.orientation.evaluate(np.array([1.0]))[0][0]
+    end = np.eye(4)
+    end[:3, :3], end[:3, 3] = R, p[0]
+    return ProgrammedMove(kind, end, p[1] if kind == "circular" else None, speed, blend, L,
+                          next_length)
 
 
 @dataclass
@@ -182,12 +211,19 @@ class CartesianContext:
         world_from_frame0: Pose of frame 0 in the world, (4, 4).
         frames: Poses of the cell's objects in the world by name, (4, 4) each: scenario points
             may be given in them (``frame = "<object>"``).
+        home_q: The cell's home configuration, rad (where a TP program starts).
+        flange_to_tcp: The tcp in the flange frame, (4, 4) (a TP program's UT 0 poses are the
+            flange's).
+        robot: The robot's registry entry (its maker's joint convention, for TP CONFIG).
     """
 
     kinematics: Any
     seams: dict[str, Any] = field(default_factory=dict)
     world_from_frame0: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     frames: dict[str, NDArray[np.float64]] = field(default_factory=dict)
+    home_q: NDArray[np.float64] | None = None
+    flange_to_tcp: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    robot: Any = None
 
     def frame0_from(self, frame: str, label: str) -> NDArray[np.float64]:
         """Pose of a named frame in frame 0, (4, 4): ``frame0`` (the robot's), ``world`` or a
@@ -242,14 +278,14 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     while todo:
         phase = todo.pop(0)
         label = f"{where}: phases[{phase.index}] ({phase.name})"
-        if isinstance(phase, CartesianPhase) and (phase.blend > 0
+        if isinstance(phase, CartesianPhase) and (_blends(phase)
                                                   or _is_polyline(phase, context)):
             if context is None:
                 raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
             group = [phase]
-            while group[-1].blend > 0 and todo and isinstance(todo[0], CartesianPhase):
+            while _blends(group[-1]) and todo and isinstance(todo[0], CartesianPhase):
                 group.append(todo.pop(0))
-            if len(group) == 1 and phase.blend > 0 and not _is_polyline(phase, context):
+            if len(group) == 1 and _blends(phase) and not _is_polyline(phase, context):
                 raise ScenarioError(f"{label}.blend_mm: the next phase is not a linear or "
                                     "circular move to blend into (leave blend_mm out)")
             labels = [f"{where}: phases[{ph.index}] ({ph.name})" for ph in group]
@@ -261,6 +297,12 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
             q = phases[-1].trajectory.at(phases[-1].t1).q
             continue
         if isinstance(phase, JointPhase):
+            if q is None and np.isnan(phase.q[0]).any():  # a TP program starts at home
+                if context is None or context.home_q is None:
+                    raise ScenarioError(f"{label}: the start pose needs the cell's home")
+                qs = phase.q.copy()
+                qs[0] = context.home_q
+                phase = dataclasses.replace(phase, q=qs)
             placed = phase.with_start(t, q)
             if pending is not None:  # the previous joint phase blends into this one
                 qs = placed.q.copy()
@@ -272,8 +314,11 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
                 if context is None:
                     raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
                 placed = placed.with_end(_solve_target(phase, placed.q[0], context, label))
-            if phase.blend > 0:
-                placed, pending = _joint_blend(placed, todo[0] if todo else None, context, label)
+            if phase.speed_pct is not None:
+                placed = _timed_by_speed(placed, scenario.robot)
+            if phase.blend > 0 or phase.blend_fraction > 0:
+                placed, pending = _joint_blend(placed, todo[0] if todo else None, context, label,
+                                               scenario.robot)
             traj = plan_phase(placed, where)
             pm = PhaseMotion(placed, placed.t0, placed.t1, traj, knot_times=placed.times.copy())
         elif isinstance(phase, HoldPhase):
@@ -295,8 +340,25 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     return motion
 
 
+def _timed_by_speed(placed: JointPhase, robot: Any) -> JointPhase:
+    """A phase timed like a controller's joint move at ``speed_pct`` of the joint speed limits:
+    the duration makes the peak speed of the joint that takes longest ``speed_pct`` times its
+    limit (the knots keep their shares of the time)."""
+    share = placed.times - placed.t0
+    total = float(share[-1])
+    trial = dataclasses.replace(placed, times=share / total, durations=np.diff(share / total))
+    traj = plan_phase(trial, "")
+    ts = np.linspace(0.0, 1.0, 401)
+    peak = np.abs(traj.at(ts).qd).max(axis=0)  # for a 1 s move
+    T = float(np.max(peak / (placed.speed_pct * np.asarray(robot.max_speed))))
+    T = max(T, 1e-3)
+    times = placed.t0 + share / total * T
+    return dataclasses.replace(placed, times=times, durations=np.diff(times))
+
+
 def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | None,
-                 label: str) -> tuple[JointPhase, tuple[NDArray[np.float64], dict]]:
+                 label: str, robot: Any = None
+                 ) -> tuple[JointPhase, tuple[NDArray[np.float64], dict]]:
     """A joint phase that blends into the next joint phase (``blend_deg``): instead of stopping
     at its last knot ``q_c`` it passes the corner without stopping. The incoming and outgoing
     chords are cut where each has moved ``r`` (the largest joint change, at most half the
@@ -314,13 +376,16 @@ def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | 
         if ctx is None:
             raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
         nq = nq.with_end(_solve_target(nxt, nq.q[0], ctx, label))
+    if nxt.speed_pct is not None and robot is not None:
+        nq = _timed_by_speed(nq, robot)
     q_p, q_c, q_n = placed.q[-2], placed.q[-1], nq.q[1]
     t_p, t_c, t_n = placed.times[-2], placed.times[-1], nq.times[1]
     d_in, d_out = np.abs(q_c - q_p).max(), np.abs(q_n - q_c).max()
     if d_in < 1e-12 or d_out < 1e-12:
         raise ScenarioError(f"{label}.blend_deg: the corner knot repeats its neighbour (nothing "
                             "to blend)")
-    r = min(placed.blend, 0.5 * d_in, 0.5 * d_out)
+    r = (min(placed.blend, 0.5 * d_in, 0.5 * d_out) if placed.blend > 0
+         else placed.blend_fraction * 0.5 * min(d_in, d_out))
     a = q_c - r / d_in * (q_c - q_p)
     b = q_c + r / d_out * (q_n - q_c)
     t_a = t_c - r / d_in * (t_c - t_p)
@@ -468,6 +533,8 @@ def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianCont
         T[:3, 3] = F[:3, :3] @ tgt.position + F[:3, 3]
         T[:3, :3] = (F[:3, :3] @ tgt.rotation if tgt.rotation is not None
                      else np.asarray(ctx.kinematics.fk(q0), dtype=float)[:3, :3])
+        if tgt.flange:
+            T = T @ ctx.flange_to_tcp
     key = "to_seam" if tgt.seam is not None else "to_mm"
     try:
         sols = solve_ik(ctx.kinematics, T, current=q0)
@@ -477,7 +544,21 @@ def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianCont
     if not good:
         raise ReachError(f"{label}.{key}: the pose is reachable only outside the joint "
                          "ranges")
+    if tgt.config is not None:
+        from sim.scenario.program import config_of
+
+        robot = ctx.robot
+        match = [s for s in good if config_of(robot, s.q, s.branch) == tuple(tgt.config)]
+        if not match:
+            have = sorted({_config_text(config_of(robot, s.q, s.branch)) for s in good})
+            raise ReachError(f"{label}: no solution in the joint ranges has CONFIG "
+                             f"'{_config_text(tgt.config)}' (in range: {', '.join(have)})")
+        good = match
     return np.asarray(good[0].q, dtype=float)
+
+
+def _config_text(c: tuple) -> str:
+    return f"{c[0]} {c[1]} {c[2]}, {c[3]}, {c[4]}, {c[5]}"
 
 
 def default_ramp(phase: CartesianPhase, p0: NDArray[np.float64], seam: Any,
@@ -513,6 +594,17 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
 
     to, via, center = pt(phase.to), pt(phase.via), pt(phase.center)
     axis = None if phase.axis is None else F[:3, :3] @ np.asarray(phase.axis, dtype=float)
+    if phase.flange and phase.euler_zyx is not None:  # UT 0: flange points to tcp points
+        from sim.core.rotations import euler_zyx_to_matrix
+
+        R_end = F[:3, :3] @ euler_zyx_to_matrix(*phase.euler_zyx)
+        off = ctx.flange_to_tcp[:3, 3]
+        to = None if to is None else to + R_end @ off
+        via = None if via is None else via + R_end @ off
+    if phase.move_time is not None:  # the move's time sets its speed
+        length = (float(np.linalg.norm(to - p0)) if phase.kind == "linear" else
+                  float(np.linalg.norm(via - p0) + np.linalg.norm(to - via)))
+        phase = dataclasses.replace(phase, speed=max(length, 1e-6) / phase.move_time)
 
     seam = None
     if phase.seam is not None:
@@ -535,6 +627,8 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
         from sim.core.rotations import euler_zyx_to_matrix
 
         rot_end = F[:3, :3] @ euler_zyx_to_matrix(*phase.euler_zyx)
+        if phase.flange:
+            rot_end = rot_end @ ctx.flange_to_tcp[:3, :3]
     elif phase.orientation == "seam":
         rot_end = ctx.rot_to_frame0(seam.torch_rotation(seam.length()))
     kw: dict[str, Any] = dict(rotation_start=R0, orientation=mode,
@@ -640,12 +734,20 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     placed = JointPhase(index=phase.index, name=phase.name, planner=phase.planner, times=times,
                         durations=np.diff(times), q=q_via)
     traj = plan_phase(placed, "")
+    base = cart.base if phase.weave is not None else cart
     return PhaseMotion(phase, float(times[0]), float(times[-1]), traj, cartesian=cart, seam=seam,
-                       knot_times=times)
+                       knot_times=times,
+                       programmed=[_programmed(base, phase.kind, base.speed)])
 
 
+#: A TP program's CNT100 blends over this share of the shorter of the two moves.
+CNT_SHARE = 0.45
 #: Corner blend of a polyline seam welded without ``blend_mm``, m.
 POLYLINE_BLEND = 0.002
+
+
+def _blends(phase: CartesianPhase) -> bool:
+    return phase.blend > 0 or phase.blend_fraction > 0
 
 
 def _is_polyline(phase: CartesianPhase, ctx: CartesianContext | None) -> bool:
@@ -716,7 +818,9 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
         p = cart.path.evaluate(np.array([cart.length]))[0][0]
         R = cart.orientation.evaluate(np.array([1.0]))[0][0]
     n = len(phases)
-    radii = [phases[k].blend if k < n - 1 else 0.0 for k in range(n)]
+    radii = [(phases[k].blend if phases[k].blend > 0 else
+              phases[k].blend_fraction * CNT_SHARE * min(carts[k].length, carts[k + 1].length))
+             if k < n - 1 else 0.0 for k in range(n)]
     pieces, laws, owner = [], [], []
     for k, cart in enumerate(carts):
         L = cart.length
@@ -776,6 +880,7 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
         windows.append(win)
     n = m
     seams = [ctx.seams.get(ph.seam) if ph.seam is not None else None for ph in outer]
+    inner = phases
     phases, labels = outer, outer_labels
     # samples: every period, at the phase ends, and at the weaves' turns
     period = min(ph.sample_period for ph in phases)
@@ -804,6 +909,9 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     for k in range(n):
         ta, tb = t0 + bounds[k], t0 + bounds[k + 1]
         knots = times[(times >= ta - 1e-12) & (times <= tb + 1e-12)]
+        moves = [_programmed(c, inner[i].kind, c.speed, radii[i],
+                             carts[i + 1].length if i + 1 < len(carts) else 0.0)
+                 for i, c in enumerate(carts) if of[i] == k]
         out.append(PhaseMotion(phases[k], float(ta), float(tb), joint, cartesian=windows[k],
-                               seam=seams[k], knot_times=knots))
+                               seam=seams[k], knot_times=knots, programmed=moves))
     return out

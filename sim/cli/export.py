@@ -1,0 +1,34 @@
+"""``cellsim export SCENARIO --format fanuc-ls --out prog.ls``: a scenario's motion as a robot
+program (:mod:`sim.pipeline.export`)."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "export", help="write a scenario's motion as a FANUC TP program (.ls)",
+        description="Plan SCENARIO (no simulation) and write its motion as a FANUC TP program "
+                    "in ASCII form: J moves to joint positions, L and C moves to Cartesian "
+                    "positions with their CONFIG, FINE or CNT, Arc Start/End, WAIT. A scenario "
+                    "with `program = \"prog.ls\"` runs it back. An existing file is never "
+                    "replaced.")
+    p.add_argument("scenario", metavar="SCENARIO",
+                   help="a scenario file, or a shipped scenario's name (see `cellsim list`)")
+    p.add_argument("--format", choices=["fanuc-ls"], default="fanuc-ls",
+                   help="program format (default: fanuc-ls)")
+    p.add_argument("--out", required=True, help="the program file to write (must not exist)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from sim.pipeline.export import write_program
+    from sim.scenario import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    notes = write_program(scenario, args.out)
+    for line in notes:
+        print(f"note: {line}")
+    print(f"{scenario.name}: wrote {args.out}")
+    return 0

@@ -1,0 +1,354 @@
+"""FANUC TP programs in their ASCII form (``.LS``): read and write.
+
+What is read (everything else is listed as a warning with its line number, never skipped
+silently; a malformed line is a one-line error with its line number):
+
+* ``/PROG name``, ``/ATTR`` (ignored), ``/MN`` (the instructions), ``/POS`` (the positions),
+  ``/END``;
+* motion: ``J``, ``L`` and ``C`` (circular: ``C P[via]`` then ``: P[end] speed term`` on the
+  next line) to ``P[n]`` or ``PR[n]``, with speeds in ``%`` (J), ``mm/sec``, ``cm/min``,
+  ``inch/min`` or ``sec`` (the move's time) (L, C), and ``FINE`` or ``CNT0..100``; motion options
+  on the same line: ``Arc Start[...]``, ``Arc End[...]`` (others are warnings);
+* ``Arc Start[...]`` / ``Arc End[...]`` as instructions;
+* ``UFRAME_NUM = n``, ``UTOOL_NUM = n``; ``WAIT x(sec)`` (and ``WAIT x sec``); comments
+  (``!text``) and empty lines (``;``);
+* positions: Cartesian (``X, Y, Z`` mm, ``W, P, R`` deg: ``R = Rz(R) Ry(P) Rx(W)``, with
+  ``CONFIG : 'N U T, 0, 0, 0'``: flip/no flip, up/down, front (T) / back (B), and the turn
+  numbers of J4, J5, J6) or joint (``J1 = ... deg``: the controller's joint convention), with
+  their ``UF`` and ``UT``.
+
+:func:`parse_ls` gives a :class:`LSProgram`; :func:`write_ls` writes one.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from sim.errors import ScenarioError
+
+
+@dataclass(frozen=True)
+class LSPosition:
+    """A position of the /POS section (or a position register given to the scenario).
+
+    Attributes:
+        index: n of ``P[n]``. uf, ut: Its user frame and tool numbers.
+        xyzwpr: ``(X, Y, Z, W, P, R)`` in mm and deg, or None for a joint position.
+        config: ``(flip, up, front, turn4, turn5, turn6)``: ``"N"``/``"F"``, ``"U"``/``"D"``,
+            ``"T"``/``"B"``, ints; None for a joint position.
+        joints_deg: The controller's joint values (deg), or None for a Cartesian position.
+        line: Line number of ``P[n]{`` in the file.
+    """
+
+    index: int
+    uf: int
+    ut: int
+    xyzwpr: tuple[float, ...] | None = None
+    config: tuple | None = None
+    joints_deg: tuple[float, ...] | None = None
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class LSMotion:
+    """One motion instruction.
+
+    Attributes:
+        kind: ``"J"``, ``"L"`` or ``"C"``. target: ``("P", n)`` or ``("PR", n)``; via: the
+        circular move's via point (C only). speed: The value; unit: ``"%"``, ``"mm/sec"``,
+        ``"cm/min"``, ``"inch/min"`` or ``"sec"``. cnt: None for FINE, else 0..100.
+        arc: ``"start"`` / ``"end"`` option on the line, or None. line: line number.
+    """
+
+    kind: str
+    target: tuple[str, int]
+    speed: float
+    unit: str
+    cnt: int | None
+    via: tuple[str, int] | None = None
+    arc: str | None = None
+    line: int = 0
+
+
+@dataclass(frozen=True)
+class LSOther:
+    """A non-motion instruction: ``("uframe", n)``, ``("utool", n)``, ``("wait", seconds)``,
+    ``("arc", "start" | "end")``."""
+
+    what: str
+    value: object
+    line: int = 0
+
+
+@dataclass
+class LSProgram:
+    """A parsed TP program: its name, instructions in order, positions by index, warnings
+    (``(line, text)`` for every instruction not run)."""
+
+    name: str
+    instructions: list = field(default_factory=list)
+    positions: dict[int, LSPosition] = field(default_factory=dict)
+    warnings: list[tuple[int, str]] = field(default_factory=list)
+    path: Path | None = None
+
+
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_TARGET = r"(P|PR)\[\s*(\d+)\s*(?::[^\]]*)?\]"
+_SPEED = rf"({_NUM})\s*(%|mm/sec|cm/min|inch/min|sec)"
+_TERM = r"(FINE|CNT\s*(\d+))"
+_MOTION = re.compile(rf"^([JL])\s+{_TARGET}\s+{_SPEED}\s+{_TERM}\s*(.*)$", re.I)
+_CIRC1 = re.compile(rf"^C\s+{_TARGET}\s*$", re.I)
+_CIRC2 = re.compile(rf"^:\s*{_TARGET}\s+{_SPEED}\s+{_TERM}\s*(.*)$", re.I)
+_ARC = re.compile(r"^Arc\s+(Start|End)\s*\[[^\]]*\]\s*$", re.I)
+_FRAME = re.compile(r"^(UFRAME_NUM|UTOOL_NUM)\s*=\s*(\d+)\s*$", re.I)
+_WAIT = re.compile(rf"^WAIT\s+({_NUM})\s*\(?\s*sec\s*\)?\s*$", re.I)
+_LINE = re.compile(r"^\s*(\d+)\s*:\s*(.*?)\s*;\s*$")
+
+
+def _err(path, line: int, text: str) -> ScenarioError:
+    return ScenarioError(f"{path}: line {line}: {text}")
+
+
+def _options(rest: str, path, line: int, warnings: list) -> str | None:
+    """The arc option of a motion line (``Arc Start[..]`` / ``Arc End[..]``); any other option
+    is a warning."""
+    arc = None
+    rest = rest.strip()
+    while rest:
+        m = re.match(r"^Arc\s+(Start|End)\s*\[[^\]]*\]\s*", rest, re.I)
+        if m:
+            arc = m.group(1).lower()
+            rest = rest[m.end():].strip()
+            continue
+        m = re.match(r"^(\S+(?:\[[^\]]*\])?)\s*", rest)
+        warnings.append((line, f"motion option {m.group(1)!r} not simulated"))
+        rest = rest[m.end():].strip()
+    return arc
+
+
+def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
+    """Parse a TP program (module docstring).
+
+    Raises:
+        ScenarioError: A malformed line (one line: file, line number, what is wrong).
+    """
+    lines = text.splitlines()
+    prog = LSProgram(name="", path=Path(path))
+    section = None
+    i = 0
+    pending_circ: tuple[tuple[str, int], int] | None = None
+    while i < len(lines):
+        raw = lines[i]
+        ln = i + 1
+        s = raw.strip()
+        i += 1
+        if not s:
+            continue
+        if s.startswith("/PROG"):
+            prog.name = s.split(None, 1)[1].split()[0] if len(s.split()) > 1 else ""
+            section = "prog"
+            continue
+        if s.startswith("/"):
+            key = s.split()[0]
+            if key not in ("/ATTR", "/MN", "/POS", "/END", "/APPL", "/APPL_END"):
+                prog.warnings.append((ln, f"section {key} not read"))
+            section = key
+            continue
+        if section == "/MN":
+            m = _LINE.match(raw)
+            if m:
+                body = m.group(2).strip()
+            elif s.startswith(":") and s.endswith(";"):  # a circular move's second line
+                body = s[:-1].strip()
+            else:
+                raise _err(path, ln, f"not an instruction line ('  n: ... ;'): {s!r}")
+            if pending_circ is not None:
+                mc = _CIRC2.match(body)
+                if not mc:
+                    raise _err(path, ln, "a circular move's second line (': P[n] speed FINE|CNT') "
+                               f"expected, got {body!r}")
+                via, cline = pending_circ
+                pending_circ = None
+                speed, unit = float(mc.group(3)), mc.group(4).lower()
+                cnt = None if mc.group(5).upper() == "FINE" else int(mc.group(6))
+                prog.instructions.append(LSMotion(
+                    "C", (mc.group(1).upper(), int(mc.group(2))), speed, unit, cnt, via=via,
+                    arc=_options(mc.group(7), path, ln, prog.warnings), line=cline))
+                _check_motion(prog.instructions[-1], path, ln)
+                continue
+            if not body or body.startswith("!") or body.startswith("//"):
+                continue
+            mm = _MOTION.match(body)
+            if mm:
+                kind = mm.group(1).upper()
+                speed, unit = float(mm.group(4)), mm.group(5).lower()
+                cnt = None if mm.group(6).upper() == "FINE" else int(mm.group(7))
+                mo = LSMotion(kind, (mm.group(2).upper(), int(mm.group(3))), speed, unit, cnt,
+                              arc=_options(mm.group(8), path, ln, prog.warnings), line=ln)
+                _check_motion(mo, path, ln)
+                prog.instructions.append(mo)
+                continue
+            mc = _CIRC1.match(body)
+            if mc:
+                pending_circ = ((mc.group(1).upper(), int(mc.group(2))), ln)
+                continue
+            if re.match(r"^[JLC]\s", body):
+                raise _err(path, ln, f"malformed motion instruction {body!r} (expected e.g. "
+                           "'L P[2] 100mm/sec FINE' or 'J P[1] 50% CNT50')")
+            ma = _ARC.match(body)
+            if ma:
+                prog.instructions.append(LSOther("arc", ma.group(1).lower(), ln))
+                continue
+            mf = _FRAME.match(body)
+            if mf:
+                what = "uframe" if mf.group(1).upper() == "UFRAME_NUM" else "utool"
+                prog.instructions.append(LSOther(what, int(mf.group(2)), ln))
+                continue
+            mw = _WAIT.match(body)
+            if mw:
+                prog.instructions.append(LSOther("wait", float(mw.group(1)), ln))
+                continue
+            prog.warnings.append((ln, f"instruction not simulated: {body}"))
+            continue
+        if section == "/POS":
+            m = re.match(r"^P\[\s*(\d+)\s*(?::[^\]]*)?\]\s*\{\s*$", s)
+            if not m:
+                raise _err(path, ln, f"a position ('P[n]{{') expected, got {s!r}")
+            block = []
+            start = ln
+            while i < len(lines) and not lines[i].strip().startswith("};"):
+                block.append(lines[i])
+                i += 1
+            if i >= len(lines):
+                raise _err(path, start, f"P[{m.group(1)}]: no closing '}};'")
+            i += 1
+            prog.positions[int(m.group(1))] = _position(int(m.group(1)), " ".join(block),
+                                                        path, start)
+            continue
+        if section in ("prog", "/ATTR", "/APPL"):
+            continue
+        if section == "/END":
+            break
+        raise _err(path, ln, f"text outside a section: {s!r}")
+    if pending_circ is not None:
+        raise _err(path, pending_circ[1], "a circular move without its second line")
+    if not prog.name:
+        raise _err(path, 1, "no /PROG line (is this a TP program in ASCII form?)")
+    return prog
+
+
+def _check_motion(mo: LSMotion, path, ln: int) -> None:
+    if mo.kind == "J" and mo.unit != "%" and mo.unit != "sec":
+        raise _err(path, ln, f"a J move's speed is in % (or sec), not {mo.unit}")
+    if mo.kind in ("L", "C") and mo.unit == "%":
+        raise _err(path, ln, f"an {mo.kind} move's speed is in mm/sec, cm/min, inch/min or sec, "
+                   "not %")
+    if not mo.speed > 0:
+        raise _err(path, ln, f"speed {mo.speed:g} {mo.unit}: must be > 0")
+    if mo.unit == "%" and mo.speed > 100:
+        raise _err(path, ln, f"speed {mo.speed:g} %: at most 100")
+    if mo.cnt is not None and not 0 <= mo.cnt <= 100:
+        raise _err(path, ln, f"CNT{mo.cnt}: 0..100")
+
+
+def _position(index: int, block: str, path, ln: int) -> LSPosition:
+    uf = re.search(r"UF\s*:\s*(\d+)", block)
+    ut = re.search(r"UT\s*:\s*(\d+)", block)
+    if not uf or not ut:
+        raise _err(path, ln, f"P[{index}]: needs 'UF : n, UT : n'")
+    joints = re.findall(rf"J(\d+)\s*=\s*({_NUM})\s*deg", block)
+    if joints:
+        vals = [float(v) for _, v in sorted(joints, key=lambda kv: int(kv[0]))]
+        return LSPosition(index, int(uf.group(1)), int(ut.group(1)), joints_deg=tuple(vals),
+                          line=ln)
+    vals = []
+    for name in ("X", "Y", "Z", "W", "P", "R"):
+        m = re.search(rf"(?<![A-Za-z]){name}\s*=\s*({_NUM})", block)
+        if not m:
+            raise _err(path, ln, f"P[{index}]: no {name} value (a Cartesian position needs X, Y, "
+                       "Z mm and W, P, R deg; a joint position J1.. deg)")
+        vals.append(float(m.group(1)))
+    mc = re.search(r"CONFIG\s*:\s*'\s*([NF])\s*([UD])?\s*([TB])\s*,\s*(-?\d+)\s*,\s*(-?\d+)\s*,"
+                   r"\s*(-?\d+)\s*'", block, re.I)
+    if not mc:
+        raise _err(path, ln, f"P[{index}]: no CONFIG : 'N U T, 0, 0, 0' (flip, up/down, "
+                   "front/back, turns of J4, J5, J6)")
+    config = (mc.group(1).upper(), (mc.group(2) or "U").upper(), mc.group(3).upper(),
+              int(mc.group(4)), int(mc.group(5)), int(mc.group(6)))
+    return LSPosition(index, int(uf.group(1)), int(ut.group(1)), xyzwpr=tuple(vals),
+                      config=config, line=ln)
+
+
+def read_ls(path: str | Path) -> LSProgram:
+    """:func:`parse_ls` of a file (one-line error for a missing or unreadable file)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot read the TP program ({exc.strerror})") from None
+    return parse_ls(text, path)
+
+
+def _fmt(v: float) -> str:
+    return f"{v:10.3f}"
+
+
+def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
+             comment: str = "") -> str:
+    """A TP program in ASCII form (what :func:`parse_ls` reads)."""
+    L = [f"/PROG  {name.upper()}", "/ATTR", f'COMMENT\t\t= "{comment[:16]}";',
+         "PROG_SIZE\t= 0;", "FILE_NAME\t= ;", "VERSION\t\t= 0;",
+         f"LINE_COUNT\t= {len(instructions)};", "MEMORY_SIZE\t= 0;", "PROTECT\t\t= READ_WRITE;",
+         "DEFAULT_GROUP\t= 1,*,*,*,*;", "/MN"]
+    n = 0
+
+    def add(text: str) -> None:
+        nonlocal n
+        n += 1
+        L.append(f"{n:4d}:  {text} ;")
+
+    for ins in instructions:
+        if isinstance(ins, LSMotion):
+            term = "FINE" if ins.cnt is None else f"CNT{ins.cnt}"
+            speed = f"{ins.speed:g}{ins.unit}" if ins.unit == "%" else f"{ins.speed:g}{ins.unit}"
+            arc = "" if ins.arc is None else f" Arc {'Start' if ins.arc == 'start' else 'End'}[1]"
+            tgt = f"{ins.target[0]}[{ins.target[1]}]"
+            if ins.kind == "C":
+                add(f"C {ins.via[0]}[{ins.via[1]}]")
+                L.append(f"    :  {tgt} {speed} {term}{arc} ;")
+            else:
+                add(f"{ins.kind} {tgt} {speed} {term}{arc}")
+        elif ins.what == "uframe":
+            add(f"UFRAME_NUM={ins.value}")
+        elif ins.what == "utool":
+            add(f"UTOOL_NUM={ins.value}")
+        elif ins.what == "wait":
+            add(f"WAIT {float(ins.value):.2f}(sec)")
+        elif ins.what == "arc":
+            add(f"Arc {'Start' if ins.value == 'start' else 'End'}[1]")
+        elif ins.what == "comment":
+            add(f"!{ins.value}")
+    L.append("/POS")
+    for k in sorted(positions):
+        p = positions[k]
+        L.append(f"P[{k}]{{")
+        L.append("   GP1:")
+        if p.joints_deg is not None:
+            L.append(f"\tUF : {p.uf}, UT : {p.ut},")
+            js = [f"J{j + 1}= {v:10.3f} deg" for j, v in enumerate(p.joints_deg)]
+            for r in range(0, len(js), 3):
+                L.append("\t" + ",\t".join(js[r:r + 3]) + ("," if r + 3 < len(js) else ""))
+        else:
+            f, u, t, t4, t5, t6 = p.config
+            L.append(f"\tUF : {p.uf}, UT : {p.ut},\t\tCONFIG : '{f} {u} {t}, {t4}, {t5}, {t6}',")
+            x, y, z, w, pp, r = p.xyzwpr
+            L.append(f"\tX = {_fmt(x)}  mm,\tY = {_fmt(y)}  mm,\tZ = {_fmt(z)}  mm,")
+            L.append(f"\tW = {_fmt(w)} deg,\tP = {_fmt(pp)} deg,\tR = {_fmt(r)} deg")
+        L.append("};")
+    L.append("/END")
+    return "\n".join(L) + "\n"
+
+
+__all__ = ["LSMotion", "LSOther", "LSPosition", "LSProgram", "parse_ls", "read_ls", "write_ls"]

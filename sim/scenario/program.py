@@ -1,0 +1,285 @@
+"""A FANUC TP program (:mod:`sim.scenario.fanuc_ls`) as scenario phases and tool actions.
+
+``program = "weld1.ls"`` in a scenario (instead of ``phases``) runs the program from the robot's
+``home`` keyframe:
+
+* ``J P[n] x%``: a joint phase to the position, timed as the controller does: the joint whose
+  move takes longest at ``x %`` of its speed limit sets the duration (the phase's peak speed
+  on that joint is ``x %`` of its limit; the scenario's 4-3-4 polynomial joins the points). A
+  Cartesian position is solved by inverse kinematics on the branch its ``CONFIG`` names; a joint
+  position is in the controller's joint convention (the robot's maker map,
+  :mod:`sim.robots.maker`). ``sec`` instead of ``%``: the move's time.
+* ``L P[n] v mm/sec`` (or ``cm/min``, ``inch/min``; ``sec``: the move's time): a linear phase
+  at that speed, the orientation turned from the start's to the position's.
+* ``C P[via] : P[end] v``: a circular phase through the via point.
+* ``FINE``: the move ends at rest on the point. ``CNTx``: the move blends into the next move of
+  the same kind without stopping: for L and C moves a corner zone of radius
+  ``x / 100 * 0.45 * the shorter of the two moves`` (``blend_mm``), for J moves the joint blend
+  with ``blend_deg = x / 100 * half the shorter chord``; a CNT between a J and an L or C move
+  runs as FINE (a warning says so).
+* ``Arc Start[..]`` / ``Arc End[..]``: the arc on or off there: on at the start of the next
+  motion, off at the end of the motion before (as a motion option: when that motion reaches
+  its point).
+* ``UFRAME_NUM = n``: the user frame of the following positions: 0 is the robot's world frame
+  (FANUC's world frame is cellsim's frame 0); others through the scenario's
+  ``program_frames = { "1" = "<cell object>" }``. ``UTOOL_NUM = n``: 0 the flange, 1 the
+  scenario's tool. A position taught in another frame or tool than the program's current ones
+  is an error, as on the controller.
+* ``PR[n]``: from the scenario's ``program_registers = { "1" = [X, Y, Z, W, P, R] }`` (mm,
+  deg; configuration ``N U T, 0, 0, 0``).
+* ``WAIT x(sec)``: a hold phase.
+
+CONFIG: ``N``/``F`` the sign of the controller's J5 (``F``: J5 < 0), ``U``/``D`` the elbow up
+or down, ``T``/``B`` the wrist centre in front of J1 or behind (the branch labels of
+:mod:`sim.robots.ik`), and the turn numbers of J4, J5, J6 (the controller's joint value is its
+value in (-180, 180] deg plus 360 deg times the turn number).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.core.rotations import euler_zyx_to_matrix
+from sim.errors import ScenarioError
+from sim.scenario.fanuc_ls import LSMotion, LSOther, LSPosition, LSProgram
+from sim.scenario.model import Action, CartesianPhase, HoldPhase, JointPhase, PoseTarget
+
+#: Speed units of L and C moves in m/s per unit.
+SPEED_UNITS = {"mm/sec": 1e-3, "cm/min": 1e-2 / 60.0, "inch/min": 0.0254 / 60.0}
+#: CNT100 blends over this share of the shorter of the two moves.
+CNT_SHARE = 0.45
+
+
+def home_keyframe(robot) -> NDArray[np.float64]:
+    """The robot's ``home`` keyframe (its MJCF), rad, (n,)."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(robot.robot_path).getroot()
+    for key in root.iter("key"):
+        if key.get("name") == "home":
+            return np.array([float(v) for v in key.get("qpos").split()][:robot.n_joints])
+    return np.zeros(robot.n_joints)
+
+
+def rotation_wpr(w: float, p: float, r: float) -> NDArray[np.float64]:
+    """FANUC's W, P, R (deg): ``Rz(R) Ry(P) Rx(W)``."""
+    return euler_zyx_to_matrix(*np.deg2rad([r, p, w]))
+
+
+def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
+                   frames: dict[int, str], registers: dict[int, LSPosition], where: str,
+                   has_tool: bool) -> tuple[list, list[Action], list[str]]:
+    """The phases, tool actions and warnings of a TP program (module docstring).
+
+    Raises:
+        ScenarioError: One line naming the program file and line.
+    """
+    from sim.robots.maker import from_maker
+
+    src = prog.path.name if prog.path is not None else "<program>"
+    phases: list = []
+    actions: list[Action] = []
+    warnings = [f"{src}: line {ln}: {text}" for ln, text in prog.warnings]
+    uf, ut = 0, 1
+    n = robot.n_joints
+    pending_start = False  # an Arc Start instruction waits for the next motion
+
+    def err(line: int, text: str) -> ScenarioError:
+        return ScenarioError(f"{where}: program: {src}: line {line}: {text}")
+
+    def position(ref: tuple[str, int], line: int) -> LSPosition:
+        kind, k = ref
+        if kind == "P":
+            if k not in prog.positions:
+                raise err(line, f"P[{k}] is not in the /POS section")
+            pos = prog.positions[k]
+        else:
+            if k not in registers:
+                raise err(line, f"PR[{k}]: no value; give it in the scenario's "
+                          f"program_registers = {{ \"{k}\" = [X, Y, Z, W, P, R] }}")
+            pos = registers[k]
+            pos = LSPosition(k, uf, ut, pos.xyzwpr, pos.config, pos.joints_deg, line)
+        if (pos.uf, pos.ut) != (uf, ut):
+            raise err(line, f"{kind}[{k}] was taught with UF {pos.uf}, UT {pos.ut} but the "
+                      f"program runs UFRAME_NUM = {uf}, UTOOL_NUM = {ut}")
+        return pos
+
+    def frame_name(line: int) -> str:
+        if uf == 0:
+            return "frame0"
+        if uf not in frames:
+            raise err(line, f"UFRAME_NUM = {uf}: no frame for it; map it in the scenario "
+                      f"(program_frames = {{ \"{uf}\" = \"<cell object>\" }})")
+        return frames[uf]
+
+    def cart(pos: LSPosition, line: int) -> tuple[NDArray, NDArray]:
+        if pos.xyzwpr is None:
+            raise err(line, f"P[{pos.index}] is a joint position; an L or C move needs a "
+                      "Cartesian one")
+        x, y, z, w, p, r = pos.xyzwpr
+        return np.array([x, y, z]) * 1e-3, rotation_wpr(w, p, r)
+
+    motions = [ins for ins in prog.instructions if isinstance(ins, LSMotion)]
+    if not motions:
+        raise err(1, "no motion instruction")
+    index = 0
+    for pos_i, ins in enumerate(prog.instructions):
+        if isinstance(ins, LSOther):
+            if ins.what == "uframe":
+                uf = int(ins.value)
+            elif ins.what == "utool":
+                ut = int(ins.value)
+                if ut > 1:
+                    raise err(ins.line, f"UTOOL_NUM = {ut}: cellsim runs UT 0 (the flange) and "
+                              "UT 1 (the scenario's tool)")
+                if ut == 0 and has_tool:
+                    warnings.append(f"{src}: line {ins.line}: UT 0: positions are flange poses")
+            elif ins.what == "wait":
+                if not phases:
+                    raise err(ins.line, "WAIT before the first motion (the program starts "
+                              "with a move)")
+                phases.append(HoldPhase(index=index, name=f"line{ins.line:03d}_wait",
+                                        duration=float(ins.value)))
+                index += 1
+            elif ins.what == "arc":
+                if not has_tool:
+                    raise err(ins.line, "Arc Start/End needs a torch tool (the scenario's tool)")
+                if ins.value == "start":  # on where the robot is: the next motion starts
+                    pending_start = True
+                else:
+                    if not phases:
+                        raise err(ins.line, "Arc End before any motion")
+                    actions.append(Action("arc_off", None, phases[-1].name, "end"))
+            continue
+        mo: LSMotion = ins
+        name = f"line{mo.line:03d}_{mo.kind}"
+        target = position(mo.target, mo.line)
+        nxt = next((m for m in prog.instructions[pos_i + 1:] if isinstance(m, LSMotion)), None)
+        cnt = mo.cnt
+        if cnt is not None and cnt > 0:
+            same = nxt is not None and (nxt.kind == "J") == (mo.kind == "J")
+            if nxt is None:
+                cnt = None
+            elif not same:
+                warnings.append(f"{src}: line {mo.line}: CNT{mo.cnt} between a {mo.kind} and "
+                                f"a {nxt.kind} move runs as FINE")
+                cnt = None
+        fraction = 0.0 if not cnt else cnt / 100.0
+        if mo.kind == "J":
+            pct = mo.speed / 100.0 if mo.unit == "%" else None
+            move_time = mo.speed if mo.unit == "sec" else None
+            q = np.full((3, n), np.nan)
+            if not phases:
+                q[0] = start_q
+            times = np.array([0.0, 0.5, 1.0]) if not phases else None
+            durations = np.array([0.5, 0.5]) if move_time is None else np.full(2, move_time / 2)
+            if target.joints_deg is not None:
+                if len(target.joints_deg) != n:
+                    raise err(mo.line, f"P[{target.index}] has {len(target.joints_deg)} joint "
+                              f"values; robot {robot.name} has {n}")
+                q[-1] = from_maker(robot, np.deg2rad(target.joints_deg))
+                ptarget = None
+            else:
+                p, R = cart(target, mo.line)
+                ptarget = PoseTarget(position=p, rotation=R, frame=frame_name(mo.line),
+                                     config=target.config, flange=ut == 0)
+            if times is not None and move_time is not None:
+                times = np.array([0.0, move_time / 2, move_time])
+            phase = JointPhase(index=index, name=name, planner="434", times=times,
+                               durations=durations, q=q, target=ptarget,
+                               speed_pct=pct, blend_fraction=fraction)
+        else:
+            if not phases:
+                raise err(mo.line, "the program's first motion must be a J move (it leaves "
+                          "the robot's home)")
+            p, R = cart(target, mo.line)
+            speed, move_time = 1.0, None
+            if mo.unit == "sec":
+                move_time = mo.speed
+            else:
+                speed = mo.speed * SPEED_UNITS[mo.unit]
+            common = dict(index=index, name=name, kind="linear" if mo.kind == "L" else "circular",
+                          planner="434", speed=speed, sample_period=0.1, ramp=None,
+                          orientation="euler", to=p, frame=frame_name(mo.line),
+                          euler_zyx=_zyx(R), blend_fraction=fraction, move_time=move_time,
+                          flange=ut == 0)
+            if mo.kind == "C":
+                via = position(mo.via, mo.line)
+                pv, _ = cart(via, mo.line)
+                phase = CartesianPhase(**common, via=pv)
+            else:
+                phase = CartesianPhase(**common)
+        phases.append(phase)
+        index += 1
+        if pending_start:
+            actions.append(Action("arc_on", None, phase.name, "start"))
+            pending_start = False
+        if mo.arc == "start":  # on when the motion reaches its point: the next one starts
+            pending_start = True
+        elif mo.arc == "end":
+            actions.append(Action("arc_off", None, phase.name, "end"))
+    if pending_start:
+        actions.append(Action("arc_on", None, phases[-1].name, "end"))
+    if not isinstance(phases[0], JointPhase):
+        raise err(motions[0].line, "the program's first motion must be a J move")
+    return phases, actions, warnings
+
+
+def _zyx(R: NDArray[np.float64]) -> NDArray[np.float64]:
+    from sim.core.rotations import matrix_to_euler_zyx
+
+    return np.asarray(matrix_to_euler_zyx(R), dtype=float)
+
+
+def registers_from_scenario(values: dict[str, list[float]], where: str) -> dict[int, LSPosition]:
+    """``program_registers`` of a scenario as positions (mm, deg; config ``N U T, 0, 0, 0``)."""
+    out = {}
+    for key, v in values.items():
+        if not key.isdigit():
+            raise ScenarioError(f"{where}: program_registers.{key}: register numbers are "
+                                "whole numbers (\"1\", \"2\", ...)")
+        if len(v) != 6 or not all(math.isfinite(x) for x in v):
+            raise ScenarioError(f"{where}: program_registers.{key}: [X, Y, Z, W, P, R] in mm "
+                                "and deg (6 numbers)")
+        out[int(key)] = LSPosition(int(key), 0, 1, tuple(float(x) for x in v),
+                                   ("N", "U", "T", 0, 0, 0))
+    return out
+
+
+def frames_from_scenario(values: dict[str, str], where: str) -> dict[int, str]:
+    out = {}
+    for key, v in values.items():
+        if not key.isdigit() or int(key) == 0:
+            raise ScenarioError(f"{where}: program_frames.{key}: user frame numbers are 1, 2, "
+                                "... (UF 0 is the robot's world frame)")
+        out[int(key)] = v
+    return out
+
+
+__all__ = ["CNT_SHARE", "SPEED_UNITS", "frames_from_scenario", "home_keyframe",
+           "program_phases", "registers_from_scenario", "rotation_wpr"]
+
+
+def config_of(robot, q: NDArray[np.float64], branch: str) -> tuple:
+    """The FANUC configuration ``(flip, up, front, turn4, turn5, turn6)`` of joint values ``q``
+    (rad) on the IK branch ``branch`` (module docstring). A 5-axis robot has no flip and one
+    wrist turn (J4's place stays 0)."""
+    import re as _re
+
+    from sim.robots.maker import to_maker
+
+    words = set(_re.split(r"[^a-z]+", branch.lower()))
+    maker = np.rad2deg(to_maker(robot, np.asarray(q, dtype=float)))
+    n = len(maker)
+    flip = "F" if n >= 6 and maker[4] < 0 else "N"
+    up = "D" if "down" in words else "U"
+    front = "B" if "back" in words else "T"
+    wrist = maker[3:6] if n >= 6 else np.r_[0.0, maker[3:5]]
+    turns = tuple(int(math.ceil((float(v) - 180.0) / 360.0 - 1e-9)) for v in wrist)
+    return (flip, up, front) + turns
+
+
+__all__ += ["config_of"]
