@@ -623,3 +623,87 @@ def load_scenario_text(tmp_path: Path, name: str, text: str):
     (tmp_path / "weld1.ls").write_text((DATA / "weld1.ls").read_text())
     (tmp_path / f"{name}.toml").write_text(text)
     return load_scenario(tmp_path / f"{name}.toml")
+
+
+# ---------------------------------------------------------------------------- torch angles
+FIVE_CELL = """
+name = "five_cell"
+description = "a plate for the 5-axis LR Mate"
+tool = "mig_torch"
+
+[robot]
+model = "lrmate100ib"
+
+[[objects]]
+name = "plate"
+shape = "box"
+role = "workpiece"
+size_mm = [200, 200, 10]
+pos_mm = [380, 0, 95]
+
+[[seams]]
+name = "radial"
+object = "plate"
+kind = "line"
+points_mm = [[-40, 0, 5], [40, 0, 5]]
+normal = [0, 0, 1]
+work_angle_deg = {work}
+travel_angle_deg = {travel}
+"""
+
+FIVE_SCENARIO = """
+name = "five"
+description = "a 5-axis arm welds a seam with torch angles"
+robot = "lrmate100ib"
+cell = "cells/five.toml"
+
+[[phases]]
+name = "approach"
+planner = "546"
+time_s = [0.0, 1.0, 2.0]
+joints_deg = [[0, 0, 0, 0, 0], [0, 10, -5, 0, 0]]
+to_seam = "radial"
+
+[[phases]]
+name = "weld"
+kind = "linear"
+seam = "radial"
+orientation = "seam"
+speed_mm_s = 10.0
+"""
+
+
+@pytest.mark.parametrize("work,travel,needle", [
+    (90, 15, None),          # push along the radial seam: in the arm's plane
+    (60, 0, "work angle"),   # leaning across the seam: out of the plane
+    (90, 0, None),
+])
+def test_a_5_axis_arm_holds_torch_angles_its_posture_allows(work, travel, needle, tmp_path):
+    """The 5-axis LR Mate 100iB welds a seam running away from J1 with a travel angle (its
+    torch stays in the vertical plane through J1) within 0.1 deg of the seam's torch axis; a
+    work angle that leans the torch out of that plane is an error naming the work angle and
+    the nearest angles the arm can hold."""
+    (tmp_path / "cells").mkdir()
+    (tmp_path / "cells" / "five.toml").write_text(FIVE_CELL.format(work=work, travel=travel))
+    (tmp_path / "s.toml").write_text(FIVE_SCENARIO)
+    if needle is None:
+        ev = evaluate_scenario(load_scenario(tmp_path / "s.toml"))
+        w = ev.summary["weld"] if ev.summary["weld"] else None
+        a = ev.record.arrays
+        k = [p["name"] for p in ev.summary["phases"]].index("weld")
+        sel = a["phase"] == k
+        import mujoco
+
+        seam = ev.built.cell.seams["radial"]
+        axis = seam.torch_axis(0.0)
+        errs = []
+        for q in a["tcp_quat"][sel]:
+            R = np.zeros(9)
+            mujoco.mju_quat2Mat(R, q)
+            errs.append(np.degrees(np.arccos(np.clip(R.reshape(3, 3)[:, 0] @ axis, -1, 1))))
+        assert max(errs) < 0.1, max(errs)
+        assert w is None or True
+    else:
+        with pytest.raises(Exception, match=needle) as e:
+            evaluate_scenario(load_scenario(tmp_path / "s.toml"))
+        assert "it can hold work" in str(e.value) and "\n" not in str(e.value)

@@ -526,6 +526,8 @@ def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianCont
     T = np.eye(4)
     if tgt.seam is not None:
         seam = _seam(ctx, tgt.seam, f"{label}.to_seam")
+        if getattr(ctx.kinematics.family, "approach_column", 2) == 0:
+            _check_five_axis_torch(seam, label, "to_seam", start_only=True)
         T[:3, 3] = ctx.to_frame0(seam.tcp_point(0.0))
         T[:3, :3] = ctx.rot_to_frame0(seam.torch_rotation(0.0))
     else:
@@ -620,6 +622,10 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
                 f"{phase.seam!r} starts at {np.round(start * 1e3, 2).tolist()} mm, {gap * 1e3:.2f} mm "
                 "away; end the previous phase at the seam start")
 
+    if seam is not None and phase.orientation == "seam" \
+            and getattr(ctx.kinematics.family, "approach_column", 2) == 0:
+        _check_five_axis_torch(seam, label)
+
     rot_end = None
     mode = {"keep": "geodesic", "euler": "geodesic", "seam": "geodesic", "follow": "carry"}[
         phase.orientation]
@@ -651,6 +657,49 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
     except PlannerError as exc:
         raise ScenarioError(f"{label}: {exc}") from None
     return cart, seam
+
+
+def _check_five_axis_torch(seam: Any, label: str, key: str = "seam",
+                           start_only: bool = False) -> None:
+    """A 5-axis arm holds its torch in the vertical plane through J1 and the tool point: a
+    seam's work and travel angles that leave that plane somewhere along it cannot be held.
+    The error names the angle (work, travel or both), the seam point, and the nearest angles
+    the arm can hold there (the torch axis projected into the plane)."""
+    from sim.robots.families.five_r import PLANE_TOL
+
+    limit = float(np.degrees(np.arcsin(PLANE_TOL)))
+    for s in ([0.0] if start_only else np.linspace(0.0, seam.length(), 41)):
+        dev = seam.plane_deviation_deg(float(s))
+        if dev <= limit:
+            continue
+        T = seam.world_from_frame0
+        k1, o1 = T[:3, 2], T[:3, 3]
+        p = seam.point(float(s))
+        d = p - o1
+        rho = d - (d @ k1) * k1
+        m = np.cross(k1, rho / np.linalg.norm(rho))
+        a = seam.torch_axis(float(s))
+        a2 = a - (a @ m) * m
+        a2 /= np.linalg.norm(a2)
+        t = seam.tangent(float(s))
+        n = seam.surface_normal - (seam.surface_normal @ t) * t
+        n /= np.linalg.norm(n)
+        e = seam.torch_side * np.cross(n, t)
+        tau = float(np.degrees(np.arcsin(np.clip(a2 @ t, -1.0, 1.0))))
+        perp = a2 - (a2 @ t) * t
+        w_int = float(np.degrees(np.arctan2(-(perp @ e), -(perp @ n))))
+        work, work_set = 90.0 - w_int, 90.0 - seam.torch_work_angle_deg
+        travel_set = seam.torch_travel_angle_deg
+        which = [name for name, have, want in (("work", work, work_set),
+                                               ("travel", tau, travel_set))
+                 if abs(have - want) > 0.05]
+        raise ReachError(
+            f"{label}.{key}: a 5-axis arm cannot hold the {' and '.join(which) or 'work/travel'}"
+            f" angle{'s' if len(which) > 1 else ''} of seam {seam.name!r} at {s * 1e3:.1f} mm "
+            "from its start: "
+            f"its torch stays in the vertical plane through J1 (the seam's posture is "
+            f"{dev:.2f} deg out of it); there it can hold work {work:.1f} deg, travel "
+            f"{tau:.1f} deg (set: work {work_set:.1f}, travel {travel_set:.1f})")
 
 
 #: Least number of inverse-kinematics samples per weave cycle and per corner blend. Patterns
