@@ -306,14 +306,18 @@ class TimeWindow:
 
     Args:
         base: The blended trajectory. t0, t1: The window, s. speed: The phase's set speed,
-        m/s. ramp_in, ramp_out: Its start and stop ramps (0 where it blends), s.
+        m/s. ramp_in, ramp_out: Its start and stop ramps (0 where it blends), s. steady: The
+        part of the window at the set speed (after the start ramp or incoming corner, before
+        the stop ramp or outgoing corner), on the window's clock, s.
     """
 
     kind = "blended"
 
     def __init__(self, base, t0: float, t1: float, speed: float, ramp_in: float,
-                 ramp_out: float) -> None:
+                 ramp_out: float, steady: tuple[float, float] | None = None) -> None:
         self.base, self.t0, self.t1 = base, float(t0), float(t1)
+        #: The window's part at its set speed, on its own clock, s.
+        self.steady = (0.0, self.t1 - self.t0) if steady is None else tuple(map(float, steady))
         self._speed = float(speed)
         self.ramp_in, self.ramp_out = float(ramp_in), float(ramp_out)
         s = base.profile.evaluate(np.array([self.t0, self.t1]))[0]
@@ -337,7 +341,7 @@ class TimeWindow:
     def constant_speed_fraction(self):
         from planners.profiles import ConstantSpeedShare
 
-        tc = max(self.duration - self.ramp_in - self.ramp_out, 0.0)
+        tc = max(self.steady[1] - self.steady[0], 0.0)
         return ConstantSpeedShare(time=tc / self.duration if self.duration else 0.0,
                                   length=min(1.0, tc * self._speed / self.length)
                                   if self.length else 0.0)

@@ -161,6 +161,11 @@ class WeavingTrajectory:
         return self.base.orientation
 
     @property
+    def steady(self):
+        """The base move's part at the set speed (a blended window's), on its clock, s."""
+        return getattr(self.base, "steady", None)
+
+    @property
     def path(self):
         return self.base.path
 

@@ -707,3 +707,115 @@ def test_a_5_axis_arm_holds_torch_angles_its_posture_allows(work, travel, needle
         with pytest.raises(Exception, match=needle) as e:
             evaluate_scenario(load_scenario(tmp_path / "s.toml"))
         assert "it can hold work" in str(e.value) and "\n" not in str(e.value)
+
+
+# ---------------------------------------------------------------------------- review findings
+def run_program(tmp_path: Path, program: str, extra: str = ""):
+    (tmp_path / "p.ls").write_text(program)
+    (tmp_path / "p.toml").write_text(TP_SCENARIO.replace("weld1.ls", "p.ls") + extra)
+    ev = evaluate_scenario(load_scenario(tmp_path / "p.toml"))
+    return ev, ev.record.arrays
+
+
+POS = (DATA / "weld1.ls").read_text().split("/POS")[1]
+
+
+def test_a_short_j_move_at_100_percent_keeps_the_acceleration_limits(tmp_path):
+    """J at 100 % over 2 deg: the speed limit alone would make it last milliseconds; the
+    acceleration limits set its duration (no joint past either limit)."""
+    prog = "/PROG A\n/MN\n  1: J P[6] 100% FINE ;\n  2: J P[7] 100% FINE ;\n/POS" + POS.replace(
+        "/END", "P[7]{\n   GP1:\n\tUF : 0, UT : 1,\n\tJ1=  2.000 deg,\tJ2= 0.000 deg,\tJ3= 0.000 deg,"
+        "\n\tJ4= 0.000 deg,\tJ5= -90.000 deg,\tJ6= 0.000 deg\n};\n/END")
+    ev, a = run_program(tmp_path, prog)
+    sc = load_scenario(tmp_path / "p.toml")
+    assert np.all(np.abs(a["qd_ref"]).max(axis=0) <= np.asarray(sc.robot.max_speed) + 1e-9)
+    assert np.all(np.abs(a["qdd_ref"]).max(axis=0) <= np.asarray(sc.robot.max_accel) * 1.001)
+    assert ev.summary["verdict"] == "pass"
+
+
+def test_controller_format_lines_weld_speed_and_cnt_before_wait(tmp_path):
+    """The controller's own form: no closing ';', options on continuation lines, WELD_SPEED
+    (from program_weld_speed_mm_s); a CNT before a WAIT runs as FINE with a warning; an Arc
+    Start before a WAIT starts the arc during the wait."""
+    prog = """/PROG CTRL
+/MN
+   1:J P[1] 50% FINE
+   2:L P[2] 100mm/sec FINE
+    :  Arc Start[1]
+   3:  WAIT 0.30(sec) ;
+   4:L P[3] WELD_SPEED CNT50
+   5:  WAIT 0.20(sec) ;
+   6:L P[5] 10mm/sec FINE
+    :  Arc End[1] ;
+/POS""" + POS
+    ev, a = run_program(tmp_path, prog, "program_weld_speed_mm_s = 12.0\n")
+    speeds = {c["phase"]: c["cruise_mm_s"] for c in ev.summary["cartesian_speed"]}
+    assert speeds["line007_L"] == pytest.approx(12.0, rel=0.01)
+    assert any("CNT50 before a WAIT runs as FINE" in w for w in ev.summary["program_warnings"])
+    names = [p["name"] for p in ev.summary["phases"]]
+    acts = {x["action"]: x["t"] for x in ev.summary["actions"]}
+    assert acts["arc_on"] == pytest.approx(ev.summary["phases"][names.index("line006_wait")]["t0"])
+    assert ev.summary["verdict"] == "pass"
+
+
+def test_a_slow_phase_blended_into_a_faster_one_keeps_its_own_speed(tmp_path):
+    """10 mm/s blended into 20 mm/s: each phase's measured speed is its own (the corner, where
+    the speed changes, is left out), and the verdict passes."""
+    ev, _ = run(tmp_path, corner("blend_mm = 5.0", 10.0, 20.0))
+    speeds = {c["phase"]: c["cruise_mm_s"] for c in ev.summary["cartesian_speed"]}
+    assert speeds == pytest.approx({"leg1": 10.0, "leg2": 20.0}, rel=0.005)
+    assert ev.summary["verdict"] == "pass"
+
+
+def test_a_blended_phase_ends_in_the_middle_of_its_corner(tmp_path):
+    """leg1 (100 mm) blended by 5 mm into leg2: leg1's window ends where the corner curve is
+    half done, within the corner zone (about 2 mm from the corner here), so an action at its
+    end happens at the corner."""
+    ev, a = run(tmp_path, corner("blend_mm = 5.0"))
+    t_end = ev.summary["phases"][1]["t1"]
+    j = int(np.argmin(np.abs(a["t"] - t_end)))
+    assert np.linalg.norm(a["tcp_pos_ref"][j] - (C + F0)) < 2.5e-3
+
+
+def test_a_near_reversal_is_not_blended(tmp_path):
+    text = corner("blend_mm = 5.0").replace("to_mm = [550.0, 50.0, 0.0]",
+                                            "to_mm = [451.0, -40.0, 0.0]")
+    (tmp_path / "s.toml").write_text(text)
+    with pytest.raises(Exception, match="too sharp to pass at speed"):
+        evaluate_scenario(load_scenario(tmp_path / "s.toml"))
+
+
+@pytest.mark.parametrize("edit,needle", [
+    (lambda t: t.replace("WAIT 0.50(sec)", "WAIT -1.0(sec)"), r"line 16: WAIT -1.0 sec"),
+    (lambda t: t.replace("P[6]{", "P[5]{"), r"line 50: P\[5\] is already defined"),
+])
+def test_more_bad_programs(edit, needle, tmp_path):
+    (tmp_path / "weld1.ls").write_text(edit((DATA / "weld1.ls").read_text()))
+    (tmp_path / "s.toml").write_text(TP_SCENARIO)
+    with pytest.raises(Exception, match=needle):
+        load_scenario(tmp_path / "s.toml")
+
+
+def test_a_5r_cycle_exports_and_runs_back(tmp_path):
+    """bugnar_5r_weld_cycle (the 5-axis robot without a maker's convention, a 340 deg seam)
+    exported and run back: the arc is split into circular moves of at most 170 deg, and the
+    run passes through every Cartesian point of the program."""
+    from sim.scenario.fanuc_ls import LSMotion, read_ls
+
+    r = subprocess.run([sys.executable, "-m", "sim", "export", "bugnar_5r_weld_cycle",
+                        "--out", str(tmp_path / "b.ls")], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    prog = read_ls(tmp_path / "b.ls")
+    assert sum(isinstance(m, LSMotion) and m.kind == "C" for m in prog.instructions) >= 2
+    (tmp_path / "b.toml").write_text('name = "b"\ndescription = "x"\nrobot = "robot_5r"\n'
+                                     'cell = "weld_cylinder"\ntool = "mig_torch_long"\n'
+                                     'program = "b.ls"\n')
+    ev = evaluate_scenario(load_scenario(tmp_path / "b.toml"))
+    T = ev.built.context.world_from_frame0
+    p = ev.record.arrays["tcp_pos_ref"]
+    for pos in prog.positions.values():
+        if pos.xyzwpr is not None:
+            x = T[:3, :3] @ (np.array(pos.xyzwpr[:3]) * 1e-3) + T[:3, 3]
+            assert np.linalg.norm(p - x, axis=1).min() < 0.1e-3
+    assert ev.summary["verdict"] == "pass"

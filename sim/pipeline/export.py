@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.errors import ScenarioError
+from sim.errors import CellsimError, ScenarioError
 from sim.scenario import Scenario
 from sim.scenario.fanuc_ls import LSMotion, LSOther, LSPosition, write_ls
 from sim.scenario.model import CartesianPhase, HoldPhase, JointPhase
@@ -59,7 +59,10 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str]]:
         return k
 
     def cart_pos(T: np.ndarray, q_near: np.ndarray, what: str) -> int:
-        sols = [s for s in solve_ik(kin, T, current=q_near) if s.within_limits]
+        try:
+            sols = [s for s in solve_ik(kin, T, current=q_near) if s.within_limits]
+        except CellsimError as exc:
+            raise ScenarioError(f"{scenario.source.name}: export: {what}: {exc}") from None
         if not sols:
             raise ScenarioError(f"{scenario.source.name}: export: {what}: no IK solution in the "
                                 "joint ranges")
@@ -112,8 +115,7 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str]]:
                     cnt = int(min(100, max(1, round(100 * share))))
                 speed = round(mv.speed * 1e3, 3)
                 if mv.kind == "circular":
-                    kv = cart_pos(np.r_[np.c_[mv.end[:3, :3], mv.via], [[0, 0, 0, 1]]], q_near,
-                                  f"{ph.name} via")
+                    kv = cart_pos(mv.via, q_near, f"{ph.name} via")
                     ins.append(LSMotion("C", ("P", k), speed, "mm/sec", cnt, via=("P", kv)))
                 else:
                     ins.append(LSMotion("L", ("P", k), speed, "mm/sec", cnt))

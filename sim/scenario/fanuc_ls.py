@@ -7,8 +7,10 @@ silently; a malformed line is a one-line error with its line number):
   ``/END``;
 * motion: ``J``, ``L`` and ``C`` (circular: ``C P[via]`` then ``: P[end] speed term`` on the
   next line) to ``P[n]`` or ``PR[n]``, with speeds in ``%`` (J), ``mm/sec``, ``cm/min``,
-  ``inch/min`` or ``sec`` (the move's time) (L, C), and ``FINE`` or ``CNT0..100``; motion options
-  on the same line: ``Arc Start[...]``, ``Arc End[...]`` (others are warnings);
+  ``inch/min`` or ``sec`` (the move's time) (L, C), or ``WELD_SPEED``, and ``FINE`` or
+  ``CNT0..100``; motion options on the same line or on continuation lines (``: Arc
+  Start[6] ;``): ``Arc Start[...]``, ``Arc End[...]`` (others are warnings); the controller's
+  form without the closing ``;`` is read too;
 * ``Arc Start[...]`` / ``Arc End[...]`` as instructions;
 * ``UFRAME_NUM = n``, ``UTOOL_NUM = n``; ``WAIT x(sec)`` (and ``WAIT x sec``); comments
   (``!text``) and empty lines (``;``);
@@ -96,7 +98,7 @@ class LSProgram:
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _TARGET = r"(P|PR)\[\s*(\d+)\s*(?::[^\]]*)?\]"
-_SPEED = rf"({_NUM})\s*(%|mm/sec|cm/min|inch/min|sec)"
+_SPEED = rf"({_NUM}|WELD_SPEED|R\[\s*\d+\s*\])\s*(%|mm/sec|cm/min|inch/min|sec|)"
 _TERM = r"(FINE|CNT\s*(\d+))"
 _MOTION = re.compile(rf"^([JL])\s+{_TARGET}\s+{_SPEED}\s+{_TERM}\s*(.*)$", re.I)
 _CIRC1 = re.compile(rf"^C\s+{_TARGET}\s*$", re.I)
@@ -104,7 +106,21 @@ _CIRC2 = re.compile(rf"^:\s*{_TARGET}\s+{_SPEED}\s+{_TERM}\s*(.*)$", re.I)
 _ARC = re.compile(r"^Arc\s+(Start|End)\s*\[[^\]]*\]\s*$", re.I)
 _FRAME = re.compile(r"^(UFRAME_NUM|UTOOL_NUM)\s*=\s*(\d+)\s*$", re.I)
 _WAIT = re.compile(rf"^WAIT\s+({_NUM})\s*\(?\s*sec\s*\)?\s*$", re.I)
-_LINE = re.compile(r"^\s*(\d+)\s*:\s*(.*?)\s*;\s*$")
+_LINE = re.compile(r"^\s*(\d+)\s*:\s*(.*?)\s*;?\s*$")
+
+
+def _speed(value: str, unit: str, path, line: int) -> tuple[float, str]:
+    """A speed field: a number with its unit, or ``WELD_SPEED`` (the arc schedule's speed:
+    unit ``"weld"``); a register speed (``R[n]``) is refused."""
+    v = value.upper().replace(" ", "")
+    if v == "WELD_SPEED":
+        return 0.0, "weld"
+    if v.startswith("R["):
+        raise _err(path, line, f"speed {value}{unit}: register speeds are not read (numeric "
+                   "registers are not in the program); write the speed")
+    if not unit:
+        raise _err(path, line, f"speed {value}: no unit (%, mm/sec, cm/min, inch/min, sec)")
+    return float(value), unit.lower()
 
 
 def _err(path, line: int, text: str) -> ScenarioError:
@@ -160,8 +176,8 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
             m = _LINE.match(raw)
             if m:
                 body = m.group(2).strip()
-            elif s.startswith(":") and s.endswith(";"):  # a circular move's second line
-                body = s[:-1].strip()
+            elif s.startswith(":"):  # a circular move's second line, or options continued
+                body = s.rstrip(";").strip()
             else:
                 raise _err(path, ln, f"not an instruction line ('  n: ... ;'): {s!r}")
             if pending_circ is not None:
@@ -171,7 +187,7 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
                                f"expected, got {body!r}")
                 via, cline = pending_circ
                 pending_circ = None
-                speed, unit = float(mc.group(3)), mc.group(4).lower()
+                speed, unit = _speed(mc.group(3), mc.group(4), path, ln)
                 cnt = None if mc.group(5).upper() == "FINE" else int(mc.group(6))
                 prog.instructions.append(LSMotion(
                     "C", (mc.group(1).upper(), int(mc.group(2))), speed, unit, cnt, via=via,
@@ -180,10 +196,20 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
                 continue
             if not body or body.startswith("!") or body.startswith("//"):
                 continue
+            if body.startswith(":"):  # a motion's options continued on the next line
+                last = prog.instructions[-1] if prog.instructions else None
+                if not isinstance(last, LSMotion):
+                    raise _err(path, ln, f"a continuation line ({body!r}) after no motion")
+                from dataclasses import replace
+
+                arc = _options(body[1:], path, ln, prog.warnings)
+                if arc is not None:
+                    prog.instructions[-1] = replace(last, arc=arc)
+                continue
             mm = _MOTION.match(body)
             if mm:
                 kind = mm.group(1).upper()
-                speed, unit = float(mm.group(4)), mm.group(5).lower()
+                speed, unit = _speed(mm.group(4), mm.group(5), path, ln)
                 cnt = None if mm.group(6).upper() == "FINE" else int(mm.group(7))
                 mo = LSMotion(kind, (mm.group(2).upper(), int(mm.group(3))), speed, unit, cnt,
                               arc=_options(mm.group(8), path, ln, prog.warnings), line=ln)
@@ -208,6 +234,8 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
                 continue
             mw = _WAIT.match(body)
             if mw:
+                if float(mw.group(1)) < 0:
+                    raise _err(path, ln, f"WAIT {mw.group(1)} sec: a time is >= 0")
                 prog.instructions.append(LSOther("wait", float(mw.group(1)), ln))
                 continue
             prog.warnings.append((ln, f"instruction not simulated: {body}"))
@@ -224,6 +252,9 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
             if i >= len(lines):
                 raise _err(path, start, f"P[{m.group(1)}]: no closing '}};'")
             i += 1
+            if int(m.group(1)) in prog.positions:
+                raise _err(path, start, f"P[{m.group(1)}] is already defined (line "
+                           f"{prog.positions[int(m.group(1))].line})")
             prog.positions[int(m.group(1))] = _position(int(m.group(1)), " ".join(block),
                                                         path, start)
             continue
@@ -240,6 +271,10 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
 
 
 def _check_motion(mo: LSMotion, path, ln: int) -> None:
+    if mo.unit == "weld":
+        if mo.kind == "J":
+            raise _err(path, ln, "WELD_SPEED on a J move (J speeds are in %)")
+        return
     if mo.kind == "J" and mo.unit != "%" and mo.unit != "sec":
         raise _err(path, ln, f"a J move's speed is in % (or sec), not {mo.unit}")
     if mo.kind in ("L", "C") and mo.unit == "%":
@@ -325,7 +360,7 @@ def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
         elif ins.what == "utool":
             add(f"UTOOL_NUM={ins.value}")
         elif ins.what == "wait":
-            add(f"WAIT {float(ins.value):.2f}(sec)")
+            add(f"WAIT {float(ins.value):.3f}(sec)")
         elif ins.what == "arc":
             add(f"Arc {'Start' if ins.value == 'start' else 'End'}[1]")
         elif ins.what == "comment":

@@ -110,8 +110,10 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         raise ScenarioError(f"{where}: give phases (at least one) or program (a FANUC TP "
                             "program), not both" if spec.phases else
                             f"{where}: phases: at least one phase (or program = \"prog.ls\")")
-    if spec.program is None and (spec.program_frames or spec.program_registers):
-        raise ScenarioError(f"{where}: program_frames and program_registers go with program")
+    if spec.program is None and (spec.program_frames or spec.program_registers
+                                 or spec.program_weld_speed_mm_s is not None):
+        raise ScenarioError(f"{where}: program_frames, program_registers and "
+                            "program_weld_speed_mm_s go with program")
     for i, pspec in enumerate(spec.phases):
         key = f"{where}: phases[{i}]"
         if pspec.name in seen:
@@ -199,7 +201,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         # motion is planned: CartesianContext.home_q); the robot's own home keyframe until then
         phases, actions, warns = program_phases(
             prog, robot, np.full(robot.n_joints, np.nan), frames, registers, where,
-            has_tool=tool_kind == "torch")
+            has_tool=tool_kind == "torch", weld_speed=spec.program_weld_speed_mm_s)
         program_warnings = tuple(warns)
         seen = {ph.name: k for k, ph in enumerate(phases)}
     for i, a in enumerate(spec.actions):
@@ -384,6 +386,10 @@ def _weave(spec: LinearPhaseSpec | CircularPhaseSpec, where: str):
     if (w.frequency_hz is None) == (w.wavelength_mm is None):
         raise ScenarioError(f"{where}.weave: give exactly one of frequency_hz or wavelength_mm")
     freq = w.frequency_hz if w.frequency_hz is not None else spec.speed_mm_s / w.wavelength_mm
+    if freq > 20.0:
+        raise ScenarioError(f"{where}.weave.wavelength_mm: {w.wavelength_mm:g} mm at "
+                            f"{spec.speed_mm_s:g} mm/s is {freq:.4g} Hz; weaves run at most "
+                            "20 Hz")
     try:
         return Weave(w.pattern, w.amplitude_mm * 1e-3, freq, w.dwell_s)
     except PlannerError as exc:

@@ -139,6 +139,8 @@ class CartesianPhase:
         move_time: The move's time, s (a TP program's ``sec`` speed): the speed is then its
             length over that time.
         flange: ``to``/``via``/``euler_zyx`` are flange poses (a TP program's UT 0).
+        via_euler_zyx: The via point's own orientation (a TP program's circular move; used to
+            turn a flange via point into the tcp's), rad.
     """
 
     index: int
@@ -162,6 +164,7 @@ class CartesianPhase:
     blend_fraction: float = 0.0
     move_time: float | None = None
     flange: bool = False
+    via_euler_zyx: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True)

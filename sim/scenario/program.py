@@ -9,8 +9,9 @@
   Cartesian position is solved by inverse kinematics on the branch its ``CONFIG`` names; a joint
   position is in the controller's joint convention (the robot's maker map,
   :mod:`sim.robots.maker`). ``sec`` instead of ``%``: the move's time.
-* ``L P[n] v mm/sec`` (or ``cm/min``, ``inch/min``; ``sec``: the move's time): a linear phase
-  at that speed, the orientation turned from the start's to the position's.
+* ``L P[n] v mm/sec`` (or ``cm/min``, ``inch/min``; ``sec``: the move's time, its ramps
+  included; ``WELD_SPEED``: the scenario's ``program_weld_speed_mm_s``): a linear phase at that
+  speed, the orientation turned from the start's to the position's.
 * ``C P[via] : P[end] v``: a circular phase through the via point.
 * ``FINE``: the move ends at rest on the point. ``CNTx``: the move blends into the next move of
   the same kind without stopping: for L and C moves a corner zone of radius
@@ -71,7 +72,8 @@ def rotation_wpr(w: float, p: float, r: float) -> NDArray[np.float64]:
 
 def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                    frames: dict[int, str], registers: dict[int, LSPosition], where: str,
-                   has_tool: bool) -> tuple[list, list[Action], list[str]]:
+                   has_tool: bool, weld_speed: float | None = None
+                   ) -> tuple[list, list[Action], list[str]]:
     """The phases, tool actions and warnings of a TP program (module docstring).
 
     Raises:
@@ -141,9 +143,14 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                 if not phases:
                     raise err(ins.line, "WAIT before the first motion (the program starts "
                               "with a move)")
+                if float(ins.value) <= 0.0:  # WAIT 0: nothing to hold
+                    continue
                 phases.append(HoldPhase(index=index, name=f"line{ins.line:03d}_wait",
                                         duration=float(ins.value)))
                 index += 1
+                if pending_start:  # the arc starts while the robot waits (a start dwell)
+                    actions.append(Action("arc_on", None, phases[-1].name, "start"))
+                    pending_start = False
             elif ins.what == "arc":
                 if not has_tool:
                     raise err(ins.line, "Arc Start/End needs a torch tool (the scenario's tool)")
@@ -157,11 +164,20 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
         mo: LSMotion = ins
         name = f"line{mo.line:03d}_{mo.kind}"
         target = position(mo.target, mo.line)
-        nxt = next((m for m in prog.instructions[pos_i + 1:] if isinstance(m, LSMotion)), None)
+        nxt, waits = None, False
+        for m in prog.instructions[pos_i + 1:]:
+            if isinstance(m, LSMotion):
+                nxt = m
+                break
+            waits = waits or (m.what == "wait" and float(m.value) > 0)
         cnt = mo.cnt
         if cnt is not None and cnt > 0:
             same = nxt is not None and (nxt.kind == "J") == (mo.kind == "J")
             if nxt is None:
+                cnt = None
+            elif waits:
+                warnings.append(f"{src}: line {mo.line}: CNT{mo.cnt} before a WAIT runs as FINE "
+                                "(the robot waits at the point)")
                 cnt = None
             elif not same:
                 warnings.append(f"{src}: line {mo.line}: CNT{mo.cnt} between a {mo.kind} and "
@@ -199,6 +215,12 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
             speed, move_time = 1.0, None
             if mo.unit == "sec":
                 move_time = mo.speed
+            elif mo.unit == "weld":
+                if weld_speed is None:
+                    raise err(mo.line, "WELD_SPEED: the arc schedule's speed, which the program "
+                              "does not hold; give it in the scenario "
+                              "(program_weld_speed_mm_s = ...)")
+                speed = weld_speed * 1e-3
             else:
                 speed = mo.speed * SPEED_UNITS[mo.unit]
             common = dict(index=index, name=name, kind="linear" if mo.kind == "L" else "circular",
@@ -208,8 +230,12 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                           flange=ut == 0)
             if mo.kind == "C":
                 via = position(mo.via, mo.line)
-                pv, _ = cart(via, mo.line)
-                phase = CartesianPhase(**common, via=pv)
+                pv, Rv = cart(via, mo.line)
+                prev_end = _last_point(phases)
+                if prev_end is not None and np.linalg.norm(prev_end - p) < 1e-3:
+                    raise err(mo.line, "a C move ends where it starts (a full circle): split it "
+                              "into two C moves")
+                phase = CartesianPhase(**common, via=pv, via_euler_zyx=_zyx(Rv))
             else:
                 phase = CartesianPhase(**common)
         phases.append(phase)
@@ -226,6 +252,18 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
     if not isinstance(phases[0], JointPhase):
         raise err(motions[0].line, "the program's first motion must be a J move")
     return phases, actions, warnings
+
+
+def _last_point(phases: list) -> NDArray[np.float64] | None:
+    """Where the previous Cartesian move ended (its programmed point), if the last phase is
+    one in the same frame; None otherwise."""
+    last = phases[-1] if phases else None
+    if isinstance(last, CartesianPhase):
+        return np.asarray(last.to, dtype=float)
+    if isinstance(last, JointPhase) and last.target is not None \
+            and last.target.position is not None:
+        return np.asarray(last.target.position, dtype=float)
+    return None
 
 
 def _zyx(R: NDArray[np.float64]) -> NDArray[np.float64]:

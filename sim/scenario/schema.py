@@ -78,7 +78,7 @@ class WeaveSpec(_Strict):
 
     pattern: Literal["sine", "zigzag", "triangle", "circle"]
     amplitude_mm: float = Field(gt=0)
-    frequency_hz: float | None = Field(None, gt=0)
+    frequency_hz: float | None = Field(None, gt=0, le=20)
     wavelength_mm: float | None = Field(None, gt=0)
     dwell_s: float = Field(0.0, ge=0)
 
@@ -226,3 +226,5 @@ class ScenarioSpec(_Strict):
     program_frames: dict[str, str] = Field({}, description="user frame number -> cell object")
     program_registers: dict[str, list[float]] = Field(
         {}, description="position register number -> [X, Y, Z, W, P, R] (mm, deg)")
+    program_weld_speed_mm_s: float | None = Field(None, gt=0, description="the speed of the "
+                                                  "program's WELD_SPEED moves, mm/s")

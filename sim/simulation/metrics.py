@@ -66,7 +66,8 @@ def _woven_cruise(cart: Any, ts: NDArray[np.float64], p: NDArray[np.float64],
     velocity (progress over time, so the rounding of the pattern's corners averages out)."""
     v = _woven_travel_speed(cart, ts, p, T)
     ramp = float(cart.profile.ramp_time)
-    mid = (ts >= ramp) & (ts <= cart.duration - ramp)
+    lo, hi = cart.steady if cart.steady is not None else (ramp, cart.duration - ramp)
+    mid = (ts >= lo) & (ts <= hi)
     return float(np.mean(v[mid] if np.count_nonzero(mid) > 2 else v))
 
 
@@ -128,6 +129,8 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
         share = cart.constant_speed_fraction
         ramp = float(cart.profile.ramp_time)
         tc0, tc1 = pm.t0 + ramp, pm.t1 - ramp
+        if getattr(cart, "steady", None) is not None:  # a blended phase: between its corners
+            tc0, tc1 = pm.t0 + cart.steady[0], pm.t0 + cart.steady[1]
         cs = (ts >= tc0 + 1e-9) & (ts <= tc1 - 1e-9)
         if isinstance(cart, WeavingTrajectory):
             # progress along the seam over whole cycles (the pattern's corners average out)
@@ -235,8 +238,14 @@ def cartesian_speeds(arrays: dict[str, NDArray[Any]], motion: Motion,
         if sel.size < 3:
             speed = 0.0
         else:
+            steady = getattr(pm.cartesian, "steady", None)
             if isinstance(pm.cartesian, WeavingTrajectory):
                 speed = _woven_cruise(pm.cartesian, t[sel] - pm.t0, p[sel], T)
+            elif steady is not None:  # a blended phase: its speed between its corners
+                tl = t[sel] - pm.t0
+                v = np.linalg.norm(np.gradient(p[sel], t[sel], axis=0), axis=1)
+                mid = (tl >= steady[0] - 1e-9) & (tl <= steady[1] + 1e-9)
+                speed = float(np.median(v[mid] if np.count_nonzero(mid) > 2 else v))
             else:
                 v = np.linalg.norm(np.diff(p[sel], axis=0), axis=1) / np.diff(t[sel])
                 cruise = v[v >= 0.95 * v.max()] if v.max() > 0 else v

@@ -101,7 +101,7 @@ class PhaseMotion:
 
 @dataclass(frozen=True)
 class ProgrammedMove:
-    """A Cartesian move as programmed (frame 0): its end pose (and via point for an arc), the
+    """A Cartesian move as programmed (frame 0): its end pose (and via pose for an arc), the
     blend radius into the next move (m, 0: it stops there), its length and the next move's.
     What ``cellsim export`` writes as a TP motion line."""
 
@@ -115,14 +115,28 @@ class ProgrammedMove:
 
 
 def _programmed(cart: Any, kind: str, speed: float, blend: float = 0.0,
-                next_length: float = 0.0) -> ProgrammedMove:
+                next_length: float = 0.0) -> list[ProgrammedMove]:
+    """The move as programmed: one entry, or for an arc of more than 170 deg one per piece of
+    at most 170 deg (a TP circular move through three points cannot close a circle), the
+    pieces stopping at their ends and the last keeping the blend."""
     L = cart.length
-    p, _, _, _ = cart.path.evaluate(np.array([L, 0.5 * L]))
-    R = cart.orientation.evaluate(np.array([1.0]))[0][0]
-    end = np.eye(4)
-    end[:3, :3], end[:3, 3] = R, p[0]
-    return ProgrammedMove(kind, end, p[1] if kind == "circular" else None, speed, blend, L,
-                          next_length)
+    sweep = float(getattr(cart.path, "sweep", 0.0))
+    pieces = max(1, int(np.ceil(np.degrees(sweep) / 170.0 - 1e-9))) if kind == "circular" else 1
+
+    def pose(s: float) -> NDArray[np.float64]:
+        T = np.eye(4)
+        T[:3, 3] = cart.path.evaluate(np.array([s]))[0][0]
+        T[:3, :3] = cart.orientation.evaluate(np.array([s / L]))[0][0]
+        return T
+
+    out = []
+    for k in range(pieces):
+        s0, s1 = L * k / pieces, L * (k + 1) / pieces
+        last = k == pieces - 1
+        out.append(ProgrammedMove(kind, pose(s1), pose(0.5 * (s0 + s1)) if kind == "circular"
+                                  else None, speed, blend if last else 0.0, s1 - s0,
+                                  next_length if last else 0.0))
+    return out
 
 
 @dataclass
@@ -343,17 +357,31 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
 def _timed_by_speed(placed: JointPhase, robot: Any) -> JointPhase:
     """A phase timed like a controller's joint move at ``speed_pct`` of the joint speed limits:
     the duration makes the peak speed of the joint that takes longest ``speed_pct`` times its
-    limit (the knots keep their shares of the time)."""
+    limit, and no joint's acceleration over its limit (the knots keep their shares of the
+    time; with a blend's boundary speed the duration grows until both hold)."""
     share = placed.times - placed.t0
     total = float(share[-1])
-    trial = dataclasses.replace(placed, times=share / total, durations=np.diff(share / total))
-    traj = plan_phase(trial, "")
-    ts = np.linspace(0.0, 1.0, 401)
-    peak = np.abs(traj.at(ts).qd).max(axis=0)  # for a 1 s move
-    T = float(np.max(peak / (placed.speed_pct * np.asarray(robot.max_speed))))
-    T = max(T, 1e-3)
-    times = placed.t0 + share / total * T
-    return dataclasses.replace(placed, times=times, durations=np.diff(times))
+    vlim = placed.speed_pct * np.asarray(robot.max_speed, dtype=float)
+    alim = (np.asarray(robot.max_accel, dtype=float) if robot.max_accel
+            else np.full(len(vlim), np.inf))
+    # rest to rest, 1 s: peak speeds scale as 1/T and accelerations as 1/T^2
+    rest = {k: v for k, v in placed.boundary.items() if k not in ("v0", "a0", "vf", "af")}
+    trial = dataclasses.replace(placed, times=share / total, durations=np.diff(share / total),
+                                boundary=rest)
+    ts = np.linspace(0.0, 1.0, 801)
+    st = plan_phase(trial, "").at(ts)
+    T = max(float(np.max(np.abs(st.qd).max(axis=0) / vlim)),
+            float(np.sqrt(np.max(np.abs(st.qdd).max(axis=0) / alim))), 1e-3)
+    for _ in range(8):  # with the phase's own boundary speeds (a blend): scale until inside
+        times = placed.t0 + share / total * T
+        out = dataclasses.replace(placed, times=times, durations=np.diff(times))
+        st = plan_phase(out, "").at(np.linspace(out.t0, out.t1, 801))
+        over = max(float(np.max(np.abs(st.qd).max(axis=0) / vlim)),
+                   float(np.sqrt(np.max(np.abs(st.qdd).max(axis=0) / alim))))
+        if over <= 1.0 + 1e-9:
+            return out
+        T *= over * (1.0 + 1e-6)
+    return out
 
 
 def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | None,
@@ -600,13 +628,24 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
         from sim.core.rotations import euler_zyx_to_matrix
 
         R_end = F[:3, :3] @ euler_zyx_to_matrix(*phase.euler_zyx)
+        R_via = (R_end if phase.via_euler_zyx is None
+                 else F[:3, :3] @ euler_zyx_to_matrix(*phase.via_euler_zyx))
         off = ctx.flange_to_tcp[:3, 3]
         to = None if to is None else to + R_end @ off
-        via = None if via is None else via + R_end @ off
-    if phase.move_time is not None:  # the move's time sets its speed
-        length = (float(np.linalg.norm(to - p0)) if phase.kind == "linear" else
-                  float(np.linalg.norm(via - p0) + np.linalg.norm(to - via)))
-        phase = dataclasses.replace(phase, speed=max(length, 1e-6) / phase.move_time)
+        via = None if via is None else via + R_via @ off
+    if phase.move_time is not None:  # the move's time (its ramps included) sets its speed
+        if phase.kind == "linear":
+            length = float(np.linalg.norm(to - p0))
+        else:
+            from planners.adnia import CirclePath
+
+            try:
+                length = float(CirclePath.through(p0, via, to).length)
+            except PlannerError as exc:
+                raise ScenarioError(f"{label}: {exc}") from None
+        ramp = min(max(3.0 * phase.sample_period, 0.3), phase.move_time / 3.0)
+        phase = dataclasses.replace(phase, ramp=ramp, speed=max(length, 1e-6)
+                                    / (phase.move_time - ramp))
 
     seam = None
     if phase.seam is not None:
@@ -728,10 +767,17 @@ def _sample_times(duration: float, period: float, extra: NDArray[np.float64],
             "(raise speed_mm_s or sample_period_s)")
     n = max(2, int(np.ceil(count - 1e-9)))
     ts = np.linspace(0.0, duration, n + 1)
-    extra = np.asarray(extra, dtype=float)
+    extra = np.unique(np.asarray(extra, dtype=float))
     extra = extra[(extra > 1e-9) & (extra < duration - 1e-9)]
     if extra.size:
-        near = np.min(np.abs(ts[:, None] - extra[None, :]), axis=1) < 0.25 * duration / n
+        # drop grid points closer than a quarter period to an extra time (searchsorted: no
+        # grid x extra matrix)
+        k = np.clip(np.searchsorted(extra, ts), 1, extra.size) if extra.size > 1 else \
+            np.zeros(ts.size, dtype=int)
+        lo = extra[np.clip(k - 1, 0, extra.size - 1)]
+        hi = extra[np.clip(k, 0, extra.size - 1)]
+        gap = np.minimum(np.abs(ts - lo), np.abs(ts - hi))
+        near = gap < 0.25 * duration / n
         near[[0, -1]] = False
         ts = np.unique(np.r_[ts[~near], extra])
     return ts
@@ -753,6 +799,29 @@ def _ik_knots(kin: Any, ts: NDArray[np.float64], poses: NDArray[np.float64],
                             "previous phase's end pose")
     q_via[0] = q0
     return q_via
+
+
+def _into_j1_plane(poses: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Poses (frame 0) with the tool's x axis (the 5-axis family's approach) turned by the
+    least rotation into the vertical plane through J1 and the tool point: what a 5-axis arm
+    can hold. A blended corner interpolates orientations between two such planes; this keeps
+    the corner's torch in the arm's plane at every point."""
+    out = poses.copy()
+    for k, T in enumerate(poses):
+        rho = np.array([T[0, 3], T[1, 3], 0.0])
+        if np.linalg.norm(rho) < 1e-9:
+            continue
+        m = np.cross([0.0, 0.0, 1.0], rho / np.linalg.norm(rho))
+        a = T[:3, 0]
+        b = a - (a @ m) * m
+        nb = np.linalg.norm(b)
+        if nb < 1e-9 or abs(a @ m) < 1e-12:
+            continue
+        b /= nb
+        v, c = np.cross(a, b), float(a @ b)
+        V = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+        out[k, :3, :3] = (np.eye(3) + V + V @ V / (1.0 + c)) @ T[:3, :3]
+    return out
 
 
 def _poses(states: Any) -> NDArray[np.float64]:
@@ -786,11 +855,17 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     base = cart.base if phase.weave is not None else cart
     return PhaseMotion(phase, float(times[0]), float(times[-1]), traj, cartesian=cart, seam=seam,
                        knot_times=times,
-                       programmed=[_programmed(base, phase.kind, base.speed)])
+                       programmed=_programmed(base, phase.kind, base.speed))
 
 
 #: A TP program's CNT100 blends over this share of the shorter of the two moves.
 CNT_SHARE = 0.45
+#: Largest turn of the path a corner blend may round at speed, deg (a near reversal would
+#: be a cusp).
+MAX_BLEND_TURN = 150.0
+#: Smallest corner zone, m: below it the joint polynomial through the inverse kinematics
+#: samples cannot follow the corner curve (a CNT on such short moves gets this).
+MIN_BLEND = 1e-4
 #: Corner blend of a polyline seam welded without ``blend_mm``, m.
 POLYLINE_BLEND = 0.002
 
@@ -868,8 +943,13 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
         R = cart.orientation.evaluate(np.array([1.0]))[0][0]
     n = len(phases)
     radii = [(phases[k].blend if phases[k].blend > 0 else
-              phases[k].blend_fraction * CNT_SHARE * min(carts[k].length, carts[k + 1].length))
+              max(MIN_BLEND, phases[k].blend_fraction * CNT_SHARE
+                  * min(carts[k].length, carts[k + 1].length)))
              if k < n - 1 else 0.0 for k in range(n)]
+    for k, r in enumerate(radii[:-1]):
+        if r < MIN_BLEND - 1e-15:
+            raise ScenarioError(f"{labels[k]}.blend_mm: {r * 1e3:.4g} mm is too small to blend "
+                                f"(at least {MIN_BLEND * 1e3:g} mm; leave it out to stop)")
     pieces, laws, owner = [], [], []
     for k, cart in enumerate(carts):
         L = cart.length
@@ -887,6 +967,12 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
             nxt = carts[k + 1]
             pa, ta = (v[0] for v in cart.path.evaluate(np.array([L - r_out]))[:2])
             pb, tb = (v[0] for v in nxt.path.evaluate(np.array([r_out]))[:2])
+            turn = float(np.degrees(np.arccos(np.clip(ta @ tb, -1.0, 1.0))))
+            if turn > MAX_BLEND_TURN:
+                raise ScenarioError(
+                    f"{labels[k]}.blend_mm: the path turns {turn:.1f} deg at the corner into "
+                    f"{phases[k + 1].name!r}, too sharp to pass at speed (at most "
+                    f"{MAX_BLEND_TURN:g} deg); stop there (leave the blend out)")
             try:
                 pieces.append(BlendCurve(pa, ta, pb, tb, r_out / 4))
             except PlannerError as exc:
@@ -912,16 +998,31 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
                                                                    lengths), profile)
     except PlannerError as exc:
         raise ScenarioError(f"{labels[0]}: {exc}") from None
-    # each (outer) phase's window ends where its last piece ends
+    # each (outer) phase's window ends in the middle of its last corner (where the tool
+    # "reaches" the programmed point it blends past)
     m = len(outer)
-    ends_s = [float(path.starts[max(i for i in range(len(pieces)) if of[owner[i]] == j) + 1])
-              for j in range(m)]
-    bounds = [0.0] + [profile.time_at(s) for s in ends_s[:-1]] + [profile.duration]
+    blend_t = {i: (profile.time_at(path.starts[i]), profile.time_at(path.starts[i + 1]))
+               for i, pc in enumerate(pieces) if pc.kind == "blend"}
+    last = [max(i for i in range(len(pieces)) if of[owner[i]] == j) for j in range(m)]
+    bounds = [0.0]
+    for j in range(m - 1):
+        i = last[j]
+        bounds.append(0.5 * sum(blend_t[i]) if i in blend_t
+                      else profile.time_at(path.starts[i + 1]))
+    bounds.append(profile.duration)
     windows = []
     for j in range(m):
         ramp_in = float(carts[0].profile.ramp_time) if j == 0 else 0.0
         ramp_out = float(carts[-1].profile.ramp_time) if j == m - 1 else 0.0
-        win = TimeWindow(traj, bounds[j], bounds[j + 1], outer[j].speed, ramp_in, ramp_out)
+        # the part at the set speed: after the start ramp or the incoming corner, before the
+        # stop ramp or the outgoing corner
+        first = min(i for i in range(len(pieces)) if of[owner[i]] == j)
+        a = ramp_in if j == 0 else blend_t[first - 1][1] - bounds[j] if first - 1 in blend_t \
+            else 0.0
+        b = (bounds[j + 1] - bounds[j] - ramp_out if j == m - 1 else
+             blend_t[last[j]][0] - bounds[j] if last[j] in blend_t else bounds[j + 1] - bounds[j])
+        win = TimeWindow(traj, bounds[j], bounds[j + 1], outer[j].speed, ramp_in, ramp_out,
+                         steady=(max(a, 0.0), max(b, max(a, 0.0))))
         if outer[j].weave is not None:
             from planners.weave import WeavingTrajectory
 
@@ -934,10 +1035,8 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     # samples: every period, at the phase ends, and at the weaves' turns
     period = min(ph.sample_period for ph in phases)
     extra = [np.array(bounds[1:-1])]
-    for i, pc in enumerate(pieces):
-        if pc.kind == "blend":
-            period = min(period, (profile.time_at(path.starts[i + 1])
-                                  - profile.time_at(path.starts[i])) / SAMPLES_PER_BLEND)
+    for t_a, t_b in blend_t.values():  # each corner sampled on its own
+        extra.append(np.linspace(t_a, t_b, SAMPLES_PER_BLEND + 1))
     for k, win in enumerate(windows):
         if phases[k].weave is not None:
             period = min(period, _weave_period(phases[k].weave))
@@ -949,6 +1048,8 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
         sel = which == k
         if np.any(sel):
             poses[sel] = _poses(win.at(ts[sel] - bounds[k]))
+    if getattr(kin.family, "approach_column", 2) == 0:  # a 5-axis arm: corners in its plane
+        poses = _into_j1_plane(poses)
     q_via = _ik_knots(kin, ts, poses, q0, labels[0])
     times = t0 + ts
     placed = JointPhase(index=phases[0].index, name=phases[0].name, planner=phases[0].planner,
@@ -958,9 +1059,9 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     for k in range(n):
         ta, tb = t0 + bounds[k], t0 + bounds[k + 1]
         knots = times[(times >= ta - 1e-12) & (times <= tb + 1e-12)]
-        moves = [_programmed(c, inner[i].kind, c.speed, radii[i],
-                             carts[i + 1].length if i + 1 < len(carts) else 0.0)
-                 for i, c in enumerate(carts) if of[i] == k]
+        moves = [mv for i, c in enumerate(carts) if of[i] == k
+                 for mv in _programmed(c, inner[i].kind, c.speed, radii[i],
+                                       carts[i + 1].length if i + 1 < len(carts) else 0.0)]
         out.append(PhaseMotion(phases[k], float(ta), float(tb), joint, cartesian=windows[k],
                                seam=seams[k], knot_times=knots, programmed=moves))
     return out
