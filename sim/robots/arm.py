@@ -87,30 +87,28 @@ class Arm:
         lo, hi = self.chain.lower, self.chain.upper
         cur = np.zeros(self.chain.n) if current is None else np.asarray(current, dtype=float)
         out: list[Solution] = []
+        def add_with_turns(q: NDArray[np.float64], label: str) -> None:
+            """Every whole-turn variant inside the ranges; the solution itself, flagged, when
+            no variant is."""
+            variants = [_turns(q[i], lo[i], hi[i]) for i in range(len(q))]
+            if all(variants):
+                for combo in itertools.product(*variants):
+                    out.append(Solution(np.array(combo), label, True))
+            else:
+                out.append(Solution(q, label, False))
+
         if self.opw is not None:
-            rows = opw.inverse(self.opw, T)
-            for q in rows:
+            for q in opw.inverse(self.opw, T):
                 if np.isnan(q).any():
                     continue
                 if np.max(np.abs(self.chain.fk(q) - T)) > 1e-7:
                     continue  # a branch the arm's geometry makes spurious
-                label = opw.configuration(self.opw, q)
-                variants = [_turns(q[i], lo[i], hi[i]) for i in range(len(q))]
-                if all(variants):
-                    for combo in itertools.product(*variants):
-                        out.append(Solution(np.array(combo), label, True))
-                else:
-                    out.append(Solution(q, label, False))
+                add_with_turns(q, opw.configuration(self.opw, q))
         elif self.five is not None:
             for q, label in self.five.inverse(T):
                 if np.abs(self.chain.fk(q)[:3, 3] - T[:3, 3]).max() > 1e-7:
                     continue
-                variants = [_turns(q[i], lo[i], hi[i]) for i in range(len(q))]
-                if all(variants):
-                    for combo in itertools.product(*variants):
-                        out.append(Solution(np.array(combo), label, True))
-                else:
-                    out.append(Solution(q, label, False))
+                add_with_turns(q, label)
         else:
             for q in numeric_solve(self.chain, T, cur):
                 out.append(Solution(q, "numeric", True))
