@@ -104,28 +104,22 @@ class BlendCurve:
             u = np.clip(u - (s_u - s) / np.maximum(sp[2], 1e-300), 0.0, 1.0)
         return u
 
+    def _tangent(self, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+        """Unit tangent and its arc-length derivative at parameters ``u`` (d/ds = d/du / |B'|)."""
+        b1, b2 = self._d(u, 1), self._d(u, 2)
+        sp = np.linalg.norm(b1, axis=-1, keepdims=True)
+        T = b1 / sp
+        return T, (b2 - np.sum(b2 * T, axis=-1, keepdims=True) * T) / sp**2
+
     def evaluate(self, s: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
         s = np.asarray(s, dtype=float)
         u = self._u_of_s(s)
-        b1, b2, b3 = self._d(u, 1), self._d(u, 2), self._d(u, 3)
-        sp = np.linalg.norm(b1, axis=-1, keepdims=True)
-        T = b1 / sp
-        # d/ds = (1/|B'|) d/du
-        dT = (b2 - np.sum(b2 * T, axis=-1, keepdims=True) * T) / sp**2
-        # third derivative: the tangent's second derivative by differences of dT (small, smooth)
+        T, dT = self._tangent(u)
+        # third derivative: the tangent's second derivative by central differences of dT
         h = 1e-6 * max(self.length, 1e-9)
-        up = self._u_of_s(s + h)
-        um = self._u_of_s(s - h)
-
-        def dT_at(uv):
-            c1, c2 = self._d(uv, 1), self._d(uv, 2)
-            n1 = np.linalg.norm(c1, axis=-1, keepdims=True)
-            t1 = c1 / n1
-            return (c2 - np.sum(c2 * t1, axis=-1, keepdims=True) * t1) / n1**2
-
         span = (np.clip(s + h, 0, self.length) - np.clip(s - h, 0, self.length))[..., None]
-        d3 = (dT_at(up) - dT_at(um)) / np.maximum(span, 1e-300)
-        del b3
+        d3 = ((self._tangent(self._u_of_s(s + h))[1] - self._tangent(self._u_of_s(s - h))[1])
+              / np.maximum(span, 1e-300))
         return self._d(u, 0), T, dT, d3
 
 

@@ -977,3 +977,25 @@ def test_a_urdf_robot_name_that_is_no_file_name_still_runs(tmp_path, monkeypatch
     (tmp_path / "arm.urdf").write_text(text)
     spec = resolve_robot("arm.urdf", tmp_path)
     assert spec.name == "arm" and spec.robot_path.is_file()
+
+
+def test_a_second_load_of_a_dh_robot_reuses_its_cache_without_mujoco(dh_robot):
+    """The first load of a DH robot folder writes its model and derived acceleration limits
+    into cellsim's cache; a second load (a new process) reads both back, identical, and does
+    not import mujoco (the command line picks its OpenGL backend after loading a scenario)."""
+    import os
+
+    from sim.robots.robotfile import load_robot_folder
+
+    first = load_robot_folder(dh_robot / "robots" / "dh_arm")
+    code = ("import sys, json; from sim.robots.robotfile import load_robot_folder; "
+            f"s = load_robot_folder({str(dh_robot / 'robots' / 'dh_arm')!r}); "
+            "print(json.dumps([list(s.max_accel), 'mujoco' in sys.modules]))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=300, env={**os.environ})
+    assert r.returncode == 0, r.stderr
+    import json
+
+    accel, imported = json.loads(r.stdout.strip().splitlines()[-1])
+    assert accel == list(first.max_accel)
+    assert imported is False

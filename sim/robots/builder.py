@@ -27,13 +27,16 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sim.core.rotations import make_transform, rot_x, rot_z
 from sim.errors import KinematicsError
+
+if TYPE_CHECKING:  # imported where used: reading a DH table must not import mujoco (the
+    import mujoco  # command line chooses its OpenGL backend after loading a scenario)
 
 _JOINT_TYPES = ("R", "P")
 
@@ -251,6 +254,8 @@ class KinematicChain:
         return ET.tostring(root, encoding="unicode") + "\n"
 
     def compile(self) -> mujoco.MjModel:
+        import mujoco
+
         """The compiled MuJoCo model of :meth:`to_mjcf`."""
         return mujoco.MjModel.from_xml_string(self.to_mjcf())
 
@@ -261,6 +266,8 @@ def _fmt(values: ArrayLike) -> str:
 
 
 def _pose_attrs(T: NDArray[np.float64]) -> dict[str, str]:
+    import mujoco
+
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
     attrs = {"pos": _fmt(T[:3, 3])}

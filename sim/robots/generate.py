@@ -43,11 +43,14 @@ import hashlib
 import os
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 
 from sim.robots.chain import Chain
+
+if TYPE_CHECKING:  # imported where used: loading a cached model must not import mujoco
+    import mujoco
 
 OMEGA_N = 400.0  #: closed-loop natural frequency, rad/s (0.4 / timestep: the stability margin below)
 #: Largest sqrt(max eig(M^-1 Kp)) * timestep over the sample (semi-implicit Euler is stable
@@ -68,6 +71,8 @@ def _f(v) -> str:
 
 
 def _quat(R) -> str:
+    import mujoco
+
     q = np.zeros(4)
     mujoco.mju_mat2Quat(q, np.ascontiguousarray(R).ravel())
     return _f(q)
@@ -244,6 +249,8 @@ def diag_inertia_range(model: mujoco.MjModel, n: int, lower, upper, samples: int
     """Smallest and largest diagonal of the joint-space inertia matrix (armature included),
     per joint, over random configurations in the joint ranges, kg m^2 (the gains' basis here
     and in ``models/build_models.py``)."""
+    import mujoco
+
     data = mujoco.MjData(model)
     rng = np.random.default_rng(seed)
     lo = np.full(n, np.inf)
@@ -265,6 +272,8 @@ def _gains(xml: str, chain: Chain, payload_kg: float) -> dict[int, tuple[float, 
     payload at the flange) so that the servo alone holds the arm within :data:`SAG_RAD`;
     ``kv = 2 sqrt(kp Imax)`` (critically damped where the joint is heaviest, over-damped
     elsewhere)."""
+    import mujoco
+
     m = mujoco.MjModel.from_xml_string(xml)
     n = chain.n
     lo = np.where(np.isfinite(chain.lower), chain.lower, -np.pi)

@@ -232,13 +232,44 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     if spec.joints.max_accel_deg_s2 is not None:
         accel = np.deg2rad(spec.joints.max_accel_deg_s2)
     else:
-        from sim.robots.accel_limits import derive_accel_limits
+        accel = _derived_accel(robot, spec.mass.payload_kg,
+                               None if spec.mjcf is not None else model.parent, f"{where}: drives")
+    return dataclasses.replace(robot, max_accel=tuple(float(v) for v in accel))
+
+
+def _derived_accel(robot, payload_kg: float, cache: Path | None, where: str) -> np.ndarray:
+    """Acceleration limits derived from the drives (:mod:`sim.robots.accel_limits`), rad/s^2,
+    kept beside a generated model in cellsim's cache (whose key covers the drives, the
+    masses and the payload): a second load neither recomputes them nor imports mujoco."""
+    import json
+
+    n = robot.n_joints
+    path = None if cache is None else cache / "accel_limits.json"
+    if path is not None and path.is_file():
+        try:
+            v = np.asarray(json.loads(path.read_text(encoding="utf-8")), dtype=float)
+            if v.shape == (n,) and np.all(np.isfinite(v)) and np.all(v > 0):
+                return v
+        except (OSError, ValueError):
+            pass  # recomputed below
+    from sim.robots.accel_limits import derive_accel_limits
+
+    try:
+        accel = np.asarray(derive_accel_limits(robot, payload_kg, samples=500), dtype=float)
+    except KinematicsError as exc:
+        raise KinematicsError(f"{where}: {exc}") from None
+    if path is not None:
+        import os
+        import tempfile
 
         try:
-            accel = derive_accel_limits(robot, spec.mass.payload_kg, samples=500)
-        except KinematicsError as exc:
-            raise KinematicsError(f"{where}: drives: {exc}") from None
-    return dataclasses.replace(robot, max_accel=tuple(float(v) for v in accel))
+            fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".accel.", suffix=".tmp")
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                json.dump([float(v) for v in accel], fh)
+            os.replace(tmp, path)
+        except OSError:
+            pass  # an unwritable cache only costs time
+    return accel
 
 
 def load_urdf_robot(path: str | Path):  # -> RobotSpec
@@ -292,12 +323,7 @@ def load_urdf_robot(path: str | Path):  # -> RobotSpec
         family=ChainFamily(arm_from_chain(chain, path)),
         max_speed=tuple(float(v) for v in chain.max_speed),
         description=f"robot from {path}", drives=drives, payload_kg=0.0)
-    from sim.robots.accel_limits import derive_accel_limits
-
-    try:
-        accel = derive_accel_limits(robot, 0.0, samples=500)
-    except KinematicsError as exc:
-        raise KinematicsError(f"{path}: {exc}") from None
+    accel = _derived_accel(robot, 0.0, model.parent, str(path))
     return dataclasses.replace(robot, max_accel=tuple(float(v) for v in accel))
 
 

@@ -347,7 +347,7 @@ def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
     for ins in instructions:
         if isinstance(ins, LSMotion):
             term = "FINE" if ins.cnt is None else f"CNT{ins.cnt}"
-            speed = f"{ins.speed:g}{ins.unit}" if ins.unit == "%" else f"{ins.speed:g}{ins.unit}"
+            speed = f"{ins.speed:g}{ins.unit}"
             arc = "" if ins.arc is None else f" Arc {'Start' if ins.arc == 'start' else 'End'}[1]"
             tgt = f"{ins.target[0]}[{ins.target[1]}]"
             if ins.kind == "C":

@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from planners.weave import WeavingTrajectory
+from planners.weave import WeavingTrajectory, measure_weave
 from sim.core.intervals import true_runs
 from sim.scenario import Scenario
 from sim.simulation.compile import BuiltCell
@@ -77,8 +77,6 @@ def weave_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltC
     measured on the simulated tcp over the full-amplitude part: amplitude (half the peak to
     peak), frequency (FFT peak, :func:`planners.weave.measure_weave`), centre line (mean
     offset over whole cycles), against the set values."""
-    from planners.weave import measure_weave
-
     t = arrays["t"]
     T = built.context.world_from_frame0
     out = []

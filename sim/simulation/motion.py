@@ -288,7 +288,8 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     t = 0.0
     q = None
     todo = list(scenario.phases)
-    pending: tuple[NDArray[np.float64], dict[str, NDArray[np.float64]]] | None = None
+    pending: tuple[NDArray[np.float64], dict[str, NDArray[np.float64]],
+                   NDArray[np.float64] | None] | None = None
     while todo:
         phase = todo.pop(0)
         label = f"{where}: phases[{phase.index}] ({phase.name})"
@@ -318,16 +319,19 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
                 qs[0] = context.home_q
                 phase = dataclasses.replace(phase, q=qs)
             placed = phase.with_start(t, q)
+            solved_end = None
             if pending is not None:  # the previous joint phase blends into this one
                 qs = placed.q.copy()
                 qs[0] = pending[0]
                 placed = dataclasses.replace(placed, q=qs,
                                              boundary={**placed.boundary, **pending[1]})
+                solved_end = pending[2]  # its pose target, solved by the blend
                 pending = None
             if phase.target is not None:
                 if context is None:
                     raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
-                placed = placed.with_end(_solve_target(phase, placed.q[0], context, label))
+                placed = placed.with_end(solved_end if solved_end is not None
+                                         else _solve_target(phase, placed.q[0], context, label))
             if phase.speed_pct is not None:
                 placed = _timed_by_speed(placed, scenario.robot)
             if phase.blend > 0 or phase.blend_fraction > 0:
@@ -386,7 +390,7 @@ def _timed_by_speed(placed: JointPhase, robot: Any) -> JointPhase:
 
 def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | None,
                  label: str, robot: Any = None
-                 ) -> tuple[JointPhase, tuple[NDArray[np.float64], dict]]:
+                 ) -> tuple[JointPhase, tuple[NDArray[np.float64], dict, Any]]:
     """A joint phase that blends into the next joint phase (``blend_deg``): instead of stopping
     at its last knot ``q_c`` it passes the corner without stopping. The incoming and outgoing
     chords are cut where each has moved ``r`` (the largest joint change, at most half the
@@ -394,16 +398,20 @@ def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | 
     of ``q_c`` on every joint) with the velocity ``(b - a) / (t_b - t_a)`` and no acceleration.
 
     Returns:
-        The phase with its new end, and the next phase's start (knot and boundary values).
+        The phase with its new end, and the next phase's start: its first knot, boundary
+        values, and its end solved from its pose target (None without one), which the next
+        phase reuses.
     """
     if not isinstance(nxt, JointPhase):
         raise ScenarioError(f"{label}.blend_deg: the next phase is not a joint phase to blend "
                             "into (leave blend_deg out)")
     nq = nxt.with_start(placed.t1, placed.q[-1])
+    end = None
     if nxt.target is not None:
         if ctx is None:
             raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
-        nq = nq.with_end(_solve_target(nxt, nq.q[0], ctx, label))
+        end = _solve_target(nxt, nq.q[0], ctx, label)
+        nq = nq.with_end(end)
     if nxt.speed_pct is not None and robot is not None:
         nq = _timed_by_speed(nq, robot)
     q_p, q_c, q_n = placed.q[-2], placed.q[-1], nq.q[1]
@@ -424,7 +432,7 @@ def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | 
     q = placed.q.copy()
     q[-1] = q_b
     out = dataclasses.replace(placed, q=q, boundary={**placed.boundary, "vf": v_b, "af": zero})
-    return out, (q_b, {"v0": v_b, "a0": zero})
+    return out, (q_b, {"v0": v_b, "a0": zero}, end)
 
 
 #: Most inverse-kinematics samples of one Cartesian phase.
@@ -906,15 +914,15 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     inverse kinematics of the whole path, each phase a time window of it (ending where its
     corner blend joins the next phase). A phase along a polyline seam is one window over its
     segments, blended at the corners (:func:`_segments`)."""
-    outer, outer_labels = phases, labels
-    phases, labels, of = [], [], []
-    for j, (ph, lb) in enumerate(zip(outer, outer_labels, strict=True)):
+    # the moves: the phases, a polyline phase one move per segment (of: move -> its phase)
+    moves, move_labels, of = [], [], []
+    for j, (ph, lb) in enumerate(zip(phases, labels, strict=True)):
         parts = _segments(ph, ctx, lb) if _is_polyline(ph, ctx) else [ph]
-        phases += parts
-        labels += [lb] * len(parts)
+        moves += parts
+        move_labels += [lb] * len(parts)
         of += [j] * len(parts)
     ctx_seams = dict(ctx.seams)
-    for ph in outer:
+    for ph in phases:
         if _is_polyline(ph, ctx):
             for sg in ctx.seams[ph.seam].segments():
                 ctx_seams[sg.name] = sg
@@ -934,21 +942,20 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     kin = ctx.kinematics
     T0 = np.asarray(kin.fk(q0), dtype=float)
     p, R = T0[:3, 3], T0[:3, :3]
-    carts, seams = [], []
-    for phase, label in zip(phases, labels, strict=True):
-        cart, seam = _phase_cart(phase, p, R, ctx, label)
+    carts = []
+    for move, label in zip(moves, move_labels, strict=True):
+        cart, _ = _phase_cart(move, p, R, ctx, label)
         carts.append(cart)
-        seams.append(seam)
         p = cart.path.evaluate(np.array([cart.length]))[0][0]
         R = cart.orientation.evaluate(np.array([1.0]))[0][0]
-    n = len(phases)
-    radii = [(phases[k].blend if phases[k].blend > 0 else
-              max(MIN_BLEND, phases[k].blend_fraction * CNT_SHARE
+    n = len(moves)
+    radii = [(moves[k].blend if moves[k].blend > 0 else
+              max(MIN_BLEND, moves[k].blend_fraction * CNT_SHARE
                   * min(carts[k].length, carts[k + 1].length)))
              if k < n - 1 else 0.0 for k in range(n)]
     for k, r in enumerate(radii[:-1]):
         if r < MIN_BLEND - 1e-15:
-            raise ScenarioError(f"{labels[k]}.blend_mm: {r * 1e3:.4g} mm is too small to blend "
+            raise ScenarioError(f"{move_labels[k]}.blend_mm: {r * 1e3:.4g} mm is too small to blend "
                                 f"(at least {MIN_BLEND * 1e3:g} mm; leave it out to stop)")
     pieces, laws, owner = [], [], []
     for k, cart in enumerate(carts):
@@ -958,8 +965,8 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
         for r, who in ((r_in, k - 1), (r_out, k)):
             if r > 0 and r > 0.5 * L + 1e-12:
                 raise ScenarioError(
-                    f"{labels[who]}.blend_mm: {r * 1e3:.4g} mm is more than half of "
-                    f"{phases[k].name!r} ({L * 1e3:.4g} mm long)")
+                    f"{move_labels[who]}.blend_mm: {r * 1e3:.4g} mm is more than half of "
+                    f"{moves[k].name!r} ({L * 1e3:.4g} mm long)")
         pieces.append(SubPath(cart.path, r_in, L - r_out))
         laws.append(SubOrientation(cart.orientation, r_in / L, (L - r_out) / L))
         owner.append(k)
@@ -970,37 +977,37 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
             turn = float(np.degrees(np.arccos(np.clip(ta @ tb, -1.0, 1.0))))
             if turn > MAX_BLEND_TURN:
                 raise ScenarioError(
-                    f"{labels[k]}.blend_mm: the path turns {turn:.1f} deg at the corner into "
-                    f"{phases[k + 1].name!r}, too sharp to pass at speed (at most "
+                    f"{move_labels[k]}.blend_mm: the path turns {turn:.1f} deg at the corner into "
+                    f"{moves[k + 1].name!r}, too sharp to pass at speed (at most "
                     f"{MAX_BLEND_TURN:g} deg); stop there (leave the blend out)")
             try:
                 pieces.append(BlendCurve(pa, ta, pb, tb, r_out / 4))
             except PlannerError as exc:
-                raise ScenarioError(f"{labels[k]}.blend_mm: {exc}") from None
+                raise ScenarioError(f"{move_labels[k]}.blend_mm: {exc}") from None
             Ra = cart.orientation.evaluate(np.array([(L - r_out) / L]))[0][0]
             Rb = nxt.orientation.evaluate(np.array([r_out / nxt.length]))[0][0]
             laws.append(GeodesicOrientation(Ra, Rb))
             owner.append(k)
     path = CompositePath(pieces)
     lengths = [pc.length for pc in pieces]
-    changes = [(0.0, 0.0, phases[0].speed, float(carts[0].profile.ramp_time))]
+    changes = [(0.0, 0.0, moves[0].speed, float(carts[0].profile.ramp_time))]
     for i, pc in enumerate(pieces):
         if pc.kind == "blend":
             k = owner[i]
-            va, vb = phases[k].speed, phases[k + 1].speed
+            va, vb = moves[k].speed, moves[k + 1].speed
             if va != vb:
                 changes.append((float(path.starts[i] + pc.length / 2), va, vb,
                                 2.0 * pc.length / (va + vb)))
-    changes.append((path.length, phases[-1].speed, 0.0, float(carts[-1].profile.ramp_time)))
+    changes.append((path.length, moves[-1].speed, 0.0, float(carts[-1].profile.ramp_time)))
     try:
         profile = PiecewiseProfile(changes, path.length)
         traj = adnia.CartesianTrajectory(path, CompositeOrientation(laws, path.starts[:-1],
                                                                    lengths), profile)
     except PlannerError as exc:
         raise ScenarioError(f"{labels[0]}: {exc}") from None
-    # each (outer) phase's window ends in the middle of its last corner (where the tool
+    # each phase's window ends in the middle of its last corner (where the tool
     # "reaches" the programmed point it blends past)
-    m = len(outer)
+    m = len(phases)
     blend_t = {i: (profile.time_at(path.starts[i]), profile.time_at(path.starts[i + 1]))
                for i, pc in enumerate(pieces) if pc.kind == "blend"}
     last = [max(i for i in range(len(pieces)) if of[owner[i]] == j) for j in range(m)]
@@ -1021,17 +1028,15 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
             else 0.0
         b = (bounds[j + 1] - bounds[j] - ramp_out if j == m - 1 else
              blend_t[last[j]][0] - bounds[j] if last[j] in blend_t else bounds[j + 1] - bounds[j])
-        win = TimeWindow(traj, bounds[j], bounds[j + 1], outer[j].speed, ramp_in, ramp_out,
+        win = TimeWindow(traj, bounds[j], bounds[j + 1], phases[j].speed, ramp_in, ramp_out,
                          steady=(max(a, 0.0), max(b, max(a, 0.0))))
-        if outer[j].weave is not None:
+        if phases[j].weave is not None:
             from planners.weave import WeavingTrajectory
 
-            win = WeavingTrajectory(win, outer[j].weave, kin.family.approach_column)
+            win = WeavingTrajectory(win, phases[j].weave, kin.family.approach_column)
         windows.append(win)
     n = m
-    seams = [ctx.seams.get(ph.seam) if ph.seam is not None else None for ph in outer]
-    inner = phases
-    phases, labels = outer, outer_labels
+    seams = [ctx.seams.get(ph.seam) if ph.seam is not None else None for ph in phases]
     # samples: every period, at the phase ends, and at the weaves' turns
     period = min(ph.sample_period for ph in phases)
     extra = [np.array(bounds[1:-1])]
@@ -1059,9 +1064,9 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     for k in range(n):
         ta, tb = t0 + bounds[k], t0 + bounds[k + 1]
         knots = times[(times >= ta - 1e-12) & (times <= tb + 1e-12)]
-        moves = [mv for i, c in enumerate(carts) if of[i] == k
-                 for mv in _programmed(c, inner[i].kind, c.speed, radii[i],
-                                       carts[i + 1].length if i + 1 < len(carts) else 0.0)]
+        programmed = [mv for i, c in enumerate(carts) if of[i] == k
+                      for mv in _programmed(c, moves[i].kind, c.speed, radii[i],
+                                            carts[i + 1].length if i + 1 < len(carts) else 0.0)]
         out.append(PhaseMotion(phases[k], float(ta), float(tb), joint, cartesian=windows[k],
-                               seam=seams[k], knot_times=knots, programmed=moves))
+                               seam=seams[k], knot_times=knots, programmed=programmed))
     return out
