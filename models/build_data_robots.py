@@ -50,13 +50,13 @@ def readme_block(folder: Path) -> str:
     import numpy as np
 
     from sim.robots.accel_limits import derive_accel_limits
+    from sim.robots.generate import max_gravity_torque
     from sim.robots.robotfile import load_robot_folder
 
     spec = load_robot_folder(folder)
     arm = spec.family.arm
     chain = arm.chain
     model = mujoco.MjModel.from_xml_path(str(spec.robot_path))
-    data = mujoco.MjData(model)
     n = chain.n
     L = [GEN_BEGIN, "", "## Chain (from the URDF)", "",
          "| joint | range (deg) | origin in the parent (mm) | axis (joint frame) | max speed (deg/s) |",
@@ -88,20 +88,9 @@ def readme_block(folder: Path) -> str:
     L += ["", f"- Total mass: {float(model.body_mass.sum()):.4f} kg (the moving links and the "
           "base, 1 kg per base geom)", ""]
     # largest static gravity torque with the rated payload at the flange
-    rng = np.random.default_rng(0)
-    R = np.c_[np.where(np.isfinite(chain.lower), chain.lower, -np.pi),
-              np.where(np.isfinite(chain.upper), chain.upper, np.pi)]
-    g = np.zeros(n)
-    fl = model.site("flange").id
-    jac = np.zeros((3, model.nv))
-    for _ in range(4000):
-        data.qpos[:n] = rng.uniform(R[:, 0], R[:, 1])
-        mujoco.mj_kinematics(model, data)
-        mujoco.mj_comPos(model, data)
-        mujoco.mj_rne(model, data, 0, data.qfrc_bias)
-        mujoco.mj_jacSite(model, data, jac, None, fl)
-        tau = data.qfrc_bias[:n] + jac[:, :n].T @ np.array([0.0, 0.0, spec.payload_kg * 9.81])
-        g = np.maximum(g, np.abs(tau))
+    g = max_gravity_torque(model, n, np.where(np.isfinite(chain.lower), chain.lower, -np.pi),
+                           np.where(np.isfinite(chain.upper), chain.upper, np.pi),
+                           spec.payload_kg, 4000, np.random.default_rng(0))
     L += ["## Drives and actuators", "",
           "| joint | ratio | eta | rotor inertia (kg m^2) | rated / peak torque (N m) | max rpm | "
           "joint speed at max rpm (deg/s) | rated joint torque (N m) | largest gravity torque "

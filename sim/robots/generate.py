@@ -244,6 +244,53 @@ def wrist_point(chain: Chain) -> np.ndarray:
     return (np.linalg.inv(Tn) @ np.r_[w, 1.0])[:3]
 
 
+def mass_matrix(model: mujoco.MjModel, data: mujoco.MjData, q, n: int) -> np.ndarray:
+    """Joint-space inertia matrix of the first ``n`` joints at ``q`` (armature included),
+    kg m^2, (n, n)."""
+    import mujoco
+
+    M = np.zeros((model.nv, model.nv))
+    data.qpos[:n] = q
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_comPos(model, data)
+    mujoco.mj_crb(model, data)
+    mujoco.mj_fullM(model, data, M)
+    return M[:n, :n]
+
+
+def gravity_torque(model: mujoco.MjModel, data: mujoco.MjData, q, n: int,
+                   payload_kg: float = 0.0) -> np.ndarray:
+    """Static joint torques at ``q`` (at rest) holding the arm and ``payload_kg`` as a point
+    mass at the ``flange`` site, N m, (n,)."""
+    import mujoco
+
+    data.qpos[:n] = q
+    data.qvel[:] = 0.0
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_comPos(model, data)
+    mujoco.mj_rne(model, data, 0, data.qfrc_bias)
+    tau = data.qfrc_bias[:n].copy()
+    if payload_kg > 0.0:
+        jac = np.zeros((3, model.nv))
+        mujoco.mj_jacSite(model, data, jac, None, model.site("flange").id)
+        tau += jac[:, :n].T @ np.array([0.0, 0.0, payload_kg * 9.81])
+    return tau
+
+
+def max_gravity_torque(model: mujoco.MjModel, n: int, lower, upper, payload_kg: float,
+                       samples: int, rng: np.random.Generator) -> np.ndarray:
+    """Largest :func:`gravity_torque` per joint over ``samples`` configurations drawn from
+    ``rng`` in the ranges, N m, (n,)."""
+    import mujoco
+
+    data = mujoco.MjData(model)
+    g = np.zeros(n)
+    for _ in range(samples):
+        g = np.maximum(g, np.abs(gravity_torque(model, data, rng.uniform(lower, upper), n,
+                                                payload_kg)))
+    return g
+
+
 def diag_inertia_range(model: mujoco.MjModel, n: int, lower, upper, samples: int = 2000,
                        seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Smallest and largest diagonal of the joint-space inertia matrix (armature included),
@@ -255,15 +302,10 @@ def diag_inertia_range(model: mujoco.MjModel, n: int, lower, upper, samples: int
     rng = np.random.default_rng(seed)
     lo = np.full(n, np.inf)
     hi = np.zeros(n)
-    M = np.zeros((model.nv, model.nv))
     for _ in range(samples):
-        data.qpos[:n] = rng.uniform(lower, upper)
-        mujoco.mj_kinematics(model, data)
-        mujoco.mj_comPos(model, data)
-        mujoco.mj_crb(model, data)
-        mujoco.mj_fullM(model, data, M)
-        lo = np.minimum(lo, np.diag(M)[:n])
-        hi = np.maximum(hi, np.diag(M)[:n])
+        diag = np.diag(mass_matrix(model, data, rng.uniform(lower, upper), n))
+        lo = np.minimum(lo, diag)
+        hi = np.maximum(hi, diag)
     return lo, hi
 
 
@@ -280,33 +322,14 @@ def _gains(xml: str, chain: Chain, payload_kg: float) -> dict[int, tuple[float, 
     hi = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
     imin, imax = diag_inertia_range(m, n, lo, hi, samples=500)
     # gravity torques over the same kind of sample, the payload as a point mass at the flange
-    d = mujoco.MjData(m)
     rng = np.random.default_rng(1)
-    g_max = np.zeros(n)
-    for _ in range(500):
-        d.qpos[:n] = rng.uniform(lo, hi)
-        mujoco.mj_kinematics(m, d)
-        mujoco.mj_comPos(m, d)
-        mujoco.mj_rne(m, d, 0, d.qfrc_bias)
-        tau = d.qfrc_bias[:n].copy()
-        if payload_kg > 0.0:
-            jac = np.zeros((3, m.nv))
-            mujoco.mj_jacSite(m, d, jac, None, m.site("flange").id)
-            tau += jac[:, :n].T @ np.array([0.0, 0.0, payload_kg * 9.81])
-        g_max = np.maximum(g_max, np.abs(tau))
+    g_max = max_gravity_torque(m, n, lo, hi, payload_kg, 500, rng)
     kp = np.maximum(OMEGA_N ** 2 * imin, g_max / SAG_RAD)
     # the loops' stiffest mode over the sample stays inside the integrator's stability region:
     # the joints taking part in the stiffest mode are softened, in proportion to their share
     # of it, until no mode exceeds the margin
-    Ms = []
-    for _ in range(200):
-        M = np.zeros((m.nv, m.nv))
-        d.qpos[:n] = rng.uniform(lo, hi)
-        mujoco.mj_kinematics(m, d)
-        mujoco.mj_comPos(m, d)
-        mujoco.mj_crb(m, d)
-        mujoco.mj_fullM(m, d, M)
-        Ms.append(M[:n, :n])
+    d = mujoco.MjData(m)
+    Ms = [mass_matrix(m, d, rng.uniform(lo, hi), n) for _ in range(200)]
     for _ in range(200):
         worst, mode = 0.0, None
         for M in Ms:
@@ -367,4 +390,5 @@ def generated_model_path(chain: Chain, name: str, drives, total_mass_kg: float |
     return path
 
 
-__all__ = ["generated_model_path", "mjcf_from_chain", "model_text", "scene_text"]
+__all__ = ["generated_model_path", "gravity_torque", "mass_matrix", "max_gravity_torque",
+           "mjcf_from_chain", "model_text", "scene_text"]
