@@ -19,7 +19,12 @@ is per joint:
 * ``clearance`` (a *warning*): per phase, the smaller of the tool's and the arm's clearance to
   the cell, mm, against the scenario's ``simulation.clearance_mm``;
 * ``cartesian_speed``: per Cartesian phase, how far the reference tool point's cruise speed is
-  from the set speed, %, against 1 % (a phase sampled too coarsely for its move misses it);
+  from the set speed, %, against 1 % (a phase sampled too coarsely for its move misses it;
+  along a seam the speed is the progress along the seam, a weave's lateral motion left out);
+* ``torch_angle``: per weld phase along a seam, the largest angle of the simulated torch axis
+  from the seam's commanded axis (its work and travel angles at the nearest seam point, the
+  corner zones left out: :func:`sim.simulation.metrics.measure_seam`), deg, against the
+  scenario's ``simulation.torch_angle_tolerance_deg``;
 * ``selection`` (when actuators were chosen from a catalogue, :mod:`sim.analysis.selection`):
   per joint, the chosen pair's smallest margin, %; fails when no pair serves the joint.
 
@@ -67,9 +72,11 @@ class RunCheck:
 
 def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], spec: RobotSpec,
                tracking_tolerance_deg: float, sizing: SizingResult | None = None,
-               clearance_mm: float = 5.0, selection: Any = None) -> list[RunCheck]:
-    """Every check of a run (module docstring): joint by joint, then collisions, clearance and
-    the actuator selection when one was made."""
+               clearance_mm: float = 5.0, selection: Any = None, *,
+               torch_angle_tolerance_deg: float) -> list[RunCheck]:
+    """Every check of a run (module docstring): joint by joint, then collisions, clearance,
+    the Cartesian phases' speeds, the weld phases' torch angles, the weaves and the actuator
+    selection when one was made."""
     checks: list[RunCheck] = []
     track = np.degrees(np.max(np.abs(np.asarray(arrays["q"]) - arrays["q_ref"]), axis=0))
     speed = np.degrees(np.max(np.abs(np.asarray(arrays["qd"])), axis=0))
@@ -102,6 +109,7 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
         checks.append(RunCheck("cartesian_speed", "", dev, 1.0, "% off the set speed",
                                dev <= 1.0, subject=f"{c['phase']}: {c['cruise_mm_s']:.4g} mm/s "
                                f"for {c['set_mm_s']:.4g} mm/s"))
+    checks += torch_angle_checks(summary, torch_angle_tolerance_deg)
     for w in summary.get("weave", ()):
         # a weave the arm does not reproduce (too fast for the joints' polynomial or the
         # servos): warnings, the weld still ran
@@ -142,6 +150,23 @@ def motion_checks(summary: Mapping[str, Any], clearance_mm: float) -> list[RunCh
         checks.append(RunCheck("clearance", "", float(value), float(clearance_mm), "mm",
                                bool(value >= clearance_mm), severity="warning",
                                subject=str(c["phase"])))
+    return checks
+
+
+def torch_angle_checks(summary: Mapping[str, Any], tolerance_deg: float) -> list[RunCheck]:
+    """The ``torch_angle`` checks (errors): one per weld phase along a seam in the summary's
+    ``"weld"``, its worst torch axis error outside the corner zones against ``tolerance_deg``."""
+    checks = []
+    for w in summary.get("weld", ()):
+        if w.get("seam") is None:
+            continue
+        err = float(w["torch_angle_error_deg"])
+        at = "" if w["t_worst_angle_s"] is None else f" at {w['t_worst_angle_s']:.3f} s"
+        checks.append(RunCheck(
+            "torch_angle", "", err, float(tolerance_deg), "deg", err <= tolerance_deg,
+            subject=f"{w['phase']}: seam {w['seam']}, worst{at}; work angle up to "
+            f"{w['work_angle_error_deg']:.3g} deg off, travel angle up to "
+            f"{w['travel_angle_error_deg']:.3g} deg off"))
     return checks
 
 

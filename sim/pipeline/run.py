@@ -267,7 +267,9 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
         checks = run_checks(arrays, summary, scenario.robot,
                             scenario.simulation.tracking_tolerance_deg, sizing,
                             clearance_mm=scenario.simulation.clearance_mm,
-                            selection=selected)
+                            selection=selected,
+                            torch_angle_tolerance_deg=(
+                                scenario.simulation.torch_angle_tolerance_deg))
         summary["checks"] = [c.to_dict() for c in checks]
         summary["verdict"] = verdict(checks)
         summary["warnings"] = warnings_count(checks)
@@ -443,11 +445,16 @@ def add_collisions(summary: dict[str, Any], built: BuiltCell, motion: Any,
     the summary."""
     import time
 
-    from sim.simulation.collisions import check_motion, phase_seams, samples_from_arrays
+    from sim.simulation.collisions import (
+        check_motion,
+        phase_seams,
+        phase_weaves,
+        samples_from_arrays,
+    )
 
     start = time.perf_counter()
     report = check_motion(built, samples_from_arrays(arrays), [pm.name for pm in motion.phases],
-                          phase_seams(motion))
+                          phase_seams(motion), weaves=phase_weaves(motion))
     summary["collisions"] = report.collisions
     summary["clearance"] = report.clearance
     summary["allowed_contacts"] = report.allowed
