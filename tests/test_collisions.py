@@ -241,11 +241,12 @@ def test_wire_in_the_pool_is_allowed_with_the_arc_on_the_nozzle_never():
     assert "robot/tool/wire" in plate[0]["all_geoms"]
 
 
-def test_wire_touching_with_the_arc_off_only_up_to_its_radius():
-    """Arc off: the wire may touch a workpiece up to its radius (0.6 mm: touch sensing, a tip
-    in a fillet's corner); 1 mm deep is a collision from the first sample."""
-    assert _wire_sinks([0.5], arc_on=False) == []
-    found = _wire_sinks([1.0, 30.0], arc_on=False)
+def test_wire_touching_with_the_arc_off_only_up_to_its_touch_depth():
+    """Arc off: the wire may touch a workpiece up to its radius + the torch's touch depth
+    (0.6 + 0.5 mm: touch sensing, the tip set on the root); 1.5 mm deep is a collision from the
+    first sample."""
+    assert _wire_sinks([0.5, 1.0], arc_on=False) == []
+    found = _wire_sinks([1.5, 30.0], arc_on=False)
     assert found and found[0]["t0"] == 0.0
     assert found[0]["bodies"] == ["robot/tool/torch", "base_plate"]
     assert found[0]["depth_mm"] > 10.0 and "robot/tool/wire" in found[0]["all_geoms"]

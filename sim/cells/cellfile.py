@@ -24,6 +24,12 @@ Seam torch angles (AWS A3.0 terms; the file's convention, converted for :class:`
   (the torch points ahead), negative = drag.
 
 :class:`Seam` measures its work angle from the normal, so it receives ``90 - work_angle_deg``.
+
+A seam's ``ctwd_mm`` (contact-tip-to-work distance; ``stickout_mm`` is the same distance under
+its older name, and a seam gives at most one of the two) becomes its stand-off,
+``Seam.standoff_m = ctwd - the torch's nominal stick-out``: the tool point (the wire tip at the
+nominal stick-out) then runs that far back from the seam along the torch axis, on lines, arcs
+and polylines alike (:mod:`sim.cells.seam`).
 """
 
 from __future__ import annotations
@@ -46,7 +52,12 @@ from sim.cells.compose import (
     quat_from_matrix,
 )
 from sim.cells.seam import Seam
-from sim.cells.tools import CONTACT_FIXTURE, CONTACT_PART_AFFINITY, CONTACT_PART_TYPE
+from sim.cells.tools import (
+    CONTACT_FIXTURE,
+    CONTACT_PART_AFFINITY,
+    CONTACT_PART_TYPE,
+    ToolSpec,
+)
 from sim.core.rotations import euler_zyx_to_matrix
 from sim.core.tomlschema import Strict, load_toml
 from sim.errors import CellError, CellsimError
@@ -128,6 +139,7 @@ class SeamBlock(Strict):
     travel_angle_deg: float = Field(0.0, gt=-90, lt=90)
     lean: Literal["left", "right"] = "left"
     stickout_mm: float | None = Field(None, gt=0, le=100)
+    ctwd_mm: float | None = Field(None, gt=0, le=100)
     joins: list[str] = []
     description: str = ""
 
@@ -431,10 +443,14 @@ def read_cell_file(path: str | Path) -> CellFile:
                 raise CellError(f"{key}.normal: {np.round(sb.normal, 6).tolist()} runs along the "
                                 f"seam ({label}); the reference surface's normal must be across "
                                 "the seam")
-        if sb.kind == "arc" and sb.stickout_mm is not None:
+        if sb.stickout_mm is not None and sb.ctwd_mm is not None:
+            raise CellError(f"{key}.ctwd_mm: give one of stickout_mm or ctwd_mm (both set the "
+                            "contact-tip-to-work distance)")
+        dist_key = _ctwd_key(sb)
+        if sb.kind == "arc" and dist_key is not None:
             axis = seam.normal
             if abs(abs(axis @ seam.surface_normal) - 1.0) > 1e-6:
-                raise CellError(f"{key}.stickout_mm: on an arc a stick-out other than the tool's "
+                raise CellError(f"{key}.{dist_key}: on an arc a stand-off other than the tool's "
                                 "needs the normal along the arc's axis (the torch then keeps its "
                                 "posture to the circle, and the tool point runs a coaxial arc)")
     for i, sl in enumerate(spec.slots):
@@ -483,6 +499,35 @@ def _seam_points(sb: SeamBlock, key: str) -> NDArray[np.float64]:
     if not np.all(np.isfinite(pts)):
         raise CellError(f"{key}.points_mm: must be finite numbers")
     return pts
+
+
+def _ctwd_key(sb: SeamBlock) -> str | None:
+    """The key that sets a seam's contact-tip-to-work distance (``ctwd_mm`` or its synonym
+    ``stickout_mm``), or None."""
+    if sb.ctwd_mm is not None:
+        return "ctwd_mm"
+    return "stickout_mm" if sb.stickout_mm is not None else None
+
+
+def _standoff(sb: SeamBlock, i: int, tool: ToolSpec | None, where: str) -> float:
+    """A seam's stand-off, m (:mod:`sim.cells.seam`): its contact-tip-to-work distance less
+    the torch's nominal stick-out; 0 when the seam gives none.
+
+    Raises:
+        CellError: The distance is shorter than the nominal stick-out: the modelled wire (that
+            long) would reach into the work.
+    """
+    key = _ctwd_key(sb)
+    if key is None:
+        return 0.0
+    ctwd = float(getattr(sb, key)) * 1e-3
+    if tool is None or tool.kind != "torch":
+        return ctwd
+    try:
+        return tool.standoff(ctwd)
+    except CellsimError as exc:
+        raise CellError(f"{where}: seams[{i}].{key}: {exc}; give at least the nominal, or a "
+                        "tool with a shorter stickout_mm") from None
 
 
 def _seam_in_world(sb: SeamBlock, T_obj: NDArray[np.float64], pts: NDArray[np.float64], *,
@@ -654,10 +699,9 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
                 objects[name] = geoms
     seams: dict[str, Seam] = {}
     seam_objects: dict[str, tuple[str, ...]] = {}
-    nominal = rig.tool.stickout_m if rig.tool is not None and rig.tool.kind == "torch" else 0.0
     for i, sb in enumerate(spec.seams):
         obj = cf.solids[sb.object]
-        standoff = 0.0 if sb.stickout_mm is None else sb.stickout_mm * 1e-3 - nominal
+        standoff = _standoff(sb, i, rig.tool, cf.where)
         seam = _seam_in_world(sb, obj.pose, _seam_points(sb, f"seams[{i}]"),
                               tool_axis=rig.spec.family.approach_column,
                               world_from_frame0=T0, standoff=standoff)

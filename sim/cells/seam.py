@@ -35,11 +35,15 @@ Polylines are two or more points in travel order (:meth:`Seam.segments` gives th
 segments as line seams; welding one in a single pass with corner blending is the weld-programs
 issue's).
 
-**Stand-off** (``standoff_m``): a seam may ask for a contact-tip-to-work distance other than
-the tool's nominal stick-out (a cell file's per-seam ``stickout_mm``). The tool point (the wire
-tip at the nominal stick-out) then runs ``standoff_m = stickout - nominal`` back along the torch
-axis from the seam (:meth:`Seam.tcp_point`): the torch is farther from the work by that much
-and the wire reaches the seam.
+**Stand-off** (``standoff_m``): the tool point of a torch is the wire tip at the tool's nominal
+stick-out ``l0`` (the contact tip is ``l0`` behind it on the torch axis). A seam (a cell file's
+``ctwd_mm`` or ``stickout_mm``) or a weld phase (a scenario's ``ctwd_mm``) may ask for a
+contact-tip-to-work distance ``c`` other than ``l0``: the contact tip then stays ``c`` from the
+seam point along the torch axis, so the tool point runs ``standoff_m = c - l0`` back along the
+torch axis from the seam (:meth:`Seam.tcp_point`), ``p_tool = p_seam - standoff_m * a``. On a
+polyline every segment takes the stand-off along its own torch axis; where the axis turns at a
+corner, so does the stand-off (the tool point moves by ``standoff_m * (a_k - a_k+1)`` while the
+wire tip stays on the seam): give :meth:`Seam.tcp_point` the torch axis the motion commands there.
 """
 
 from __future__ import annotations
@@ -254,11 +258,19 @@ class Seam:
                      description=f"segment {k + 1} of {self.name}", standoff_m=self.standoff_m)
                 for k in range(len(self.points) - 1)]
 
-    def tcp_point(self, s: float) -> NDArray[np.float64]:
+    def tcp_point(self, s: float, axis: ArrayLike | None = None) -> NDArray[np.float64]:
         """Where the tool point goes at ``s``: the seam point moved ``standoff_m`` back along
-        the torch axis, world, m, (3,)."""
+        the torch axis, world, m, (3,).
+
+        ``axis``: the unit torch axis the motion commands at ``s`` where it is not the seam's
+        own (a polyline's corner zone, where the torch turns from one segment's posture to the
+        next); default :meth:`torch_axis`.
+        """
         p = self.point(s)
-        return p if self.standoff_m == 0.0 else p - self.standoff_m * self.torch_axis(s)
+        if self.standoff_m == 0.0:
+            return p
+        a = self.torch_axis(s) if axis is None else _unit(axis, f"seam {self.name!r} axis")
+        return p - self.standoff_m * a
 
     def tcp_points(self) -> NDArray[np.float64]:
         """The tool point's control points (:meth:`tcp_point` at the seam's own points): a

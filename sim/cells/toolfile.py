@@ -11,6 +11,7 @@ visual mesh::
     tcp_mm = [0, 0, 320]                # the wire tip at the nominal stick-out
     tcp_euler_zyx_deg = [0, 0, 0]       # tcp axes in the tool frame; the torch axis is the tcp +z
     stickout_mm = 15                    # torch: the wire (the tool's work geom), back from the tcp
+    touch_depth_mm = 0.5                # torch: the wire tip may press this far into the work
     [[shapes]]
     shape = "cylinder"
     from_mm = [0, 0, 0]
@@ -74,6 +75,7 @@ class ToolFileSpec(Strict):
     tcp_euler_zyx_deg: list[float] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
     stickout_mm: float = Field(15.0, gt=0, le=100)
     wire_diameter_mm: float = Field(1.2, gt=0, le=5)
+    touch_depth_mm: float = Field(0.5, ge=0, le=5)
     mesh: str | None = None
     mesh_unit: Literal["mm", "m"] = "mm"
     shapes: list[ShapeSpec] = Field(min_length=1)
@@ -179,6 +181,9 @@ def load_tool_file(path: str | Path) -> ToolSpec:
     if dup:
         raise CellError(f"{where}: shapes: the name {sorted(dup)[0]!r} is used twice (or is "
                         "reserved: 'wire' is the torch's wire, 'mesh' the visual mesh)")
+    if spec.kind != "torch" and "touch_depth_mm" in spec.model_fields_set:
+        raise CellError(f"{where}: touch_depth_mm: only a torch's wire touches the work "
+                        f"(kind = {spec.kind!r})")
     if (spec.com_mm is None) != (spec.inertia_kg_m2 is None):
         raise CellError(f"{where}: com_mm and inertia_kg_m2 go together (give both or neither)")
     if spec.inertia_kg_m2 is not None:
@@ -207,7 +212,8 @@ def load_tool_file(path: str | Path) -> ToolSpec:
         mass_kg=mass, length_m=float(np.linalg.norm(X[:3, 3])), kind=spec.kind,
         work_geoms=("wire",) if spec.kind == "torch" else (),
         tcp_in_tool=None if straight else tuple(tuple(float(v) for v in row) for row in X),
-        stickout_m=spec.stickout_mm * 1e-3, source=path.resolve(),
+        stickout_m=spec.stickout_mm * 1e-3, touch_depth_m=spec.touch_depth_mm * 1e-3,
+        source=path.resolve(),
         builder=_ToolBuilder(spec, mesh_path, X, wire_from, geoms))
 
 

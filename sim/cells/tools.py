@@ -40,8 +40,10 @@ aluminium), collision sensor r 34 mm 15-65 mm (0.939 kg, effective 5170 kg/m^3),
 With its default torch each robot's tcp is where the seed dimensions put it (100iB: l3 = 80 + 145 =
 225 mm; 5R: l3 = 100 + 300 = 400 mm), so ``sim/robots/registry.py``'s dims hold as they are in the welding
 cells. The 15 mm wire stick-out is the contact-tip-to-work distance usual for 1.0-1.2 mm wire in
-short-arc MAG welding. The hose package is not modelled (it hangs from the robot's arm). Torch
-geoms do not collide with anything (``contype = conaffinity = 0``): a welding torch never touches
+short-arc MAG welding. Touch sensing (the wire tip set on the root with the arc off) may press
+the tip up to ``touch_depth_m`` = 0.5 mm beyond the wire's radius into the work
+(:mod:`sim.simulation.collisions`). The hose package is not modelled (it hangs from the robot's
+arm). Torch geoms do not collide with anything (``contype = conaffinity = 0``): a welding torch never touches
 the work, and contact forces would pollute the joint torques used for motor sizing.
 
 ``vacuum_gripper`` - a single Ø40 mm suction cup on a stem, 100 mm from the flange face to the cup
@@ -80,6 +82,7 @@ import numpy as np
 from dm_control import mjcf
 
 from planners.registry import Registry
+from sim.errors import CellsimError
 
 #: Contact bit masks used across cellsim's cells (MuJoCo ``contype``/``conaffinity``): a contact
 #: is generated when ``(contype1 & conaffinity2) | (contype2 & conaffinity1)`` is non-zero.
@@ -129,6 +132,9 @@ class ToolSpec:
             ``tcp_euler_zyx_deg``); None for a straight tool (tcp at ``(0, 0, length_m)``,
             oriented as the tool frame).
         stickout_m: Nominal wire stick-out of a torch (contact tip to wire tip), m.
+        touch_depth_m: How far the wire tip of a torch may press into a workpiece beyond the
+            wire's radius with the arc off (touch sensing, the tip set on the root), m
+            (:mod:`sim.simulation.collisions`).
         source: The tool file, for a tool given as a file (:mod:`sim.cells.toolfile`).
         builder: Builds the tool's MJCF (a tool file's own); None for the shipped tools.
     """
@@ -142,6 +148,7 @@ class ToolSpec:
     work_geoms: tuple[str, ...] = ()
     tcp_in_tool: tuple[tuple[float, ...], ...] | None = None
     stickout_m: float = 0.015
+    touch_depth_m: float = 0.0005
     source: Path | None = None
     builder: Callable[[], object] | None = field(default=None, repr=False, compare=False)
 
@@ -149,6 +156,21 @@ class ToolSpec:
     def straight(self) -> bool:
         """The tcp lies on the flange axis, oriented as the tool frame."""
         return self.tcp_in_tool is None
+
+    def standoff(self, ctwd: float) -> float:
+        """The stand-off of a contact-tip-to-work distance ``ctwd`` (m) with this torch: ``ctwd``
+        less its nominal stick-out, m (how far its tool point keeps back from the seam,
+        :mod:`sim.cells.seam`).
+
+        Raises:
+            CellsimError: ``ctwd`` is shorter than the nominal stick-out: the modelled wire,
+                that long, would reach into the work (the message names no key: callers add it).
+        """
+        if ctwd < self.stickout_m - 1e-12:
+            raise CellsimError(f"{ctwd * 1e3:g} mm is shorter than the nominal stick-out of tool "
+                               f"{self.name!r}, {self.stickout_m * 1e3:g} mm: its wire would reach "
+                               f"{(self.stickout_m - ctwd) * 1e3:g} mm into the work")
+        return ctwd - self.stickout_m
 
     def tcp_pose(self) -> np.ndarray:
         """Pose of the tcp in the tool frame, (4, 4), m."""

@@ -26,7 +26,12 @@ import numpy as np
 
 from sim.errors import ReachError
 from sim.scenario import Scenario
-from sim.simulation.collisions import check_motion, phase_seams, samples_from_motion
+from sim.simulation.collisions import (
+    check_motion,
+    phase_seams,
+    phase_weaves,
+    samples_from_motion,
+)
 from sim.simulation.compile import build
 from sim.simulation.motion import Motion, build_motion, limit_violations
 
@@ -77,7 +82,7 @@ def check_scenario(scenario: Scenario, *, dt: float = CHECK_DT_S) -> CheckResult
     res.findings += _singular_passes(built, motion, dt=0.01)
     report = check_motion(built, samples_from_motion(built, motion, dt),
                           [pm.name for pm in motion.phases], phase_seams(motion),
-                          with_clearance=False)
+                          with_clearance=False, weaves=phase_weaves(motion))
     res.timings["check_s"] = time.perf_counter() - t0
     res.collisions = report.collisions
     for c in report.collisions:

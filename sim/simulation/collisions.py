@@ -18,11 +18,23 @@ What is checked (:class:`CollisionModel`):
 
 Allowed contacts are declared (:func:`allowed_contacts`), not guessed:
 
-* the tool's *work geoms* (:attr:`sim.cells.tools.ToolSpec.work_geoms`): the welding wire with
-  the workpieces of the seam the phase welds (:attr:`sim.cells.Cell.seam_objects`) while the
-  arc is on, up to its radius plus :data:`WIRE_ARC_DEPTH_M` deep (the tip in the pool), and with
-  any workpiece up to its radius with the arc off (touch sensing, the tip in a fillet's
-  corner); the cup lip with the part it picks (the nearest part holding the tool point when
+* the tool's *work geoms* (:attr:`sim.cells.tools.ToolSpec.work_geoms`): the welding wire
+  in the joint while the arc is on: with the workpieces of the seam the phase welds
+  (:attr:`sim.cells.Cell.seam_objects`), up to its radius, plus the phase's weave reach
+  (:func:`weave_reach`: the largest offset of its pattern from the path; moving a geom by a
+  vector ``d`` deepens its penetration of another by at most ``|d|``), plus
+  :data:`WIRE_ARC_DEPTH_M` (the tip in the pool); and at any time, arc off included, with any
+  workpiece up to its radius plus the torch's ``touch_depth_m`` (touch sensing: the tip set on
+  the root). A wire tip whose centre lies on the work's surface overlaps it by at most its
+  radius however the wire is tilted (a cylinder's rim: ``r sin(tilt)``; a 0.6 mm wire with its
+  tip on the corner line of two boxes, 45 deg work and 12 deg travel angle: 0.433 mm into each,
+  ``mj_geomDistance``). Each geom pair is measured and allowed on its own, so a tip in a
+  fillet's corner counts once per wall, never the sum, and no deeper than on one wall (a
+  pair's depth is the least translation that frees the wire from that geom alone). Deeper
+  means the tip's centre is in the work: 1 mm along the torch axis into that corner measures
+  1.125 mm (so does a root drawn where a bent part's faces would meet: that line lies
+  ``0.41 R`` deep in a bend of inside radius ``R``);
+  the cup lip with the part it picks (the nearest part holding the tool point when
   suction comes on), from the start of the phase before suction comes on (the descent) to the
   end of the phase after it goes off (the retract);
 * a part with the cell while it is not held (it rests), with another part while neither is
@@ -74,8 +86,9 @@ DETECTION_MARGIN_M = 1e-3
 CLEARANCE_RANGE_M = 0.1
 #: Period of the coarse scan (clearance, and the intervals a collision may hide in), s.
 CLEARANCE_STRIDE_S = 0.01
-#: Depth the welding wire may reach beyond its radius in the seam's workpiece while the arc is
-#: on (the tip in the weld pool, tracking included), m; the contact tip and nozzle never touch.
+#: Depth the welding wire may reach beyond its radius (and the phase's weave reach) in the seam's
+#: workpiece while the arc is on (the tip in the weld pool, tracking included), m; the contact
+#: tip and nozzle never touch.
 WIRE_ARC_DEPTH_M = 1e-3
 #: Depth a part may sink into what it rests on, is lifted off or set down on, or into the cup's
 #: lip, m: the soft contacts of the simulation sink by a fraction of this.
@@ -385,14 +398,27 @@ def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
     return true_runs(mask)
 
 
+def weave_reach(weave: Any) -> float:
+    """How far a weave (:class:`planners.weave.Weave`, or None) takes the tool point from its
+    path, m: the largest ``|(lateral, longitudinal)|`` offset of its pattern over a cycle (its
+    fade envelope is at most 1): the amplitude ``A`` for a sine, zigzag or circle,
+    ``sqrt(5) / 2 A`` for the triangle (``A`` across, ``A / 2`` behind); 0 without a weave."""
+    if weave is None:
+        return 0.0
+    lateral, longitudinal = weave.shape(np.linspace(0.0, 1.0, 401))  # the extremes at 1/4, 3/4
+    return float(np.max(np.hypot(lateral, longitudinal)))
+
+
 def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
-                     phase_seams: Sequence[str | None]) -> list[AllowedContact]:
+                     phase_seams: Sequence[str | None],
+                     weaves: Sequence[float] | None = None) -> list[AllowedContact]:
     """The contacts the work makes on purpose (module docstring), as declarations.
 
     Args:
         cm: The check model.
         samples: The sampled motion.
         phase_seams: The seam each phase follows (None when it follows none), by phase index.
+        weaves: Each phase's weave reach, m (:func:`phase_weaves`); None: no phase weaves.
     """
     built = cm.built
     cell = built.cell
@@ -404,23 +430,27 @@ def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
         all_work = frozenset().union(*(cm.ids(CELL, obj) for objs in cell.seam_objects.values()
                                        for obj in objs))
         radius = max(float(built.model.geom_size[g, 0]) for g in work)
-        # the wire in the weld pool of the seam it welds, while the arc is on
+        # the wire in the joint of the seam it welds, weaving included, while the arc is on
         for k, seam in enumerate(phase_seams):
             when = samples.arc_on & (samples.phase == k)
             if not when.any():
                 continue
             objs = cell.seam_objects.get(seam, ()) if seam is not None else ()
             pieces = (frozenset().union(*(cm.ids(CELL, o) for o in objs)) if objs else all_work)
+            reach = 0.0 if weaves is None else float(weaves[k])
+            depth = radius + reach + WIRE_ARC_DEPTH_M
+            weaving = f" + weave {reach * 1e3:.1f} mm" if reach > 0 else ""
             out.append(AllowedContact(
-                work, pieces, when, f"wire on the workpiece of seam {seam!r}, arc on (up to "
-                f"{(radius + WIRE_ARC_DEPTH_M) * 1e3:.1f} mm)",
-                max_depth_m=radius + WIRE_ARC_DEPTH_M))
-        # the wire touching a workpiece with the arc off: touch sensing, or its tip in the
-        # corner of a fillet at a seam's start or end (a wire of radius r whose tip centre is in
-        # a 90 deg corner overlaps both plates by r / sqrt(2)); deeper is a collision
+                work, pieces, when, f"wire in the joint of seam {seam!r}, arc on (up to "
+                f"{depth * 1e3:.1f} mm: radius{weaving} + {WIRE_ARC_DEPTH_M * 1e3:g} mm)",
+                max_depth_m=depth))
+        # the wire tip set on a workpiece, arc off included (touch sensing, the tip on the
+        # root at a seam's start or end); deeper is a collision
+        touch = cell.tool.touch_depth_m
         out.append(AllowedContact(work, all_work, np.ones(n, bool),
-                                  f"wire touching a workpiece (up to its radius, "
-                                  f"{radius * 1e3:.1f} mm)", max_depth_m=radius))
+                                  f"wire touching a workpiece (up to {(radius + touch) * 1e3:.1f} "
+                                  f"mm: radius + touch depth {touch * 1e3:g} mm)",
+                                  max_depth_m=radius + touch))
     # parts: at rest, lifted off, set down; the cup lip with the part it picks
     part_ids = {p: cm.ids(PART, p) for p in cell.parts}
     if not part_ids:
@@ -766,15 +796,16 @@ class CollisionReport:
 
 
 def check_motion(built: BuiltCell, samples: MotionSamples, phase_names: Sequence[str],
-                 phase_seams: Sequence[str | None], *, with_clearance: bool = True
-                 ) -> CollisionReport:
-    """Check a sampled motion for collisions (and clearance) on the cell's check model."""
+                 phase_seams: Sequence[str | None], *, with_clearance: bool = True,
+                 weaves: Sequence[float] | None = None) -> CollisionReport:
+    """Check a sampled motion for collisions (and clearance) on the cell's check model
+    (``weaves``: each phase's weave reach, m, :func:`phase_weaves`)."""
     if not np.all(np.isfinite(samples.qpos)):
         i = int(np.flatnonzero(~np.all(np.isfinite(samples.qpos), axis=1))[0])
         raise SimulationError(f"the motion has non-finite positions at t = {samples.t[i]:.6g} s: "
                               "no collision check is possible")
     cm = CollisionModel(built)
-    allowed = allowed_contacts(cm, samples, phase_seams)
+    allowed = allowed_contacts(cm, samples, phase_seams, weaves)
     scanned = coarse_scan(cm, samples.qpos, coarse_samples(samples))
     collisions = find_collisions(cm, samples, phase_names, allowed, scanned)
     clear = clearance(cm, samples, phase_names, allowed, scanned) if with_clearance else []
@@ -810,3 +841,8 @@ def samples_from_motion(built: BuiltCell, motion: Any, dt: float) -> MotionSampl
 def phase_seams(motion: Any) -> list[str | None]:
     """The seam each phase of a motion follows (None where it follows none)."""
     return [None if pm.seam is None else pm.seam.name for pm in motion.phases]
+
+
+def phase_weaves(motion: Any) -> list[float]:
+    """Each phase's weave reach, m (:func:`weave_reach`; 0 where it does not weave)."""
+    return [weave_reach(getattr(pm.phase, "weave", None)) for pm in motion.phases]
