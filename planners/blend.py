@@ -191,6 +191,33 @@ def _h(x):  # quintic smoothstep and its derivatives and integral
             60 * x * (1 - x) * (1 - 2 * x), x**4 * (2.5 - 3 * x + x * x))
 
 
+class CornerOrientation:
+    """The tool turning from one move's orientation to the next inside a corner blend: the
+    shortest rotation from ``start`` to ``end``, its angle a quintic smoothstep of the corner's
+    own parameter ``u`` (0..1 by arc length along the corner curve). The turn's rate and
+    acceleration are zero where the corner meets the moves, so the tool's angular velocity
+    and acceleration stay continuous there (a uniform slerp would jump both).
+
+    Args:
+        start, end: Tool frames where the corner leaves the first move and joins the next,
+            (3, 3).
+    """
+
+    name = "corner"
+
+    def __init__(self, start: ArrayLike, end: ArrayLike) -> None:
+        from planners.rotations import GeodesicOrientation
+
+        self._geo = GeodesicOrientation(start, end)
+        self.start, self.end, self.angle = self._geo.start, self._geo.end, self._geo.angle
+
+    def evaluate(self, u: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        u = np.asarray(u, dtype=float)
+        h, h1 = _h(u)[:2]
+        R, dR = self._geo.evaluate(h)
+        return R, dR * h1[..., None, None]
+
+
 @dataclass(frozen=True)
 class _Piece:
     t0: float
@@ -345,5 +372,13 @@ class TimeWindow:
         return self.base.at(self.t0 + t)
 
 
-__all__ = ["BlendCurve", "CompositeOrientation", "CompositePath", "PiecewiseProfile", "SubOrientation",
-           "SubPath", "TimeWindow"]
+__all__ = [
+    "BlendCurve",
+    "CompositeOrientation",
+    "CompositePath",
+    "CornerOrientation",
+    "PiecewiseProfile",
+    "SubOrientation",
+    "SubPath",
+    "TimeWindow",
+]

@@ -71,7 +71,7 @@ def test_bad_input_exit_code_2_one_line(args, fragment):
 
 @pytest.mark.parametrize("body, fragment", [
     ("name = 'x'\ndescription = 'd'\nrobot = 'robot_5r'\n[[phases]]\nname='a'\nplanner='434'\n"
-     "time_s=[0,1]\njoints_deg=[[0,0,0,0,0],[1,1,1,1,1]]\n", "at least 3"),
+     "time_s=[1]\njoints_deg=[[0,0,0,0,0]]\n", "at least 2"),
     ("name = 'x'\ndescription = 'd'\nrobot = 'robot_5r'\n[[phases]]\nname='a'\nplanner='443'\n"
      "time_s=[0,1,2]\njoints_deg=[[0,0,0,0,0],[1,1,1,1,1],[2,2,2,2,2]]\n", "phases[0].planner"),
     ("name = 'x'\ndescription = 'd'\nrobot = 'robot_5r'\n[[phases]]\nname='a'\nplanner='434'\n"

@@ -129,9 +129,6 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
                 raise ScenarioError(
                     f"{key}.time_s: after a {prev.kind} phase the start time is only known once "
                     "the motion is planned; give durations_s (and the knots after the start)")
-            if pspec.durations_s is not None and prev is None:
-                raise ScenarioError(
-                    f"{key}.durations_s: the first phase must give time_s and its start knot")
             phase = _build_joint_phase(i, pspec, robot, key)
             if (isinstance(prev, JointPhase) and prev.times is not None and phase.times is not None
                     and prev.target is None):
@@ -204,6 +201,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
             has_tool=tool_kind == "torch", weld_speed=spec.program_weld_speed_mm_s)
         program_warnings = tuple(warns)
         seen = {ph.name: k for k, ph in enumerate(phases)}
+    phases = _with_ctwd(phases, spec, tool, where)
     for i, a in enumerate(spec.actions):
         if (a.time_s is None) == (a.phase is None):
             raise ScenarioError(f"{where}: actions[{i}]: give exactly one of time_s or phase")
@@ -242,11 +240,10 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
         raise ScenarioError(f"{where}: give exactly one of time_s or durations_s")
     if spec.time_s is not None:
         times = np.asarray(spec.time_s, dtype=float)
-        if times.size < 3:
+        if times.size < 2:
             raise ScenarioError(
-                f"{where}.time_s: {times.size} knot time(s) given; a {spec.planner} phase needs "
-                "at least 3 (start, one via point, end); for a single move give "
-                "durations_s = [T] in a later phase")
+                f"{where}.time_s: {times.size} knot time given; a phase needs at least 2 "
+                "(start and end; a single move's joint-space midpoint becomes its via point)")
         steps = np.diff(times)
         if np.any(steps <= 0):
             k = int(np.argmax(steps <= 0)) + 1
@@ -362,7 +359,10 @@ def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
     if spec.to_seam is not None:
         if spec.frame != "frame0":
             raise ScenarioError(f"{where}.frame: only used with to_mm (a seam is in its cell)")
-        return PoseTarget(seam=spec.to_seam)
+        return _seam_target(spec, where)
+    for key in ("approach_mm", "retract_mm"):
+        if getattr(spec, key) is not None:
+            raise ScenarioError(f"{where}.{key}: only used with to_seam")
     if spec.to_mm is None:
         if spec.frame != "frame0":
             raise ScenarioError(f"{where}.frame: only used with to_mm")
@@ -374,6 +374,47 @@ def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
         rot = euler_zyx_to_matrix(*np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)))
     return PoseTarget(position=np.asarray(spec.to_mm, dtype=float) * 1e-3, rotation=rot,
                       frame=spec.frame)
+
+
+def _seam_target(spec: JointPhaseSpec | LinearPhaseSpec, where: str) -> PoseTarget:
+    """``to_seam`` with ``approach_mm`` (before its start) or ``retract_mm`` (back from its
+    end) along the seam's torch axis."""
+    if spec.approach_mm is not None and spec.retract_mm is not None:
+        raise ScenarioError(f"{where}: give one of approach_mm (before the seam's start) or "
+                            "retract_mm (back from its end)")
+    end = "end" if spec.retract_mm is not None else "start"
+    mm = spec.retract_mm if spec.retract_mm is not None else spec.approach_mm or 0.0
+    return PoseTarget(seam=spec.to_seam, seam_end=end, offset=mm * 1e-3)
+
+
+def _with_ctwd(phases: list[Phase], spec: ScenarioSpec, tool: Any, where: str) -> list[Phase]:
+    """The phases with the stand-off of each weld phase that gives ``ctwd_mm``: that distance
+    less the torch's nominal stick-out (:mod:`sim.cells.seam`).
+
+    Raises:
+        ScenarioError: ``ctwd_mm`` without a seam, without a torch, or shorter than the torch's
+            nominal stick-out (its modelled wire would reach into the work).
+    """
+    import dataclasses
+
+    out = list(phases)
+    for i, pspec in enumerate(spec.phases):
+        ctwd = getattr(pspec, "ctwd_mm", None)
+        if ctwd is None:
+            continue
+        key = f"{where}: phases[{i}].ctwd_mm"
+        if getattr(pspec, "seam", None) is None:
+            raise ScenarioError(f"{key}: only used with seam (the contact-tip-to-work distance "
+                                "of a pass along a seam)")
+        if tool is None or tool.kind != "torch":
+            raise ScenarioError(f"{key}: needs a torch (the tool is "
+                                f"{'none' if tool is None else tool.name})")
+        try:
+            standoff = tool.standoff(ctwd * 1e-3)
+        except CellsimError as exc:
+            raise ScenarioError(f"{key}: {exc}") from None
+        out[i] = dataclasses.replace(out[i], standoff=standoff)
+    return out
 
 
 def _weave(spec: LinearPhaseSpec | CircularPhaseSpec, where: str):
@@ -405,8 +446,9 @@ def _build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec
         raise ScenarioError(f"{where}.euler_zyx_deg: required with orientation = \"euler\"")
     if spec.euler_zyx_deg is not None and spec.orientation != "euler":
         raise ScenarioError(f"{where}.euler_zyx_deg: only used with orientation = \"euler\"")
-    if spec.orientation == "seam" and spec.seam is None:
-        raise ScenarioError(f"{where}.orientation: \"seam\" needs a seam to follow (seam = ...)")
+    if spec.orientation == "seam" and spec.seam is None and getattr(spec, "to_seam", None) is None:
+        raise ScenarioError(f"{where}.orientation: \"seam\" needs a seam to follow (seam = ...)"
+                            " or to go to (to_seam = ...)")
     common = dict(index=index, name=spec.name, kind=spec.kind, planner=spec.planner,
                   speed=spec.speed_mm_s * 1e-3, sample_period=spec.sample_period_s,
                   ramp=spec.ramp_s, orientation=spec.orientation, seam=spec.seam,
@@ -417,9 +459,21 @@ def _build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec
     if spec.seam is not None and spec.frame != "frame0":
         raise ScenarioError(f"{where}.frame: not used with seam (a seam is in its cell)")
     if isinstance(spec, LinearPhaseSpec):
-        if (spec.seam is None) == (spec.to_mm is None):
-            raise ScenarioError(f"{where}: give exactly one of seam or to_mm")
-        return CartesianPhase(**common, to=vec_m(spec.to_mm))
+        given = [k for k in ("seam", "to_mm", "to_seam") if getattr(spec, k) is not None]
+        if len(given) != 1:
+            raise ScenarioError(f"{where}: give exactly one of seam, to_mm or to_seam"
+                                + (f" (got {' and '.join(given)})" if given else ""))
+        if spec.to_seam is None:
+            for key in ("approach_mm", "retract_mm"):
+                if getattr(spec, key) is not None:
+                    raise ScenarioError(f"{where}.{key}: only used with to_seam")
+            return CartesianPhase(**common, to=vec_m(spec.to_mm))
+        if spec.frame != "frame0":
+            raise ScenarioError(f"{where}.frame: not used with to_seam (a seam is in its cell)")
+        if spec.weave is not None:
+            raise ScenarioError(f"{where}.weave: not used with to_seam (a move to or from a "
+                                "seam does not weave)")
+        return CartesianPhase(**common, target=_seam_target(spec, where))
     if spec.seam is not None:
         extra = [k for k in ("to_mm", "via_mm", "center_mm", "axis", "sweep_deg")
                  if getattr(spec, k) is not None]

@@ -16,6 +16,7 @@ from sim.scenario.schema import SimulationSpec, SizingSpec, VideoSpec
 
 if TYPE_CHECKING:
     from sim.cells import CellSpec
+    from sim.cells.seam import Seam
     from sim.cells.tools import ToolSpec
 
 
@@ -104,6 +105,10 @@ class PoseTarget:
         position: tcp position in ``frame``, m, (3,), or ``None`` with ``seam``.
         rotation: tcp orientation in ``frame``, (3, 3); ``None`` keeps the previous one.
         seam: A cell seam whose start (and torch posture) is the target.
+        seam_end: ``"start"`` or ``"end"``: which end of ``seam`` (``retract_mm`` gives the
+            end).
+        offset: Distance back from that end of the seam along its torch axis, m
+            (``approach_mm`` / ``retract_mm``).
         frame: Frame of ``position`` and ``rotation``: ``frame0`` (the robot's), ``world`` or a
             cell object's name.
         config: A TP program's configuration ``(flip, up, front, turn4, turn5, turn6)``: the
@@ -117,6 +122,8 @@ class PoseTarget:
     frame: str = "frame0"
     config: tuple | None = None
     flange: bool = False
+    seam_end: str = "start"
+    offset: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -141,6 +148,11 @@ class CartesianPhase:
         flange: ``to``/``via``/``euler_zyx`` are flange poses (a TP program's UT 0).
         via_euler_zyx: The via point's own orientation (a TP program's circular move; used to
             turn a flange via point into the tcp's), rad.
+        target: A linear move's end given by a seam (``to_seam``, with ``approach_mm`` or
+            ``retract_mm``): a :class:`PoseTarget` with ``seam``; ``to`` is then None.
+        standoff: The pass's own stand-off along ``seam``, m (its ``ctwd_mm`` less the torch's
+            nominal stick-out, :mod:`sim.cells.seam`); None: the seam's
+            (:meth:`seam_as_welded`).
     """
 
     index: int
@@ -165,6 +177,18 @@ class CartesianPhase:
     move_time: float | None = None
     flange: bool = False
     via_euler_zyx: NDArray[np.float64] | None = None
+    target: "PoseTarget | None" = None
+    standoff: float | None = None
+
+    def seam_as_welded(self, seam: Seam) -> Seam:
+        """The seam this phase welds: ``seam`` (the cell's seam named ``self.seam``) with the
+        phase's own stand-off where it gives ``ctwd_mm``, else as it is. A polyline's
+        :meth:`~sim.cells.seam.Seam.segments` carry that stand-off too."""
+        if self.standoff is None or self.standoff == seam.standoff_m:
+            return seam
+        import dataclasses
+
+        return dataclasses.replace(seam, standoff_m=self.standoff)
 
 
 @dataclass(frozen=True)

@@ -65,6 +65,12 @@ class JointPhaseSpec(_Strict):
     end_jerk_rad_s3: list[float] | None = None
     to_mm: Vec3 | None = None
     to_seam: str | None = None
+    approach_mm: float | None = Field(None, ge=0, le=5000, description="with to_seam: "
+                                      "stop this far before the seam's start, back along "
+                                      "its torch axis, mm")
+    retract_mm: float | None = Field(None, ge=0, le=5000, description="with to_seam: go "
+                                     "this far back from the seam's end along its torch "
+                                     "axis, mm")
     euler_zyx_deg: Vec3 | None = None
     frame: str = Field("frame0", description='frame of to_mm and euler_zyx_deg: "frame0", '
                        '"world" or a cell object')
@@ -97,6 +103,9 @@ class _CartesianSpec(_Strict):
     blend_mm: float | None = Field(None, ge=0, description="corner zone radius into the next "
                                    "Cartesian phase, mm (the tool does not stop)")
     weave: WeaveSpec | None = None
+    ctwd_mm: float | None = Field(None, gt=0, le=100, description="with seam: the "
+                                  "contact-tip-to-work distance of this pass, mm (default: "
+                                  "the seam's)")
     note: str | None = None
 
 
@@ -105,6 +114,14 @@ class LinearPhaseSpec(_CartesianSpec):
 
     kind: Literal["linear"]
     orientation: Literal["keep", "seam", "euler"] = "keep"
+    to_seam: str | None = Field(None, description="end at a seam's start (or, with "
+                                "retract_mm, back from its end) in its torch posture")
+    approach_mm: float | None = Field(None, ge=0, le=5000, description="with to_seam: "
+                                      "stop this far before the seam's start, back along "
+                                      "its torch axis, mm")
+    retract_mm: float | None = Field(None, ge=0, le=5000, description="with to_seam: go "
+                                     "this far back from the seam's end along its torch "
+                                     "axis, mm")
 
 
 class CircularPhaseSpec(_CartesianSpec):
@@ -169,6 +186,7 @@ class SimulationSpec(_Strict):
     enforce_accel_limits: bool = True
     motor_speed_limits: bool = True
     tracking_tolerance_deg: float = Field(0.1, gt=0, le=180)
+    torch_angle_tolerance_deg: float = Field(2.0, gt=0, le=180)
     clearance_mm: float = Field(5.0, ge=0, le=1000)
 
 

@@ -79,6 +79,10 @@ class PhaseMotion:
         knot_times: Knot times of the joint polynomial, s.
         programmed: Cartesian phases: the moves as programmed, one per move (a polyline seam
             has one per segment): :class:`ProgrammedMove`.
+        corner_zones: Phases along a seam: the stretches of the seam, as arc-length intervals
+            ``(s0, s1)`` in m from the seam's start, where the torch turns from one leg's
+            posture to the next (a polyline's blended corners); outside them the torch holds
+            the seam's work and travel angles. Empty for a line, an arc or a circle.
     """
 
     phase: Phase
@@ -89,6 +93,7 @@ class PhaseMotion:
     seam: Any = None
     knot_times: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     programmed: list = field(default_factory=list)
+    corner_zones: list[tuple[float, float]] = field(default_factory=list)
 
     @property
     def name(self) -> str:
@@ -293,6 +298,8 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     while todo:
         phase = todo.pop(0)
         label = f"{where}: phases[{phase.index}] ({phase.name})"
+        if isinstance(phase, CartesianPhase):
+            _check_seam_blends(phase, todo[0] if todo else None, context, label)
         if isinstance(phase, CartesianPhase) and (_blends(phase)
                                                   or _is_polyline(phase, context)):
             if context is None:
@@ -318,6 +325,7 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
                 qs = phase.q.copy()
                 qs[0] = context.home_q
                 phase = dataclasses.replace(phase, q=qs)
+                q = np.asarray(context.home_q, dtype=float)
             placed = phase.with_start(t, q)
             solved_end = None
             if pending is not None:  # the previous joint phase blends into this one
@@ -561,11 +569,7 @@ def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianCont
     assert tgt is not None
     T = np.eye(4)
     if tgt.seam is not None:
-        seam = _seam(ctx, tgt.seam, f"{label}.to_seam")
-        if getattr(ctx.kinematics.family, "approach_column", 2) == 0:
-            _check_five_axis_torch(seam, label, "to_seam", start_only=True)
-        T[:3, 3] = ctx.to_frame0(seam.tcp_point(0.0))
-        T[:3, :3] = ctx.rot_to_frame0(seam.torch_rotation(0.0))
+        T = _seam_pose(tgt, ctx, label)
     else:
         F = ctx.frame0_from(tgt.frame, label)
         T[:3, 3] = F[:3, :3] @ tgt.position + F[:3, 3]
@@ -595,6 +599,20 @@ def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianCont
     return np.asarray(good[0].q, dtype=float)
 
 
+def _seam_pose(tgt: Any, ctx: CartesianContext, label: str) -> NDArray[np.float64]:
+    """The tcp pose (frame 0) of a seam target: the seam's start or end tool point in its
+    torch posture there, moved ``tgt.offset`` back along the torch axis (``approach_mm``,
+    ``retract_mm``)."""
+    seam = _seam(ctx, tgt.seam, f"{label}.to_seam")
+    s = 0.0 if tgt.seam_end == "start" else seam.length()
+    if getattr(ctx.kinematics.family, "approach_column", 2) == 0:
+        _check_five_axis_torch(seam, label, "to_seam", at=(s,))
+    T = np.eye(4)
+    T[:3, 3] = ctx.to_frame0(seam.tcp_point(s) - tgt.offset * seam.torch_axis(s))
+    T[:3, :3] = ctx.rot_to_frame0(seam.torch_rotation(s))
+    return T
+
+
 def _config_text(c: tuple) -> str:
     return f"{c[0]} {c[1]} {c[2]}, {c[3]}, {c[4]}, {c[5]}"
 
@@ -620,9 +638,16 @@ def default_ramp(phase: CartesianPhase, p0: NDArray[np.float64], seam: Any,
 
 
 def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.float64],
-                ctx: CartesianContext, label: str) -> tuple[Any, Any]:
+                ctx: CartesianContext, label: str, *, corner: bool = False,
+                roll: float | None = None) -> tuple[Any, Any]:
     """The phase's ADNIA move (``CartesianTrajectory``, frame 0) from the tool pose ``p0``,
-    ``R0``, with its seam (or ``None``)."""
+    ``R0``, with its seam (or ``None``).
+
+    A move along a seam with ``orientation = "seam"`` takes the seam's torch frame at every
+    point (:class:`sim.simulation.seam_orientation.SeamOrientation`), keeping the roll about
+    the torch axis it arrives with. ``corner``: the move is a polyline's next leg, entered
+    through a corner that turns the torch (``R0`` is the previous leg's frame, not this leg's
+    start); ``roll`` is then the first leg's roll, kept on every leg."""
     from planners import adnia
 
     F = ctx.frame0_from(phase.frame, label)  # the phase's points are in this frame
@@ -632,6 +657,10 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
 
     to, via, center = pt(phase.to), pt(phase.via), pt(phase.center)
     axis = None if phase.axis is None else F[:3, :3] @ np.asarray(phase.axis, dtype=float)
+    seam_end_pose = None
+    if phase.target is not None:  # to_seam, with approach_mm / retract_mm
+        seam_end_pose = _seam_pose(phase.target, ctx, label)
+        to = seam_end_pose[:3, 3]
     if phase.flange and phase.euler_zyx is not None:  # UT 0: flange points to tcp points
         from sim.core.rotations import euler_zyx_to_matrix
 
@@ -657,12 +686,14 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
 
     seam = None
     if phase.seam is not None:
-        seam = _seam(ctx, phase.seam, f"{label}.seam")
+        seam = phase.seam_as_welded(_seam(ctx, phase.seam, f"{label}.seam"))
         if seam.kind != ("line" if phase.kind == "linear" else "arc"):
             raise ScenarioError(f"{label}.seam: {phase.seam!r} is a {seam.kind} seam; a "
                                 f"{phase.kind} phase needs a {'line' if phase.kind == 'linear' else 'arc'}")
         start = ctx.to_frame0(seam.tcp_point(0.0))
         gap = float(np.linalg.norm(start - p0))
+        if corner:  # a polyline's next leg: its tool path starts back along its own torch axis
+            p0, gap = start, 0.0
         if gap > 5e-4:
             raise ScenarioError(
                 f"{label}.seam: the tool is at {np.round(p0 * 1e3, 2).tolist()} mm (frame 0) but seam "
@@ -682,6 +713,8 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
         rot_end = F[:3, :3] @ euler_zyx_to_matrix(*phase.euler_zyx)
         if phase.flange:
             rot_end = rot_end @ ctx.flange_to_tcp[:3, :3]
+    elif phase.orientation == "seam" and seam_end_pose is not None:
+        rot_end = seam_end_pose[:3, :3]
     elif phase.orientation == "seam":
         rot_end = ctx.rot_to_frame0(seam.torch_rotation(seam.length()))
     kw: dict[str, Any] = dict(rotation_start=R0, orientation=mode,
@@ -703,11 +736,40 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
             cart = adnia.circle_move(center, axis, p0, phase.sweep, phase.speed, **kw)
     except PlannerError as exc:
         raise ScenarioError(f"{label}: {exc}") from None
+    if seam is not None and phase.orientation == "seam":
+        cart = _along_seam(cart, seam, R0, ctx, label, corner=corner, roll=roll)
     return cart, seam
 
 
+def _along_seam(cart: Any, seam: Any, R0: NDArray[np.float64], ctx: CartesianContext,
+                label: str, *, corner: bool, roll: float | None) -> Any:
+    """``cart`` with the seam's torch frame at every point (:func:`_phase_cart`)."""
+    from planners.adnia import CartesianTrajectory
+    from sim.simulation.seam_orientation import (
+        MAX_START_MISALIGNMENT_DEG,
+        SeamOrientation,
+        roll_about,
+    )
+
+    column = int(getattr(ctx.kinematics.family, "approach_column", 2))
+    to0 = ctx.frame0_from_world[:3, :3]
+    if roll is None:
+        roll = (roll_about(to0 @ seam.torch_rotation(0.0), R0, column) if column == 2 and not corner
+                else 0.0)
+    ramp_share = 0.5 * cart.speed * float(cart.profile.ramp_time) / cart.length
+    law = SeamOrientation(seam, to0, 0.0, seam.length(), column=column, roll=roll,
+                          start=None if corner else R0, settle=min(0.5, ramp_share))
+    if law.start_misalignment_deg > MAX_START_MISALIGNMENT_DEG:
+        raise ScenarioError(
+            f"{label}.seam: the torch arrives {law.start_misalignment_deg:.2f} deg off seam "
+            f"{seam.name!r}'s posture at its start (at most {MAX_START_MISALIGNMENT_DEG:g} deg "
+            "is corrected on the start ramp); end the previous phase in the seam's posture "
+            "(to_seam, with approach_mm to stop short of it)")
+    return CartesianTrajectory(cart.path, law, cart.profile)
+
+
 def _check_five_axis_torch(seam: Any, label: str, key: str = "seam",
-                           start_only: bool = False) -> None:
+                           at: tuple[float, ...] | None = None) -> None:
     """A 5-axis arm holds its torch in the vertical plane through J1 and the tool point: a
     seam's work and travel angles that leave that plane somewhere along it cannot be held.
     The error names the angle (work, travel or both), the seam point, and the nearest angles
@@ -715,7 +777,7 @@ def _check_five_axis_torch(seam: Any, label: str, key: str = "seam",
     from sim.robots.families.five_r import PLANE_TOL
 
     limit = float(np.degrees(np.arcsin(PLANE_TOL)))
-    for s in ([0.0] if start_only else np.linspace(0.0, seam.length(), 41)):
+    for s in (at if at is not None else np.linspace(0.0, seam.length(), 41)):
         dev = seam.plane_deviation_deg(float(s))
         if dev <= limit:
             continue
@@ -754,6 +816,9 @@ def _check_five_axis_torch(seam: Any, label: str, key: str = "seam",
 #: corner over about one sample spacing, overshooting by about 1 % of the amplitude at 48.
 SAMPLES_PER_WEAVE_CYCLE = 24
 SAMPLES_PER_BLEND = 8
+#: A corner that turns the torch gets an inverse-kinematics sample at least every this many
+#: degrees of the turn, so the joints follow the commanded frame through it.
+DEG_PER_CORNER_SAMPLE = 2.0
 
 
 def _weave_period(weave: Any) -> float:
@@ -866,6 +931,39 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
                        programmed=_programmed(base, phase.kind, base.speed))
 
 
+#: Where an exported polyline's corner zones begin and end, the TP points blend over this share
+#: of the shorter adjacent move (CNT20: the rounding stays near the zone's ends).
+ZONE_POINT_CNT = 0.2
+
+
+def _programmed_legs(legs: list[tuple[Any, float, float]]) -> list[ProgrammedMove]:
+    """A polyline phase as TP moves (``(cart, r_in, r_out)`` per leg): each leg from where its
+    incoming corner zone ends to where its outgoing one begins, holding the leg's torch frame,
+    and a move across each corner zone, in which the torch turns. A TP linear move interpolates
+    the orientation between its ends, so the corner points alone (one move per leg) would turn
+    the torch over the whole next leg; these points keep each leg's posture, as planned."""
+    def pose(cart: Any, s: float) -> NDArray[np.float64]:
+        T = np.eye(4)
+        T[:3, 3] = cart.path.evaluate(np.array([s]))[0][0]
+        T[:3, :3] = cart.orientation.evaluate(np.array([s / cart.length]))[0][0]
+        return T
+
+    stops = []  # (pose, length of the move that ends there)
+    at = pose(legs[0][0], 0.0)[:3, 3]
+    for cart, r_in, r_out in legs:
+        for s in ([r_in] if r_in > 0 else []) + [cart.length - r_out]:
+            T = pose(cart, s)
+            stops.append((T, float(np.linalg.norm(T[:3, 3] - at))))
+            at = T[:3, 3]
+    out = []
+    speed = legs[0][0].speed
+    for j, (T, length) in enumerate(stops):
+        nxt = stops[j + 1][1] if j + 1 < len(stops) else 0.0
+        blend = ZONE_POINT_CNT * CNT_SHARE * min(length, nxt) if nxt > 0 else 0.0
+        out.append(ProgrammedMove("linear", T, None, speed, blend, length, nxt))
+    return out
+
+
 #: A TP program's CNT100 blends over this share of the shorter of the two moves.
 CNT_SHARE = 0.45
 #: Largest turn of the path a corner blend may round at speed, deg (a near reversal would
@@ -879,7 +977,30 @@ POLYLINE_BLEND = 0.002
 
 
 def _blends(phase: CartesianPhase) -> bool:
-    return phase.blend > 0 or phase.blend_fraction > 0
+    """Whether the phase blends into the next one (a seam phase never does: it ends on its
+    seam's last point; a polyline's ``blend_mm`` rounds its own corners)."""
+    return phase.seam is None and (phase.blend > 0 or phase.blend_fraction > 0)
+
+
+def _check_seam_blends(phase: CartesianPhase, nxt: Phase | None,
+                       ctx: CartesianContext | None, label: str) -> None:
+    """A seam phase starts and ends on its seam's end points: no blend may cut them.
+
+    Raises:
+        ScenarioError: A line or arc seam phase with ``blend_mm``, or a phase blending into a
+            seam phase.
+    """
+    if phase.seam is not None and (phase.blend > 0 or phase.blend_fraction > 0) \
+            and not _is_polyline(phase, ctx):
+        raise ScenarioError(
+            f"{label}.blend_mm: a seam phase ends on its seam's last point (the arc goes off "
+            "there); a blend would cut it. To weld round a corner without stopping, make the "
+            "seam one polyline (its blend_mm rounds the inner corners); else leave blend_mm out")
+    if _blends(phase) and isinstance(nxt, CartesianPhase) and nxt.seam is not None:
+        raise ScenarioError(
+            f"{label}.blend_mm: the next phase {nxt.name!r} welds seam {nxt.seam!r}, which "
+            "starts on its first point; a blend into it would cut that point (leave blend_mm "
+            "out: the tool stops on the seam's start)")
 
 
 def _is_polyline(phase: CartesianPhase, ctx: CartesianContext | None) -> bool:
@@ -890,20 +1011,47 @@ def _is_polyline(phase: CartesianPhase, ctx: CartesianContext | None) -> bool:
 def _segments(phase: CartesianPhase, ctx: CartesianContext, label: str
               ) -> list[CartesianPhase]:
     """A linear phase along a polyline seam as one linear move per segment (the seam's
-    ``<name>/<i>`` line seams), blended at the corners by ``blend_mm`` (default
-    :data:`POLYLINE_BLEND`, at most 45 % of the shorter segment at each corner); the last keeps
-    the phase's own blend into the next phase."""
+    ``<name>/<i>`` line seams), blended at the inner corners by ``blend_mm`` (default
+    :data:`POLYLINE_BLEND`, at most 45 % of the shorter segment at each corner). The seam's
+    last point is never cut: the last segment stops there (blend 0)."""
     seam = ctx.seams[phase.seam]
     segs = seam.segments()
     corner = phase.blend if phase.blend > 0 else POLYLINE_BLEND
     out = []
     for i, sg in enumerate(segs):
+        r = 0.0
         if i + 1 < len(segs):
-            short = min(sg.length(), segs[i + 1].length())
-            r = min(corner, 0.45 * short)
-        else:
-            r = phase.blend
-        out.append(dataclasses.replace(phase, seam=sg.name, blend=r, weave=None))
+            r = min(corner, 0.45 * min(sg.length(), segs[i + 1].length()))
+        out.append(dataclasses.replace(phase, seam=sg.name, blend=r, blend_fraction=0.0,
+                                       weave=None))
+    return out
+
+
+#: Share of a joint's speed and acceleration limits a blended corner may use; a corner whose
+#: joint motion needs more (the torch turning fast in a small blend) is passed more slowly.
+CORNER_LIMIT_SHARE = 0.8
+#: Slowest a corner may be passed, as a share of the set speed, before it is refused as too
+#: sharp for its blend.
+MIN_CORNER_SPEED_SHARE = 0.02
+
+
+def _corner_load(joint: Any, t0: float, windows: dict[int, tuple[float, float]],
+                 robot: Any) -> dict[int, float]:
+    """Per corner (piece index -> its time window on the path's clock): the largest share of a
+    joint's speed or acceleration limit the joint reference uses there (acceleration as the
+    square root of its share, so both scale with the corner's speed)."""
+    if robot is None:
+        return {}
+    vlim = np.asarray(robot.max_speed, dtype=float)
+    alim = np.asarray(robot.max_accel, dtype=float) if robot.max_accel else None
+    out = {}
+    for i, (ta, tb) in windows.items():
+        pad = 0.25 * (tb - ta)
+        st = joint.at(t0 + np.linspace(ta - pad, tb + pad, 401))
+        load = float(np.max(np.abs(st.qd) / vlim))
+        if alim is not None:
+            load = max(load, float(np.sqrt(np.max(np.abs(st.qdd) / alim))))
+        out[i] = load
     return out
 
 
@@ -913,7 +1061,11 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     (:mod:`planners.blend`): one speed law without stops, one joint polynomial through the
     inverse kinematics of the whole path, each phase a time window of it (ending where its
     corner blend joins the next phase). A phase along a polyline seam is one window over its
-    segments, blended at the corners (:func:`_segments`)."""
+    segments, blended at the corners (:func:`_segments`): each leg holds the seam's torch
+    frame, and the torch turns from one leg's frame to the next inside the corner only
+    (:class:`planners.blend.CornerOrientation`). A corner whose joint motion would need more
+    than :data:`CORNER_LIMIT_SHARE` of a joint's speed or acceleration limit at the set speed
+    is passed more slowly (the speed dips inside the corner zone, and only there)."""
     # the moves: the phases, a polyline phase one move per segment (of: move -> its phase)
     moves, move_labels, of = [], [], []
     for j, (ph, lb) in enumerate(zip(phases, labels, strict=True)):
@@ -922,29 +1074,81 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
         move_labels += [lb] * len(parts)
         of += [j] * len(parts)
     ctx_seams = dict(ctx.seams)
-    for ph in phases:
+    welded = [None if ph.seam is None else ph.seam_as_welded(ctx.seams[ph.seam])
+              for ph in phases]
+    for ph, seam in zip(phases, welded, strict=True):
         if _is_polyline(ph, ctx):
-            for sg in ctx.seams[ph.seam].segments():
+            for sg in seam.segments():
                 ctx_seams[sg.name] = sg
     ctx = dataclasses.replace(ctx, seams=ctx_seams)
-    from planners import adnia
+    rolls: dict[int, float] = {}
+    for _ in range(len(moves)):  # first the legs' rolls, at the set speed
+        geo = _blend_geometry(moves, move_labels, of, ctx, q0, rolls)
+        fix = _wrist_roll(_time_blended(phases, labels, moves, of, geo, {}, t0, q0, ctx), geo,
+                          of, t0, ctx)
+        if not fix:
+            break
+        rolls.update(fix)
+    plan = _time_with_corner_speeds(phases, labels, moves, move_labels, of, geo, t0, q0, ctx)
+    carts, radii = geo.carts, geo.radii
+    n = len(moves)
+    out = []
+    times, bounds, windows = plan.times, plan.bounds, plan.windows
+    seams = welded
+    for k in range(len(phases)):
+        ta, tb = t0 + bounds[k], t0 + bounds[k + 1]
+        knots = times[(times >= ta - 1e-12) & (times <= tb + 1e-12)]
+        programmed = [mv for i, c in enumerate(carts) if of[i] == k
+                      for mv in _programmed(c, moves[i].kind, c.speed, radii[i],
+                                            carts[i + 1].length if i + 1 < len(carts) else 0.0)]
+        zones = []
+        if _is_polyline(phases[k], ctx):
+            programmed = _programmed_legs([(carts[i], radii[i - 1] if i and of[i - 1] == k
+                                            else 0.0, radii[i] if of[i] == k and i + 1 < n
+                                            and of[i + 1] == k else 0.0) for i in range(n)
+                                           if of[i] == k])
+            cum = np.r_[0.0, np.cumsum([sg.length() for sg in seams[k].segments()])]
+            legs = [i for i in range(n) if of[i] == k]
+            zones = [(float(cum[m + 1] - radii[i]), float(cum[m + 1] + radii[i]))
+                     for m, i in enumerate(legs[:-1])]
+        out.append(PhaseMotion(phases[k], float(ta), float(tb), plan.joint,
+                               cartesian=windows[k], seam=seams[k], knot_times=knots,
+                               programmed=programmed, corner_zones=zones))
+    return out
+
+
+@dataclass
+class _BlendGeometry:
+    carts: list[Any]
+    radii: list[float]
+    pieces: list[Any]
+    laws: list[Any]
+    owner: list[int]
+    path: Any
+
+
+def _blend_geometry(moves: list[CartesianPhase], move_labels: list[str], of: list[int],
+                    ctx: CartesianContext, q0: NDArray[np.float64],
+                    rolls: dict[int, float]) -> _BlendGeometry:
+    """The moves of a blended path (each a polyline leg's roll from ``rolls`` where given),
+    trimmed at their corners, the corner curves and the orientation laws."""
     from planners.blend import (
         BlendCurve,
-        CompositeOrientation,
         CompositePath,
-        PiecewiseProfile,
+        CornerOrientation,
         SubOrientation,
         SubPath,
-        TimeWindow,
     )
-    from planners.rotations import GeodesicOrientation
 
-    kin = ctx.kinematics
-    T0 = np.asarray(kin.fk(q0), dtype=float)
+    T0 = np.asarray(ctx.kinematics.fk(q0), dtype=float)
     p, R = T0[:3, 3], T0[:3, :3]
     carts = []
-    for move, label in zip(moves, move_labels, strict=True):
-        cart, _ = _phase_cart(move, p, R, ctx, label)
+    roll = None
+    for k, (move, label) in enumerate(zip(moves, move_labels, strict=True)):
+        leg = k > 0 and of[k] == of[k - 1]  # a polyline's next leg, entered through a corner
+        cart, _ = _phase_cart(move, p, R, ctx, label, corner=leg,
+                              roll=rolls.get(k, roll) if leg else None)
+        roll = getattr(cart.orientation, "roll", None)
         carts.append(cart)
         p = cart.path.evaluate(np.array([cart.length]))[0][0]
         R = cart.orientation.evaluate(np.array([1.0]))[0][0]
@@ -986,18 +1190,151 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
                 raise ScenarioError(f"{move_labels[k]}.blend_mm: {exc}") from None
             Ra = cart.orientation.evaluate(np.array([(L - r_out) / L]))[0][0]
             Rb = nxt.orientation.evaluate(np.array([r_out / nxt.length]))[0][0]
-            laws.append(GeodesicOrientation(Ra, Rb))
+            laws.append(CornerOrientation(Ra, Rb))
             owner.append(k)
-    path = CompositePath(pieces)
+    return _BlendGeometry(carts, radii, pieces, laws, owner, CompositePath(pieces))
+
+
+def _time_with_corner_speeds(phases: list[CartesianPhase], labels: list[str],
+                             moves: list[CartesianPhase], move_labels: list[str], of: list[int],
+                             geo: _BlendGeometry, t0: float, q0: NDArray[np.float64],
+                             ctx: CartesianContext) -> _BlendedPlan:
+    """:func:`_time_blended`, each corner slowed until its joints stay within
+    :data:`CORNER_LIMIT_SHARE` of their limits (at most a few passes)."""
+    corner_speed: dict[int, float] = {}
+    for _ in range(12):
+        plan = _time_blended(phases, labels, moves, of, geo, corner_speed, t0, q0, ctx)
+        load = _corner_load(plan.joint, t0, plan.blend_t, ctx.robot)
+        over = {i: x for i, x in load.items() if x > CORNER_LIMIT_SHARE * (1 + 1e-6)}
+        if not over:
+            break
+        for i, x in over.items():
+            k = geo.owner[i]
+            v = corner_speed.get(i, min(moves[k].speed, moves[k + 1].speed))
+            v_new = v * max(0.25, CORNER_LIMIT_SHARE / x * 0.98)  # a quarter at most a pass
+            if v_new < MIN_CORNER_SPEED_SHARE * min(moves[k].speed, moves[k + 1].speed):
+                turn = float(np.degrees(geo.laws[i].angle))
+                raise ScenarioError(
+                    f"{move_labels[k]}.blend_mm: the corner into {moves[k + 1].name!r} is too "
+                    f"sharp for its {geo.radii[k] * 1e3:.3g} mm blend: the torch turns "
+                    f"{turn:.1f} deg there, which the joints cannot follow at "
+                    f"{MIN_CORNER_SPEED_SHARE * 100:g} % of the set speed; give a larger "
+                    "blend_mm (or stop at the corner)")
+            corner_speed[i] = v_new
+    return plan
+
+
+#: A polyline leg whose wrist comes closer than this to its singularity (|sin theta5|) is
+#: given another roll about the torch axis, where one keeps the wrist farther from it.
+WRIST_CLEARANCE = float(np.sin(np.radians(10.0)))
+#: Largest joint change between neighbouring samples of a corner before it counts as a wrist
+#: flip, rad.
+MAX_SAMPLE_STEP = float(np.radians(20.0))
+#: Rolls about the torch axis tried for such a leg, deg (relative to the roll it has).
+ROLL_CANDIDATES_DEG = (30.0, -30.0, 60.0, -60.0, 90.0, -90.0, 120.0, -120.0, 150.0, -150.0, 180.0)
+
+
+def _wrist_roll(plan: _BlendedPlan, geo: _BlendGeometry, of: list[int], t0: float,
+                ctx: CartesianContext) -> dict[int, float]:
+    """The roll about the torch axis is free on a 6-axis arm (the seam fixes the torch axis
+    only). A polyline leg entered through a corner whose joints pass near the wrist
+    singularity (the torch turning through it makes the wrist spin) gets the roll, among
+    :data:`ROLL_CANDIDATES_DEG`, that keeps the wrist farthest from it over the corner and
+    the leg (and no wrist flip, where the branch the inverse kinematics had would take a
+    joint out of its range). Returns the first such leg's new roll (move index -> rad), or
+    nothing."""
+    from planners.blend import CornerOrientation
+    from sim.robots.ik import ik_path
+    from sim.robots.jacobian import singularity_measures
+    from sim.simulation.seam_orientation import SeamOrientation
+
+    kin = ctx.kinematics
+    if getattr(kin.family, "approach_column", 2) != 2:
+        return {}
+
+    def clearance(q: NDArray[np.float64]) -> float:
+        """The wrist's least distance from its singularity along ``q`` (|sin theta5|), less
+        1 where the joints jump between neighbouring samples (a wrist flip: the branch the
+        inverse kinematics had runs into a joint's range)."""
+        m = singularity_measures(kin, q)
+        c = float(np.min(np.abs(m["wrist"]))) if "wrist" in m else 1.0
+        return c - float(np.max(np.abs(np.diff(q, axis=0))) > MAX_SAMPLE_STEP)
+
+    for i, (ta, _) in plan.blend_t.items():
+        k = geo.owner[i]
+        if of[k] != of[k + 1] or getattr(geo.carts[k + 1].orientation, "name", "") != "seam":
+            continue
+        t_leg_end = plan.blend_t.get(i + 2, (None,))[0]
+        if t_leg_end is None:
+            t_leg_end = float(plan.times[-1] - t0)
+        tb = plan.blend_t[i][1]
+        ts = np.r_[np.linspace(ta, tb, 81), np.linspace(tb, t_leg_end, 81)]
+        if clearance(plan.joint.at(t0 + ts).q) >= WRIST_CLEARANCE:
+            continue
+        q_a = plan.joint.at(t0 + ta).q
+        cart, nxt = geo.carts[k], geo.carts[k + 1]
+        law = nxt.orientation
+        r = geo.radii[k]
+        pa = geo.pieces[i].evaluate(np.array([0.0]))[0][0]
+        pb = geo.pieces[i].evaluate(np.array([geo.pieces[i].length]))[0][0]
+        Ra = cart.orientation.evaluate(np.array([(cart.length - r) / cart.length]))[0][0]
+        best, best_c = None, clearance(plan.joint.at(t0 + ts).q)
+        for d in ROLL_CANDIDATES_DEG:
+            cand = SeamOrientation(law.seam, law.to_frame0, law.s0, law.s1, column=2,
+                                   roll=law.roll + np.radians(d))
+            u = np.linspace(0.0, 1.0, 41)
+            corner = CornerOrientation(Ra, cand.evaluate(np.array([r / nxt.length]))[0][0])
+            poses = np.zeros((82, 4, 4))
+            poses[:, 3, 3] = 1.0
+            poses[:41, :3, :3] = corner.evaluate(u)[0]
+            poses[:41, :3, 3] = pa + u[:, None] * (pb - pa)
+            poses[41:, :3, :3] = cand.evaluate(u)[0]
+            poses[41:, :3, 3] = nxt.path.evaluate(u * nxt.length)[0]
+            try:
+                c = clearance(ik_path(kin, poses, q_start=q_a))
+            except CellsimError:
+                continue
+            if c > best_c + 1e-3:
+                best, best_c = law.roll + np.radians(d), c
+        if best is not None:
+            return {k + 1: float(best)}
+    return {}
+
+
+@dataclass
+class _BlendedPlan:
+    joint: Any
+    times: NDArray[np.float64]
+    bounds: list[float]
+    windows: list[Any]
+    blend_t: dict[int, tuple[float, float]]
+
+
+def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[CartesianPhase],
+                  of: list[int], geo: _BlendGeometry, corner_speed: dict[int, float],
+                  t0: float, q0: NDArray[np.float64], ctx: CartesianContext) -> _BlendedPlan:
+    """The time law of a blended path (each corner at ``corner_speed`` where given: the speed
+    dips over the corner's first third, holds, and recovers over its last third), the
+    phases' time windows, and the joint polynomial through the inverse kinematics of its
+    samples."""
+    from planners import adnia
+    from planners.blend import CompositeOrientation, PiecewiseProfile, TimeWindow
+
+    kin = ctx.kinematics
+    carts, pieces, laws, owner, path = geo.carts, geo.pieces, geo.laws, geo.owner, geo.path
     lengths = [pc.length for pc in pieces]
     changes = [(0.0, 0.0, moves[0].speed, float(carts[0].profile.ramp_time))]
     for i, pc in enumerate(pieces):
         if pc.kind == "blend":
             k = owner[i]
             va, vb = moves[k].speed, moves[k + 1].speed
-            if va != vb:
-                changes.append((float(path.starts[i] + pc.length / 2), va, vb,
-                                2.0 * pc.length / (va + vb)))
+            vc = corner_speed.get(i)
+            s0, ell = float(path.starts[i]), pc.length
+            if vc is not None and vc < min(va, vb):
+                changes.append((s0 + ell / 6, va, vc, 2.0 * (ell / 3) / (va + vc)))
+                changes.append((s0 + 5 * ell / 6, vc, vb, 2.0 * (ell / 3) / (vc + vb)))
+            elif va != vb:
+                changes.append((s0 + ell / 2, va, vb, 2.0 * ell / (va + vb)))
     changes.append((path.length, moves[-1].speed, 0.0, float(carts[-1].profile.ramp_time)))
     try:
         profile = PiecewiseProfile(changes, path.length)
@@ -1035,19 +1372,19 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
 
             win = WeavingTrajectory(win, phases[j].weave, kin.family.approach_column)
         windows.append(win)
-    n = m
-    seams = [ctx.seams.get(ph.seam) if ph.seam is not None else None for ph in phases]
     # samples: every period, at the phase ends, and at the weaves' turns
     period = min(ph.sample_period for ph in phases)
     extra = [np.array(bounds[1:-1])]
-    for t_a, t_b in blend_t.values():  # each corner sampled on its own
-        extra.append(np.linspace(t_a, t_b, SAMPLES_PER_BLEND + 1))
+    for i, (t_a, t_b) in blend_t.items():  # each corner sampled on its own, finer as it turns
+        turn = float(np.degrees(getattr(laws[i], "angle", 0.0)))
+        n_c = max(SAMPLES_PER_BLEND, int(np.ceil(turn / DEG_PER_CORNER_SAMPLE)))
+        extra.append(np.linspace(t_a, t_b, n_c + 1))
     for k, win in enumerate(windows):
         if phases[k].weave is not None:
             period = min(period, _weave_period(phases[k].weave))
             extra.append(bounds[k] + win.breakpoints())
     ts = _sample_times(profile.duration, period, np.concatenate(extra), labels[0])
-    which = np.clip(np.searchsorted(np.array(bounds), ts, side="right") - 1, 0, n - 1)
+    which = np.clip(np.searchsorted(np.array(bounds), ts, side="right") - 1, 0, m - 1)
     poses = np.zeros((len(ts), 4, 4))
     for k, win in enumerate(windows):
         sel = which == k
@@ -1059,14 +1396,4 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     times = t0 + ts
     placed = JointPhase(index=phases[0].index, name=phases[0].name, planner=phases[0].planner,
                         times=times, durations=np.diff(times), q=q_via)
-    joint = plan_phase(placed, "")
-    out = []
-    for k in range(n):
-        ta, tb = t0 + bounds[k], t0 + bounds[k + 1]
-        knots = times[(times >= ta - 1e-12) & (times <= tb + 1e-12)]
-        programmed = [mv for i, c in enumerate(carts) if of[i] == k
-                      for mv in _programmed(c, moves[i].kind, c.speed, radii[i],
-                                            carts[i + 1].length if i + 1 < len(carts) else 0.0)]
-        out.append(PhaseMotion(phases[k], float(ta), float(tb), joint, cartesian=windows[k],
-                               seam=seams[k], knot_times=knots, programmed=programmed))
-    return out
+    return _BlendedPlan(plan_phase(placed, ""), times, bounds, windows, blend_t)
