@@ -218,3 +218,49 @@ def test_ik_unknown_tool_lists_the_tools(capsys):
     assert main(["ik", "lrmate200ic5l", "500", "0", "300", "--tool", "torch9"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "mig_torch" in err and "vacuum_gripper" in err
+
+
+# ---------------------------------------------------------------------------- no solution
+#: DH tables [a mm, alpha deg, d mm, theta offset deg]: an ortho-parallel arm (closed form,
+#: OPW) and a UR5 (offset wrist: the numeric solver), Universal Robots' published table.
+OPW_DH_MM = [[75, -90, 330, 0], [300, 0, 0, -90], [75, -90, 0, 0], [0, 90, 320, 0],
+             [0, -90, 0, 0], [0, 0, 80, 0]]
+UR5_DH_MM = [[0, 90, 89.159, 0], [-425, 0, 0, 0], [-392.25, 0, 0, 0], [0, 90, 109.15, 0],
+             [0, -90, 94.65, 0], [0, 0, 82.3, 0]]
+
+
+def _dh_folder(root: Path, name: str, rows: list[list[float]]) -> Path:
+    folder = root / name
+    folder.mkdir()
+    (folder / "robot.toml").write_text(
+        f'name = "{name}"\n[kinematics]\nconvention = "dh"\ndh = {rows!r}\n'
+        f"[joints]\nrange_deg = {[[-170, 170]] * len(rows)!r}\n")
+    return folder
+
+
+@pytest.mark.parametrize("kind", ["shipped", "shipped_from_urdf", "robot_folder_opw",
+                                  "dh_numeric", "bare_urdf"])
+def test_a_pose_with_no_solution_exits_2_with_one_line_for_every_kind_of_robot(kind, capsys,
+                                                                                tmp_path):
+    """The same pose 3 m from the base, for each way of giving a robot: one line on stderr,
+    nothing on stdout, exit 2 (with and without --json). The same robot at a pose made by its
+    own forward kinematics (so it has a solution) exits 0 and lists it: the exit 2 is about
+    the pose, not the robot."""
+    from sim.robots.arm import load_arm
+
+    ref = {"shipped": "lrmate200ic5l", "shipped_from_urdf": "kr6r900_2",
+           "robot_folder_opw": str(_dh_folder(tmp_path, "opw_arm", OPW_DH_MM)),
+           "dh_numeric": str(_dh_folder(tmp_path, "ur5", UR5_DH_MM)),
+           "bare_urdf": str(REPO / "tests" / "data" / "kuka_kr6r700sixx.urdf")}[kind]
+    for extra in ([], ["--json"]):
+        code, out, err = _run(capsys, "ik", ref, "3000", "0", "500", *extra)
+        assert code == 2, (kind, out, err)
+        assert out == "" and err.count("\n") == 1, (kind, err)
+        assert "unreachable" in err or "no inverse-kinematics solution" in err, (kind, err)
+    q = np.deg2rad([10.0, 20.0, -15.0, 25.0, 30.0, 40.0])
+    fk = (kinematic_model(ROBOTS[ref]).fk if ref in ROBOTS else load_arm(ref).fk)(q)
+    a, b, g = np.rad2deg(matrix_to_euler_zyx(fk[:3, :3]))
+    code, out, err = _run(capsys, "ik", ref, *(f"{v:.9f}" for v in 1e3 * fk[:3, 3]),
+                          "--euler-zyx-deg", f"{a:.9f}", f"{b:.9f}", f"{g:.9f}", "--json")
+    assert code == 0, (kind, err)
+    assert json.loads(out)["solutions"], kind

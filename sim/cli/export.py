@@ -11,9 +11,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "export", help="write a scenario's motion as a FANUC TP program (.ls)",
         description="Plan SCENARIO (no simulation) and write its motion as a FANUC TP program "
                     "in ASCII form: J moves to joint positions, L and C moves to Cartesian "
-                    "positions with their CONFIG, FINE or CNT, Arc Start/End, WAIT. A scenario "
-                    "with `program = \"prog.ls\"` runs it back. An existing file is never "
-                    "replaced.")
+                    "positions with their CONFIG, FINE or CNT, Arc Start/End, WAIT, and Weave "
+                    "Sine/Circle ... Weave End with the weave schedules in prog.weave.toml "
+                    "beside the program. A scenario with `program = \"prog.ls\"` runs it back. "
+                    "An existing file is never replaced.")
     p.add_argument("scenario", metavar="SCENARIO",
                    help="a scenario file, or a shipped scenario's name (see `cellsim list`)")
     p.add_argument("--format", choices=["fanuc-ls"], default="fanuc-ls",
@@ -27,8 +28,8 @@ def run(args: argparse.Namespace) -> int:
     from sim.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
-    notes = write_program(scenario, args.out)
+    notes, written = write_program(scenario, args.out)
     for line in notes:
         print(f"note: {line}")
-    print(f"{scenario.name}: wrote {args.out}")
+    print(f"{scenario.name}: wrote {' and '.join(str(p) for p in written)}")
     return 0

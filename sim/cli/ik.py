@@ -6,7 +6,9 @@ angles in degrees, ``R = Rz(A) Ry(B) Rx(G)`` (seed 000 eq. 6); default: the tcp 
 the home configuration (q = 0). Solutions are printed best first (inside the joint ranges,
 then closest to home; see :mod:`sim.robots.ik`), in degrees, only the best unless
 ``--all``. For the 5-axis robots A is implied by the position: a disagreeing A is replaced
-(one note on stderr). ``--json`` prints::
+(one note on stderr). A pose with no solution is one line on stderr and exit code 2, for every
+kind of robot (shipped, a robot folder, an arm as data with a closed form or the numeric
+solver). ``--json`` prints::
 
     {"robot": str, "tool": str or null,
      "solutions": [{"joints_deg": [..], "within_limits": bool}]}
@@ -19,11 +21,12 @@ import json
 import math
 import sys
 import warnings
+from typing import NoReturn
 
 import numpy as np
 
 from sim.core.rotations import euler_zyx_to_matrix, make_transform
-from sim.errors import KinematicsError
+from sim.errors import KinematicsError, UnreachableError
 from sim.robots.ik import solve_ik
 from sim.robots.model import kinematic_model
 from sim.robots.registry import resolve_robot
@@ -76,6 +79,13 @@ def _print_solutions(sols, shown, show_all: bool, maker=None) -> None:
         print(f"  ({len(sols) - 1} more with --all)")
 
 
+def _no_solution(name: str, args: argparse.Namespace, how: str) -> NoReturn:
+    """An IK that found no solution is an unreachable pose for every kind of robot: one line,
+    exit 2 (the closed forms of the shipped robots raise the same error with the distance)."""
+    raise UnreachableError(f"{name}: pose unreachable: no inverse-kinematics solution for "
+                           f"X Y Z = {args.x:g} {args.y:g} {args.z:g} mm ({how})", 0.0)
+
+
 def _run_arm(args: argparse.Namespace) -> int:
     """``cellsim ik`` of an arm given as data (:mod:`sim.robots.arm`): the flange pose in the
     arm's base frame (a DH table's frame 0, a URDF's root link)."""
@@ -91,6 +101,11 @@ def _run_arm(args: argparse.Namespace) -> int:
     else:
         R = euler_zyx_to_matrix(*np.deg2rad(args.euler_zyx_deg))
     sols = arm.ik(make_transform(R, p))
+    how = {"opw": "closed form (OPW)", "five_r": "closed form (seed 000's 5R)"}.get(
+        arm.solver, f"numeric ({arm.why_numeric})")
+    if not sols:
+        _no_solution(arm.name, args, "numeric solver: none found in the joint ranges"
+                     if arm.solver == "numeric" else f"{arm.solver} solver")
     shown = sols if args.all else sols[:1]
     if args.json:
         print(json.dumps({"robot": arm.name, "solver": arm.solver, "tool": None,
@@ -98,8 +113,6 @@ def _run_arm(args: argparse.Namespace) -> int:
                                          "within_limits": bool(s.within_limits),
                                          "branch": s.branch} for s in shown]}))
         return 0
-    how = {"opw": "closed form (OPW)", "five_r": "closed form (seed 000's 5R)"}.get(
-        arm.solver, f"numeric ({arm.why_numeric})")
     print(f"{arm.name} ({arm.source}): {len(sols)} solution(s), {how}; joints "
           f"{' '.join(arm.chain.joint_names)} in deg")
     _print_solutions(sols, shown, args.all)
@@ -140,6 +153,8 @@ def run(args: argparse.Namespace) -> int:
         sols = solve_ik(model, make_transform(R, p))
     for w in caught:
         print(f"cellsim: warning: {w.message}", file=sys.stderr)
+    if not sols:
+        _no_solution(spec.name, args, "closed form")
     shown = sols if args.all else sols[:1]
     from sim.robots.maker import maker_joint_names, to_maker
 

@@ -11,7 +11,13 @@ that :mod:`sim.scenario.program` reads back to the same tool path at every progr
   polyline seam gives one per segment) to a Cartesian position in user frame 0 (frame 0), tool
   1 (the scenario's tool), with its CONFIG (:func:`sim.scenario.program.config_of`), ``FINE``
   or ``CNTx`` for a blend (``x = 100 r / (0.45 * the shorter move)``, what the import maps
-  back); a weave is not written (TP weaving is a controller option cellsim does not read);
+  back);
+* a weave (``sine`` or ``circle``) of a linear or circular phase: ``Weave Sine[n]`` (``Weave
+  Circle[n]``) before its moves and ``Weave End[n]`` after them, ``n`` a schedule of the weave
+  table written beside the program (``prog.weave.toml``,
+  :func:`sim.scenario.fanuc_ls.weave_table_path`), one schedule per distinct weave. A zigzag
+  or triangle weave has no TP pattern and is not written; a weave over a polyline seam's
+  several moves runs back on each move on its own (a note says so for both);
 * a hold phase: ``WAIT t(sec)``;
 * ``arc_on`` / ``arc_off`` actions at phase starts and ends: ``Arc Start[1]`` / ``Arc End[1]``
   (other tool actions are written as comments).
@@ -26,12 +32,22 @@ import numpy as np
 
 from sim.errors import CellsimError, ScenarioError
 from sim.scenario import Scenario
-from sim.scenario.fanuc_ls import LSMotion, LSOther, LSPosition, write_ls
+from sim.scenario.fanuc_ls import (
+    LSMotion,
+    LSOther,
+    LSPosition,
+    LSWeave,
+    WeaveSchedule,
+    weave_table_path,
+    write_ls,
+    write_weave_schedules,
+)
 from sim.scenario.model import CartesianPhase, HoldPhase, JointPhase
 
 
-def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str]]:
-    """The TP program text of ``scenario`` and notes on what it leaves out.
+def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
+    """The TP program text of ``scenario``, notes on what it leaves out, and the text of its
+    weave table (None when no phase weaves).
 
     Raises:
         ScenarioError: A motion the TP form cannot hold (one line).
@@ -39,7 +55,7 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str]]:
     from sim.core.rotations import matrix_to_euler_zyx
     from sim.robots.ik import solve_ik
     from sim.robots.maker import to_maker
-    from sim.scenario.program import CNT_SHARE, config_of
+    from sim.scenario.program import CNT_SHARE, TP_WEAVE_PATTERNS, config_of
     from sim.simulation.compile import build
     from sim.simulation.motion import build_motion, check_motion_limits
 
@@ -52,6 +68,18 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str]]:
     ins: list = [LSOther("uframe", 0), LSOther("utool", 1)]
     positions: dict[int, LSPosition] = {}
     vmax = np.asarray(robot.max_speed, dtype=float)
+
+    schedules: dict[int, WeaveSchedule] = {}
+    tp_pattern = {v: k for k, v in TP_WEAVE_PATTERNS.items()}
+
+    def schedule_of(weave) -> int:
+        """The number of the weave's schedule (a new one for a weave not yet written)."""
+        sch = WeaveSchedule(weave.frequency, weave.amplitude * 1e3, weave.dwell, weave.dwell)
+        for k, other in schedules.items():
+            if other == sch:
+                return k
+        schedules[len(schedules) + 1] = sch
+        return len(schedules)
 
     def add_pos(**kw) -> int:
         k = len(positions) + 1
@@ -104,8 +132,16 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str]]:
                 notes.append(f"{ph.name}: its via knots are not written (J to the end point)")
             ins.append(LSMotion("J", ("P", k), float(pct), "%", None, line=0))
         elif isinstance(ph, CartesianPhase):
-            if ph.weave is not None:
-                notes.append(f"{ph.name}: its weave is not written")
+            k_weave = None
+            if ph.weave is not None and ph.weave.pattern not in tp_pattern:
+                notes.append(f"{ph.name}: its {ph.weave.pattern} weave has no TP weave pattern "
+                             f"({', '.join(TP_WEAVE_PATTERNS)}): not written")
+            elif ph.weave is not None:
+                k_weave = schedule_of(ph.weave)
+                ins.append(LSOther("weave", LSWeave(tp_pattern[ph.weave.pattern], k_weave)))
+                if len(pm.programmed) > 1:
+                    notes.append(f"{ph.name}: its weave spans {len(pm.programmed)} TP moves; "
+                                 "run back, each move weaves on its own (fading in and out)")
             q_near = np.asarray(motion.at(pm.t0).q[0], dtype=float)
             for j, mv in enumerate(pm.programmed):
                 k = cart_pos(mv.end, q_end if mv.blend == 0 else q_near, f"{ph.name} end")
@@ -119,44 +155,67 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str]]:
                     ins.append(LSMotion("C", ("P", k), speed, "mm/sec", cnt, via=("P", kv)))
                 else:
                     ins.append(LSMotion("L", ("P", k), speed, "mm/sec", cnt))
+            if k_weave is not None:
+                ins.append(LSOther("weave_end", k_weave))
         for t, a in acts:
             if abs(t - pm.t1) < 1e-9 and a == "arc_off":
                 ins.append(LSOther("arc", "end"))
     name = "".join(c if c.isalnum() else "_" for c in scenario.name)[:36] or "PROG"
-    return write_ls(name, ins, positions, comment=scenario.name), notes
+    table = write_weave_schedules(schedules, name.upper()) if schedules else None
+    return write_ls(name, ins, positions, comment=scenario.name), notes, table
 
 
-def write_program(scenario: Scenario, out: str | Path) -> list[str]:
-    """Write the TP program of ``scenario`` to ``out`` (refusing to replace an existing file),
-    atomically. Returns the notes.
+def write_program(scenario: Scenario, out: str | Path) -> tuple[list[str], list[Path]]:
+    """Write the TP program of ``scenario`` to ``out``, and its weave table beside it when a
+    phase weaves (:func:`sim.scenario.fanuc_ls.weave_table_path`), each atomically, refusing
+    to replace an existing file. Returns the notes and the files written.
 
     Raises:
-        ScenarioError: ``out`` exists, or its folder does not.
+        ScenarioError: ``out`` or its weave table exists, or the folder does not.
     """
+    def refuse_existing(path: Path) -> None:
+        if path.exists():
+            raise ScenarioError(f"{path}: exists; cellsim does not overwrite files it did not "
+                                "write (choose another --out)")
+
+    out = Path(out)
+    refuse_existing(out)
+    if not out.parent.is_dir():
+        raise ScenarioError(f"{out.parent}: no such folder")
+    text, notes, table = export_fanuc_ls(scenario)
+    if table is None:
+        _write_new(out, text)
+        return notes, [out]
+    table_path = weave_table_path(out)
+    refuse_existing(table_path)
+    _write_new(table_path, table)  # the table first: the program never runs without it
+    try:
+        _write_new(out, text)
+    except ScenarioError:
+        table_path.unlink()
+        raise
+    return notes, [out, table_path]
+
+
+def _write_new(path: Path, text: str) -> None:
+    """Write ``text`` to a new file ``path`` atomically (a temporary file linked into place);
+    a file that appeared there meanwhile is never replaced."""
     import os
     import tempfile
 
-    out = Path(out)
-    if out.exists():
-        raise ScenarioError(f"{out}: exists; cellsim does not overwrite files it did not write "
-                            "(choose another --out)")
-    if not out.parent.is_dir():
-        raise ScenarioError(f"{out.parent}: no such folder")
-    text, notes = export_fanuc_ls(scenario)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     with os.fdopen(fd, "w", encoding="utf-8") as fh:
         fh.write(text)
     try:
-        os.link(tmp, out)  # fails if out appeared meanwhile: never replaced
+        os.link(tmp, path)  # fails if path appeared meanwhile: never replaced
     except FileExistsError:
         os.unlink(tmp)
-        raise ScenarioError(f"{out}: exists; cellsim does not overwrite files it did not "
+        raise ScenarioError(f"{path}: exists; cellsim does not overwrite files it did not "
                             "write") from None
     except OSError:
-        os.replace(tmp, out)
+        os.replace(tmp, path)
     else:
         os.unlink(tmp)
-    return notes
 
 
 __all__ = ["export_fanuc_ls", "write_program"]

@@ -12,6 +12,19 @@ silently; a malformed line is a one-line error with its line number):
   Start[6] ;``): ``Arc Start[...]``, ``Arc End[...]`` (others are warnings); the controller's
   form without the closing ``;`` is read too;
 * ``Arc Start[...]`` / ``Arc End[...]`` as instructions;
+* ArcTool's weave instructions: ``Weave Sine[n]`` (and ``Circle``, ``Figure 8``, ``Sine 2``,
+  ``L``) with a weave schedule number ``n``, or with the schedule's values written in
+  (``Weave Sine[1.5Hz,2.0mm,0.100s,0.100s]``: frequency, amplitude, right dwell, left dwell; the
+  units may be left out); ``Weave End`` and ``Weave End[n]``. The schedule table is a sidecar
+  file next to the program, ``<program>.weave.toml`` (:func:`weave_table_path`)::
+
+      [weave_schedules.1]
+      frequency_hz = 1.5
+      amplitude_mm = 2.0
+      dwell_right_s = 0.0
+      dwell_left_s = 0.0
+
+  :func:`read_ls` reads it when it is there (:func:`read_weave_schedules`);
 * ``UFRAME_NUM = n``, ``UTOOL_NUM = n``; ``WAIT x(sec)`` (and ``WAIT x sec``); comments
   (``!text``) and empty lines (``;``);
 * positions: Cartesian (``X, Y, Z`` mm, ``W, P, R`` deg: ``R = Rz(R) Ry(P) Rx(W)``, with
@@ -19,7 +32,8 @@ silently; a malformed line is a one-line error with its line number):
   numbers of J4, J5, J6) or joint (``J1 = ... deg``: the controller's joint convention), with
   their ``UF`` and ``UT``.
 
-:func:`parse_ls` gives a :class:`LSProgram`; :func:`write_ls` writes one.
+:func:`parse_ls` gives a :class:`LSProgram`; :func:`write_ls` writes one, and
+:func:`write_weave_schedules` its schedule table.
 """
 
 from __future__ import annotations
@@ -28,6 +42,9 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from pydantic import Field
+
+from sim.core.tomlschema import Strict, load_toml
 from sim.errors import ScenarioError
 
 
@@ -75,9 +92,31 @@ class LSMotion:
 
 
 @dataclass(frozen=True)
+class WeaveSchedule:
+    """A weave schedule of ArcTool, in the controller's units: frequency (Hz), amplitude (mm),
+    the dwells at the right and left extremes (s)."""
+
+    frequency_hz: float
+    amplitude_mm: float
+    dwell_right_s: float = 0.0
+    dwell_left_s: float = 0.0
+
+
+@dataclass(frozen=True)
+class LSWeave:
+    """A ``Weave <pattern>[..]`` instruction: the pattern as written (``"Sine"``,
+    ``"Circle"``, ``"Figure 8"``, ``"Sine 2"``, ``"L"``) and either a schedule number or the
+    schedule's values written in."""
+
+    pattern: str
+    schedule: int | None = None
+    values: WeaveSchedule | None = None
+
+
+@dataclass(frozen=True)
 class LSOther:
     """A non-motion instruction: ``("uframe", n)``, ``("utool", n)``, ``("wait", seconds)``,
-    ``("arc", "start" | "end")``."""
+    ``("arc", "start" | "end")``, ``("weave", LSWeave)``, ``("weave_end", n or None)``."""
 
     what: str
     value: object
@@ -87,13 +126,16 @@ class LSOther:
 @dataclass
 class LSProgram:
     """A parsed TP program: its name, instructions in order, positions by index, warnings
-    (``(line, text)`` for every instruction not run)."""
+    (``(line, text)`` for every instruction not run), and the weave schedules of its sidecar
+    table (``weave_table``: that file, None when there is none)."""
 
     name: str
     instructions: list = field(default_factory=list)
     positions: dict[int, LSPosition] = field(default_factory=dict)
     warnings: list[tuple[int, str]] = field(default_factory=list)
     path: Path | None = None
+    weave_schedules: dict[int, WeaveSchedule] = field(default_factory=dict)
+    weave_table: Path | None = None
 
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
@@ -107,6 +149,16 @@ _ARC = re.compile(r"^Arc\s+(Start|End)\s*\[[^\]]*\]\s*$", re.I)
 _FRAME = re.compile(r"^(UFRAME_NUM|UTOOL_NUM)\s*=\s*(\d+)\s*$", re.I)
 _WAIT = re.compile(rf"^WAIT\s+({_NUM})\s*\(?\s*sec\s*\)?\s*$", re.I)
 _LINE = re.compile(r"^\s*(\d+)\s*:\s*(.*?)\s*;?\s*$")
+#: ArcTool's weave patterns, as the instruction writes them (longest first for the match).
+WEAVE_PATTERNS = ("Figure 8", "Sine 2", "Circle", "Sine", "L")
+_WEAVE_ALT = "|".join(p.replace(" ", r"\s*") for p in WEAVE_PATTERNS)
+_WEAVE = re.compile(rf"^Weave\s+({_WEAVE_ALT})\s*\[\s*(.*?)\s*\]\s*$", re.I)
+_WEAVE_END = re.compile(r"^Weave\s+End\s*(?:\[\s*(\d+)\s*\])?\s*$", re.I)
+#: The values of ``Weave Sine[f, a, r, l]``: name and unit (the unit may be left out).
+_WEAVE_VALUES = (("frequency", "Hz"), ("amplitude", "mm"), ("right dwell", "s"),
+                 ("left dwell", "s"))
+#: Highest weave frequency cellsim runs, Hz (as a scenario's ``[phases.weave]``).
+MAX_WEAVE_HZ = 20.0
 
 
 def _speed(value: str, unit: str, path, line: int) -> tuple[float, str]:
@@ -227,6 +279,15 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
             if ma:
                 prog.instructions.append(LSOther("arc", ma.group(1).lower(), ln))
                 continue
+            mwe = _WEAVE_END.match(body)
+            if mwe:
+                prog.instructions.append(LSOther(
+                    "weave_end", None if mwe.group(1) is None else int(mwe.group(1)), ln))
+                continue
+            mwv = _WEAVE.match(body)
+            if mwv:
+                prog.instructions.append(LSOther("weave", _weave(mwv, path, ln), ln))
+                continue
             mf = _FRAME.match(body)
             if mf:
                 what = "uframe" if mf.group(1).upper() == "UFRAME_NUM" else "utool"
@@ -268,6 +329,42 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
     if not prog.name:
         raise _err(path, 1, "no /PROG line (is this a TP program in ASCII form?)")
     return prog
+
+
+def _weave(m: re.Match, path, ln: int) -> LSWeave:
+    """A ``Weave <pattern>[..]`` instruction: a schedule number, or the four values written in
+    (frequency Hz, amplitude mm, right and left dwell s); a register argument is refused."""
+    written = " ".join(m.group(1).split())
+    pattern = next(p for p in WEAVE_PATTERNS if p.replace(" ", "").lower()
+                   == written.replace(" ", "").lower())
+    arg = m.group(2)
+    what = f"Weave {pattern}[{arg}]"
+    if re.fullmatch(r"\d+", arg):
+        if int(arg) < 1:
+            raise _err(path, ln, f"{what}: weave schedules are numbered from 1")
+        return LSWeave(pattern, schedule=int(arg))
+    if arg.upper().startswith("R["):
+        raise _err(path, ln, f"{what}: a register schedule number is not read (numeric "
+                   "registers are not in the program); write the number")
+    parts = [x.strip() for x in arg.split(",")]
+    if len(parts) != len(_WEAVE_VALUES):
+        raise _err(path, ln, f"{what}: a schedule number or 4 values (frequency Hz, amplitude "
+                   f"mm, right dwell s, left dwell s), got {len(parts)}")
+    values = []
+    for text, (name, unit) in zip(parts, _WEAVE_VALUES, strict=True):
+        mv = re.fullmatch(rf"({_NUM})\s*([A-Za-z]*)", text)
+        units = (unit.lower(), "sec") if unit == "s" else (unit.lower(),)
+        if not mv or (mv.group(2) and mv.group(2).lower() not in units):
+            raise _err(path, ln, f"{what}: the {name} is a number in {unit}, got {text!r}")
+        values.append(float(mv.group(1)))
+    freq, amp, right, left = values
+    if not 0.0 < freq <= MAX_WEAVE_HZ:
+        raise _err(path, ln, f"{what}: frequency {freq:g} Hz: 0 < f <= {MAX_WEAVE_HZ:g}")
+    if not amp > 0.0:
+        raise _err(path, ln, f"{what}: amplitude {amp:g} mm: must be > 0")
+    if right < 0.0 or left < 0.0:
+        raise _err(path, ln, f"{what}: a dwell is >= 0 s")
+    return LSWeave(pattern, values=WeaveSchedule(freq, amp, right, left))
 
 
 def _check_motion(mo: LSMotion, path, ln: int) -> None:
@@ -317,13 +414,68 @@ def _position(index: int, block: str, path, ln: int) -> LSPosition:
 
 
 def read_ls(path: str | Path) -> LSProgram:
-    """:func:`parse_ls` of a file (one-line error for a missing or unreadable file)."""
+    """:func:`parse_ls` of a file (one-line error for a missing or unreadable file), with the
+    weave schedules of its sidecar table when there is one (:func:`weave_table_path`)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8", errors="replace")
     except OSError as exc:
         raise ScenarioError(f"{path}: cannot read the TP program ({exc.strerror})") from None
-    return parse_ls(text, path)
+    prog = parse_ls(text, path)
+    table = weave_table_path(path)
+    if table.is_file():
+        prog.weave_schedules = read_weave_schedules(table)
+        prog.weave_table = table
+    return prog
+
+
+def weave_table_path(program: str | Path) -> Path:
+    """The weave schedule table of a program: ``prog.ls`` -> ``prog.weave.toml`` beside it.
+
+    A sidecar rather than a scenario key: on the controller the schedules are data of the
+    controller, not of the program, and ``cellsim export`` writes a program and its table as a
+    pair that any scenario naming the program runs as written."""
+    return Path(program).with_suffix(".weave.toml")
+
+
+class _ScheduleSpec(Strict):
+    frequency_hz: float = Field(gt=0, le=MAX_WEAVE_HZ)
+    amplitude_mm: float = Field(gt=0)
+    dwell_right_s: float = Field(0.0, ge=0)
+    dwell_left_s: float = Field(0.0, ge=0)
+
+
+class _WeaveTableSpec(Strict):
+    weave_schedules: dict[str, _ScheduleSpec]
+
+
+def read_weave_schedules(path: str | Path) -> dict[int, WeaveSchedule]:
+    """The schedules of a weave table file (module docstring), by number.
+
+    Raises:
+        ScenarioError: One line naming the file and the key.
+    """
+    path = Path(path)
+    spec, _ = load_toml(path, _WeaveTableSpec, ScenarioError)
+    out = {}
+    for key, s in spec.weave_schedules.items():
+        if not key.isdigit() or int(key) < 1:
+            raise ScenarioError(f"{path}: weave_schedules.{key}: schedule numbers are 1, 2, ...")
+        out[int(key)] = WeaveSchedule(s.frequency_hz, s.amplitude_mm, s.dwell_right_s,
+                                      s.dwell_left_s)
+    return out
+
+
+def write_weave_schedules(schedules: dict[int, WeaveSchedule], program: str) -> str:
+    """The weave table file of ``schedules`` (what :func:`read_weave_schedules` reads)."""
+    L = [f"# Weave schedules of {program} (ArcTool's weave schedule table): Weave Sine[n] "
+         "runs schedule n", ""]
+    for k in sorted(schedules):
+        s = schedules[k]
+        L += [f"[weave_schedules.{k}]", f"frequency_hz = {s.frequency_hz!r}",
+              f"amplitude_mm = {s.amplitude_mm!r}", f"dwell_right_s = {s.dwell_right_s!r}",
+              f"dwell_left_s = {s.dwell_left_s!r}", ""]
+    return "\n".join(L)
 
 
 def _fmt(v: float) -> str:
@@ -363,6 +515,10 @@ def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
             add(f"WAIT {float(ins.value):.3f}(sec)")
         elif ins.what == "arc":
             add(f"Arc {'Start' if ins.value == 'start' else 'End'}[1]")
+        elif ins.what == "weave":  # by schedule number (the table: write_weave_schedules)
+            add(f"Weave {ins.value.pattern}[{ins.value.schedule}]")
+        elif ins.what == "weave_end":
+            add("Weave End" if ins.value is None else f"Weave End[{ins.value}]")
         elif ins.what == "comment":
             add(f"!{ins.value}")
     L.append("/POS")
@@ -386,4 +542,6 @@ def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
     return "\n".join(L) + "\n"
 
 
-__all__ = ["LSMotion", "LSOther", "LSPosition", "LSProgram", "parse_ls", "read_ls", "write_ls"]
+__all__ = ["MAX_WEAVE_HZ", "WEAVE_PATTERNS", "LSMotion", "LSOther", "LSPosition", "LSProgram",
+           "LSWeave", "WeaveSchedule", "parse_ls", "read_ls", "read_weave_schedules",
+           "weave_table_path", "write_ls", "write_weave_schedules"]

@@ -29,6 +29,13 @@
 * ``PR[n]``: from the scenario's ``program_registers = { "1" = [X, Y, Z, W, P, R] }`` (mm,
   deg; configuration ``N U T, 0, 0, 0``).
 * ``WAIT x(sec)``: a hold phase.
+* ``Weave Sine[n]`` / ``Weave Circle[n]`` ... ``Weave End``: the L and C moves between them
+  weave (:class:`planners.weave.Weave`, ``"sine"`` / ``"circle"``) with schedule ``n`` of the
+  program's weave table (``prog.weave.toml``, :func:`sim.scenario.fanuc_ls.weave_table_path`) or
+  the values written in the instruction; each move weaves on its own (fading in and out over
+  its ramps or half a cycle, as a scenario phase does). The left and right dwells must be equal
+  (cellsim's weave holds one dwell at both extremes). J moves in between do not weave, and the
+  other patterns (``Figure 8``, ``Sine 2``, ``L``) are not run; a warning says so.
 
 CONFIG: ``N``/``F`` the sign of the controller's J5 (``F``: J5 < 0), ``U``/``D`` the elbow up
 or down, ``T``/``B`` the wrist centre in front of J1 or behind (the branch labels of
@@ -44,14 +51,23 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.core.rotations import euler_zyx_to_matrix
-from sim.errors import ScenarioError
-from sim.scenario.fanuc_ls import LSMotion, LSOther, LSPosition, LSProgram
+from sim.errors import PlannerError, ScenarioError
+from sim.scenario.fanuc_ls import (
+    LSMotion,
+    LSOther,
+    LSPosition,
+    LSProgram,
+    LSWeave,
+    weave_table_path,
+)
 from sim.scenario.model import Action, CartesianPhase, HoldPhase, JointPhase, PoseTarget
 
 #: Speed units of L and C moves in m/s per unit.
 SPEED_UNITS = {"mm/sec": 1e-3, "cm/min": 1e-2 / 60.0, "inch/min": 0.0254 / 60.0}
 #: CNT100 blends over this share of the shorter of the two moves.
 CNT_SHARE = 0.45
+#: ArcTool weave patterns cellsim runs, as the TP instruction writes them -> cellsim's pattern.
+TP_WEAVE_PATTERNS = {"Sine": "sine", "Circle": "circle"}
 
 
 def home_keyframe(robot) -> NDArray[np.float64]:
@@ -88,6 +104,7 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
     uf, ut = 0, 1
     n = robot.n_joints
     pending_start = False  # an Arc Start instruction waits for the next motion
+    weave = None  # the weave of the L and C moves, between Weave <pattern>[..] and Weave End
 
     def err(line: int, text: str) -> ScenarioError:
         return ScenarioError(f"{where}: program: {src}: line {line}: {text}")
@@ -124,6 +141,35 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
         x, y, z, w, p, r = pos.xyzwpr
         return np.array([x, y, z]) * 1e-3, rotation_wpr(w, p, r)
 
+    def weave_of(w: LSWeave, line: int):
+        """The :class:`planners.weave.Weave` of a weave instruction (None: not run)."""
+        from planners.weave import Weave
+
+        what = f"Weave {w.pattern}[{w.schedule}]" if w.values is None else f"Weave {w.pattern}"
+        if w.pattern not in TP_WEAVE_PATTERNS:
+            warnings.append(f"{src}: line {line}: {what}: pattern not simulated (cellsim runs "
+                            f"{', '.join(TP_WEAVE_PATTERNS)}); the moves until Weave End do not "
+                            "weave")
+            return None
+        sch = w.values if w.values is not None else prog.weave_schedules.get(w.schedule)
+        if sch is None and prog.weave_table is None:
+            raise err(line, f"{what}: no weave table {weave_table_path(src).name} next to the "
+                      f"program to hold schedule {w.schedule} (docs/scenario-format.md, FANUC "
+                      "TP programs)")
+        if sch is None:
+            have = ", ".join(map(str, sorted(prog.weave_schedules))) or "none"
+            raise err(line, f"{what}: no weave schedule {w.schedule} in "
+                      f"{prog.weave_table.name} (it has {have})")
+        if sch.dwell_left_s != sch.dwell_right_s:
+            raise err(line, f"{what}: right dwell {sch.dwell_right_s:g} s and left dwell "
+                      f"{sch.dwell_left_s:g} s differ; cellsim's weave holds one dwell at both "
+                      "extremes")
+        try:
+            return Weave(TP_WEAVE_PATTERNS[w.pattern], sch.amplitude_mm * 1e-3,
+                         sch.frequency_hz, sch.dwell_right_s)
+        except PlannerError as exc:
+            raise err(line, f"{what}: {exc}") from None
+
     motions = [ins for ins in prog.instructions if isinstance(ins, LSMotion)]
     if not motions:
         raise err(1, "no motion instruction")
@@ -151,6 +197,10 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                 if pending_start:  # the arc starts while the robot waits (a start dwell)
                     actions.append(Action("arc_on", None, phases[-1].name, "start"))
                     pending_start = False
+            elif ins.what == "weave":
+                weave = weave_of(ins.value, ins.line)
+            elif ins.what == "weave_end":
+                weave = None
             elif ins.what == "arc":
                 if not has_tool:
                     raise err(ins.line, "Arc Start/End needs a torch tool (the scenario's tool)")
@@ -185,6 +235,9 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                 cnt = None
         fraction = 0.0 if not cnt else cnt / 100.0
         if mo.kind == "J":
+            if weave is not None:
+                warnings.append(f"{src}: line {mo.line}: a J move between Weave and Weave End "
+                                "does not weave")
             pct = mo.speed / 100.0 if mo.unit == "%" else None
             move_time = mo.speed if mo.unit == "sec" else None
             q = np.full((3, n), np.nan)
@@ -227,7 +280,7 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                           planner="434", speed=speed, sample_period=0.1, ramp=None,
                           orientation="euler", to=p, frame=frame_name(mo.line),
                           euler_zyx=_zyx(R), blend_fraction=fraction, move_time=move_time,
-                          flange=ut == 0)
+                          flange=ut == 0, weave=weave)
             if mo.kind == "C":
                 via = position(mo.via, mo.line)
                 pv, Rv = cart(via, mo.line)
@@ -297,8 +350,8 @@ def frames_from_scenario(values: dict[str, str], where: str) -> dict[int, str]:
     return out
 
 
-__all__ = ["CNT_SHARE", "SPEED_UNITS", "frames_from_scenario", "home_keyframe",
-           "program_phases", "registers_from_scenario", "rotation_wpr"]
+__all__ = ["CNT_SHARE", "SPEED_UNITS", "TP_WEAVE_PATTERNS", "frames_from_scenario",
+           "home_keyframe", "program_phases", "registers_from_scenario", "rotation_wpr"]
 
 
 def config_of(robot, q: NDArray[np.float64], branch: str) -> tuple:
