@@ -1,6 +1,7 @@
 # cellsim: set-up and the two main commands.
 #   make run    set up everything, then run the default welding scenario
-#   make test   set up everything, then run the test suite
+#   make test   set up everything, then run the test suite (its fast share; make test-slow runs
+#               the slow share, which CI runs too)
 # Set-up is idempotent: system packages are installed only when missing, the virtual
 # environment is (re)built only when pyproject.toml changes.
 
@@ -14,13 +15,19 @@ PYTEST_ARGS ?=
 # Debian packages that headless rendering needs (EGL on Mesa, or OSMesa).
 SYSTEM_PACKAGES := libegl1 libgl1 libosmesa6 libglu1-mesa
 
-.PHONY: run test setup system-deps bench clean
+.PHONY: run test test-slow setup system-deps bench clean
 
 run: setup
 	$(BIN)/cellsim run $(SCENARIO) $(if $(OUT),--out $(OUT),)
 
+# The fast share (every test but those marked slow); test-slow runs the slow share (larger
+# generated campaigns, convergence studies), which .ci/run runs after the fast one.
 test: setup
-	@$(BIN)/python -m pytest $(PYTEST_ARGS); rc=$$?; \
+	@$(BIN)/python -m pytest -m "not slow" $(PYTEST_ARGS); rc=$$?; \
+	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
+
+test-slow: setup
+	@$(BIN)/python -m pytest -m slow $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
 bench: setup
