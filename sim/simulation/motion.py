@@ -827,6 +827,32 @@ def _weave_period(weave: Any) -> float:
     return weave.period / (SAMPLES_PER_WEAVE_CYCLE * (1 if smooth else 2))
 
 
+#: Most the tool frame or the path's direction may turn between neighbouring inverse-kinematics
+#: samples, deg: the joint polynomial through them follows a tool turning fast (a small
+#: circle) only if they are this close.
+MAX_TURN_PER_SAMPLE_DEG = 3.0
+
+
+def _turn_limited_period(cart: Any, period: float, label: str) -> float:
+    """``period`` shortened where the tool frame or the path's direction turns more than
+    :data:`MAX_TURN_PER_SAMPLE_DEG` between samples (the weave left out: it has its own)."""
+    ts = _sample_times(cart.duration, period, np.zeros(0), label)
+    st = cart.at(ts)
+    R = st.rotation
+    cos_r = (np.einsum("kij,kij->k", R[:-1], R[1:]) - 1.0) / 2.0
+    turn = np.arccos(np.clip(cos_r, -1.0, 1.0))
+    v = st.velocity
+    sp = np.linalg.norm(v, axis=1)
+    moving = (sp[:-1] > 1e-9) & (sp[1:] > 1e-9)
+    if np.any(moving):
+        d = np.einsum("ki,ki->k", v[:-1], v[1:]) / np.maximum(sp[:-1] * sp[1:], 1e-300)
+        turn = np.maximum(turn, np.where(moving, np.arccos(np.clip(d, -1.0, 1.0)), 0.0))
+    worst = float(np.degrees(turn.max())) if turn.size else 0.0
+    if worst <= MAX_TURN_PER_SAMPLE_DEG:
+        return period
+    return period / float(np.ceil(worst / MAX_TURN_PER_SAMPLE_DEG))
+
+
 def _sample_times(duration: float, period: float, extra: NDArray[np.float64],
                   label: str) -> NDArray[np.float64]:
     """Sample times over ``[0, duration]``: every ``period`` and at the ``extra`` times (the
@@ -856,14 +882,43 @@ def _sample_times(duration: float, period: float, extra: NDArray[np.float64],
     return ts
 
 
+#: Least joint change between neighbouring inverse-kinematics samples that counts as a change
+#: of branch (a wrist flip, a whole turn) rather than motion, deg; larger where the joint's
+#: speed limit covers more in the samples' spacing.
+BRANCH_JUMP_DEG = 90.0
+
+
 def _ik_knots(kin: Any, ts: NDArray[np.float64], poses: NDArray[np.float64],
-              q0: NDArray[np.float64], label: str) -> NDArray[np.float64]:
+              q0: NDArray[np.float64], label: str, robot: Any = None,
+              one_branch: bool = True) -> NDArray[np.float64]:
+    """Joint via points of the tool poses ``poses`` at times ``ts``, continuing from ``q0``
+    (``one_branch = False``: a trial plan, jumps between branches let through).
+
+    Raises:
+        ReachError: A pose is out of reach, or the path cannot be followed in one branch: the
+            inverse kinematics jumps between neighbouring samples (the branch the arm is in
+            runs into a joint's range, and another takes over): the error names the joint,
+            the time and the jump.
+    """
     from sim.robots.ik import ik_path
 
     try:
         q_via = np.asarray(ik_path(kin, poses, q_start=q0), dtype=float)
     except CellsimError as exc:
         raise ReachError(f"{label}: {exc}") from None
+    step = np.abs(np.diff(q_via, axis=0))
+    allowed = np.full(step.shape, np.radians(BRANCH_JUMP_DEG))
+    if robot is not None and robot.max_speed:
+        allowed = np.maximum(allowed, 1.5 * np.diff(ts)[:, None]
+                             * np.asarray(robot.max_speed, dtype=float)[None, :])
+    if one_branch and np.any(step > allowed):
+        k, j = np.unravel_index(int(np.argmax(step - allowed)), step.shape)
+        raise ReachError(
+            f"{label}: the path cannot be followed in one arm configuration: joint j{j + 1} "
+            f"jumps {np.degrees(step[k, j]):.0f} deg between {ts[k]:.3f} and {ts[k + 1]:.3f} s "
+            "of the move (its branch runs into a joint range there and another takes over: a "
+            "wrist flip or a whole turn); turn the part or the seam, or change the torch "
+            "posture or the start configuration")
     jump = np.abs(q_via[0] - q0)
     if np.any(jump > 1e-6):
         j = int(np.argmax(jump))
@@ -912,7 +967,7 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     T0 = np.asarray(kin.fk(q0), dtype=float)
     cart, seam = _phase_cart(phase, T0[:3, 3], T0[:3, :3], ctx, label)
     extra = np.zeros(0)
-    period = phase.sample_period
+    period = _turn_limited_period(cart, phase.sample_period, label)
     if phase.weave is not None:
         from planners.weave import WeavingTrajectory
 
@@ -920,7 +975,7 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
         extra = cart.breakpoints()
         period = min(period, _weave_period(phase.weave))
     ts = _sample_times(cart.duration, period, extra, label)
-    q_via = _ik_knots(kin, ts, _poses(cart.at(ts)), q0, label)
+    q_via = _ik_knots(kin, ts, _poses(cart.at(ts)), q0, label, ctx.robot)
     times = t0 + ts
     placed = JointPhase(index=phase.index, name=phase.name, planner=phase.planner, times=times,
                         durations=np.diff(times), q=q_via)
@@ -931,36 +986,37 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
                        programmed=_programmed(base, phase.kind, base.speed))
 
 
-#: Where an exported polyline's corner zones begin and end, the TP points blend over this share
+#: An exported polyline's points where its corner zones begin and end blend over this share
 #: of the shorter adjacent move (CNT20: the rounding stays near the zone's ends).
 ZONE_POINT_CNT = 0.2
+#: Moves an exported polyline takes across each corner zone (to its planned poses there).
+ZONE_POINTS = 1
 
 
-def _programmed_legs(legs: list[tuple[Any, float, float]]) -> list[ProgrammedMove]:
-    """A polyline phase as TP moves (``(cart, r_in, r_out)`` per leg): each leg from where its
-    incoming corner zone ends to where its outgoing one begins, holding the leg's torch frame,
-    and a move across each corner zone, in which the torch turns. A TP linear move interpolates
-    the orientation between its ends, so the corner points alone (one move per leg) would turn
-    the torch over the whole next leg; these points keep each leg's posture, as planned."""
-    def pose(cart: Any, s: float) -> NDArray[np.float64]:
-        T = np.eye(4)
-        T[:3, 3] = cart.path.evaluate(np.array([s]))[0][0]
-        T[:3, :3] = cart.orientation.evaluate(np.array([s / cart.length]))[0][0]
-        return T
-
-    stops = []  # (pose, length of the move that ends there)
-    at = pose(legs[0][0], 0.0)[:3, 3]
-    for cart, r_in, r_out in legs:
-        for s in ([r_in] if r_in > 0 else []) + [cart.length - r_out]:
-            T = pose(cart, s)
-            stops.append((T, float(np.linalg.norm(T[:3, 3] - at))))
-            at = T[:3, 3]
+def _programmed_legs(path: Any, t_start: float, t_end: float,
+                     corners: list[tuple[float, float]], speed: float) -> list[ProgrammedMove]:
+    """A polyline phase as TP moves, from its planned tool path (``path.at(t)``, the phase's
+    window ``[t_start, t_end]`` and its corners' time windows, on the path's clock): each leg
+    to where its corner zone begins at the set speed, then :data:`ZONE_POINTS` moves across
+    the zone to poses of the plan there, each timed as planned (slower where the corner was
+    slowed for the turn), and a ``FINE`` stop on the seam's end. A TP linear move turns the
+    torch evenly between its ends, so one point per corner would turn it over the whole next
+    leg; these points keep each leg's posture and turn it inside the zone, as planned."""
+    times = [float(t) for ta, tb in corners
+             for t in ta + (tb - ta) * np.arange(ZONE_POINTS + 1) / ZONE_POINTS] + [t_end]
+    st = path.at(np.array([t_start, *times]))
     out = []
-    speed = legs[0][0].speed
-    for j, (T, length) in enumerate(stops):
-        nxt = stops[j + 1][1] if j + 1 < len(stops) else 0.0
+    for j, t in enumerate(times):
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = st.rotation[j + 1], st.position[j + 1]
+        length = float(np.linalg.norm(st.position[j + 1] - st.position[j]))
+        t_prev = t_start if j == 0 else times[j - 1]
+        in_zone = any(ta + 1e-12 < t <= tb + 1e-12 for ta, tb in corners)
+        v = min(speed, length / max(t - t_prev, 1e-9)) if in_zone else speed
+        nxt = (float(np.linalg.norm(st.position[j + 2] - st.position[j + 1]))
+               if j + 1 < len(times) else 0.0)
         blend = ZONE_POINT_CNT * CNT_SHARE * min(length, nxt) if nxt > 0 else 0.0
-        out.append(ProgrammedMove("linear", T, None, speed, blend, length, nxt))
+        out.append(ProgrammedMove("linear", T, None, v, blend, length, nxt))
     return out
 
 
@@ -1047,7 +1103,8 @@ def _corner_load(joint: Any, t0: float, windows: dict[int, tuple[float, float]],
     out = {}
     for i, (ta, tb) in windows.items():
         pad = 0.25 * (tb - ta)
-        st = joint.at(t0 + np.linspace(ta - pad, tb + pad, 401))
+        t = np.clip(t0 + np.linspace(ta - pad, tb + pad, 401), joint.start, joint.end)
+        st = joint.at(t)
         load = float(np.max(np.abs(st.qd) / vlim))
         if alim is not None:
             load = max(load, float(np.sqrt(np.max(np.abs(st.qdd) / alim))))
@@ -1084,8 +1141,8 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
     rolls: dict[int, float] = {}
     for _ in range(len(moves)):  # first the legs' rolls, at the set speed
         geo = _blend_geometry(moves, move_labels, of, ctx, q0, rolls)
-        fix = _wrist_roll(_time_blended(phases, labels, moves, of, geo, {}, t0, q0, ctx), geo,
-                          of, t0, ctx)
+        trial = _time_blended(phases, labels, moves, of, geo, {}, t0, q0, ctx, one_branch=False)
+        fix = _wrist_roll(trial, geo, of, t0, ctx)
         if not fix:
             break
         rolls.update(fix)
@@ -1103,10 +1160,11 @@ def _plan_blended(phases: list[CartesianPhase], t0: float, q0: NDArray[np.float6
                                             carts[i + 1].length if i + 1 < len(carts) else 0.0)]
         zones = []
         if _is_polyline(phases[k], ctx):
-            programmed = _programmed_legs([(carts[i], radii[i - 1] if i and of[i - 1] == k
-                                            else 0.0, radii[i] if of[i] == k and i + 1 < n
-                                            and of[i + 1] == k else 0.0) for i in range(n)
-                                           if of[i] == k])
+            win = windows[k].base if hasattr(windows[k], "weave") else windows[k]
+            mine = [plan.blend_t[i] for i in sorted(plan.blend_t)
+                    if of[geo.owner[i]] == k and of[geo.owner[i] + 1] == k]
+            programmed = _programmed_legs(win.base, bounds[k], bounds[k + 1], mine,
+                                          phases[k].speed)
             cum = np.r_[0.0, np.cumsum([sg.length() for sg in seams[k].segments()])]
             legs = [i for i in range(n) if of[i] == k]
             zones = [(float(cum[m + 1] - radii[i]), float(cum[m + 1] + radii[i]))
@@ -1200,16 +1258,32 @@ def _time_with_corner_speeds(phases: list[CartesianPhase], labels: list[str],
                              geo: _BlendGeometry, t0: float, q0: NDArray[np.float64],
                              ctx: CartesianContext) -> _BlendedPlan:
     """:func:`_time_blended`, each corner slowed until its joints stay within
-    :data:`CORNER_LIMIT_SHARE` of their limits (at most a few passes)."""
+    :data:`CORNER_LIMIT_SHARE` of their limits (at most a few passes). A corner whose load does
+    not fall as it slows is not what overloads the joints there (the moves beside it are: the
+    run's limit check reports them); it keeps its speed."""
     corner_speed: dict[int, float] = {}
+    before: dict[int, tuple[float, float | None]] = {}  # corner -> (load, speed) last pass
+    settled: set[int] = set()
+    plan = _time_blended(phases, labels, moves, of, geo, corner_speed, t0, q0, ctx)
     for _ in range(12):
-        plan = _time_blended(phases, labels, moves, of, geo, corner_speed, t0, q0, ctx)
         load = _corner_load(plan.joint, t0, plan.blend_t, ctx.robot)
-        over = {i: x for i, x in load.items() if x > CORNER_LIMIT_SHARE * (1 + 1e-6)}
+        over = {i: x for i, x in load.items()
+                if x > CORNER_LIMIT_SHARE * (1 + 1e-6) and i not in settled}
+        for i in list(over):
+            if i in before and over[i] > 0.9 * before[i][0]:  # slowing did not help
+                settled.add(i)
+                del over[i]
+                if before[i][1] is None:
+                    corner_speed.pop(i, None)
+                else:
+                    corner_speed[i] = before[i][1]  # type: ignore[assignment]
         if not over:
+            if settled:
+                plan = _time_blended(phases, labels, moves, of, geo, corner_speed, t0, q0, ctx)
             break
         for i, x in over.items():
             k = geo.owner[i]
+            before[i] = (x, corner_speed.get(i))
             v = corner_speed.get(i, min(moves[k].speed, moves[k + 1].speed))
             v_new = v * max(0.25, CORNER_LIMIT_SHARE / x * 0.98)  # a quarter at most a pass
             if v_new < MIN_CORNER_SPEED_SHARE * min(moves[k].speed, moves[k + 1].speed):
@@ -1221,6 +1295,7 @@ def _time_with_corner_speeds(phases: list[CartesianPhase], labels: list[str],
                     f"{MIN_CORNER_SPEED_SHARE * 100:g} % of the set speed; give a larger "
                     "blend_mm (or stop at the corner)")
             corner_speed[i] = v_new
+        plan = _time_blended(phases, labels, moves, of, geo, corner_speed, t0, q0, ctx)
     return plan
 
 
@@ -1312,7 +1387,8 @@ class _BlendedPlan:
 
 def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[CartesianPhase],
                   of: list[int], geo: _BlendGeometry, corner_speed: dict[int, float],
-                  t0: float, q0: NDArray[np.float64], ctx: CartesianContext) -> _BlendedPlan:
+                  t0: float, q0: NDArray[np.float64], ctx: CartesianContext,
+                  one_branch: bool = True) -> _BlendedPlan:
     """The time law of a blended path (each corner at ``corner_speed`` where given: the speed
     dips over the corner's first third, holds, and recovers over its last third), the
     phases' time windows, and the joint polynomial through the inverse kinematics of its
@@ -1372,8 +1448,9 @@ def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[C
 
             win = WeavingTrajectory(win, phases[j].weave, kin.family.approach_column)
         windows.append(win)
-    # samples: every period, at the phase ends, and at the weaves' turns
-    period = min(ph.sample_period for ph in phases)
+    # samples: every period (finer where the tool turns fast), at the phase ends, and at the
+    # weaves' turns
+    period = _turn_limited_period(traj, min(ph.sample_period for ph in phases), labels[0])
     extra = [np.array(bounds[1:-1])]
     for i, (t_a, t_b) in blend_t.items():  # each corner sampled on its own, finer as it turns
         turn = float(np.degrees(getattr(laws[i], "angle", 0.0)))
@@ -1392,7 +1469,7 @@ def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[C
             poses[sel] = _poses(win.at(ts[sel] - bounds[k]))
     if getattr(kin.family, "approach_column", 2) == 0:  # a 5-axis arm: corners in its plane
         poses = _into_j1_plane(poses)
-    q_via = _ik_knots(kin, ts, poses, q0, labels[0])
+    q_via = _ik_knots(kin, ts, poses, q0, labels[0], ctx.robot, one_branch)
     times = t0 + ts
     placed = JointPhase(index=phases[0].index, name=phases[0].name, planner=phases[0].planner,
                         times=times, durations=np.diff(times), q=q_via)
