@@ -111,7 +111,7 @@ ARMS = {a.key: a for a in (
     Arm("kr6r900_2", "kr6r900_2", (0, -90, 90, 0, 90, 0), (380, 600), (100, 400)),
     Arm("irb2400", "irb2400", (0, 0, 0, 0, 90, 0), (750, 1100), (300, 800)),
     Arm("lrmate100ib", "lrmate100ib", (0, 0, 0, 90, 0), (330, 470), (100, 300), torch_column=0),
-    Arm("ur5_dh", "robots/ur5_dh", (0, -90, 90, -90, -90, 0), (330, 550), (0, 250), 180.0,
+    Arm("ur5_dh", "robots/ur5_dh", (0, -90, 90, -90, -90, 0), (330, 550), (50, 250), 180.0,
         dh=UR5_DH),
 )}
 
@@ -344,6 +344,12 @@ def cases(draw: Any, arm: Arm, kind: str) -> Case:
                      for i in range(legs) for j in range(i + 2, legs)), default=np.inf)
         assume(apart >= 10.0)
         blend = min(fl(2.0, 8.0), 0.4 * float(lengths.min()))
+        if stickout is not None:
+            # the oracle places a corner zone by the seam point the torch aims at: while the
+            # torch turns in the zone (up to 150 deg, 2.62 rad) that point sweeps stand-off x
+            # turn along the seam, so a stand-off of more than blend / 2.62 would carry it out
+            # of the zone while the tool is still in its corner curve
+            stickout = min(stickout, 15.0 + blend / 2.62)
         dense = pts2
     else:
         sweep = 360.0 if kind == "circle" else fl(20.0, 300.0)
@@ -613,14 +619,16 @@ def check_reference(case: Case, root: Path) -> tuple[Planned, so.Frames] | None:
 
 
 # ---------------------------------------------------------------------------- the campaign
-#: The fast share: (arm, kind, cases checked on the reference motion); 100 in all.
+#: The fast share: (arm, kind, cases checked on the reference motion); 100 in all. Few full
+#: circles: most drawn circles are refused as out of reach (the wrist would wind past its range),
+#: and each refusal costs a plan.
 FAST_SHARE = [
-    ("lrmate200ic5l", "line", 7), ("lrmate200ic5l", "polyline", 8),
-    ("lrmate200ic5l", "arc", 6), ("lrmate200ic5l", "circle", 5),
-    ("kr6r900_2", "line", 6), ("kr6r900_2", "polyline", 6), ("kr6r900_2", "arc", 5),
-    ("kr6r900_2", "circle", 5),
-    ("irb2400", "line", 6), ("irb2400", "polyline", 6), ("irb2400", "arc", 5),
-    ("irb2400", "circle", 5),
+    ("lrmate200ic5l", "line", 8), ("lrmate200ic5l", "polyline", 10),
+    ("lrmate200ic5l", "arc", 6), ("lrmate200ic5l", "circle", 2),
+    ("kr6r900_2", "line", 7), ("kr6r900_2", "polyline", 7), ("kr6r900_2", "arc", 6),
+    ("kr6r900_2", "circle", 2),
+    ("irb2400", "line", 7), ("irb2400", "polyline", 7), ("irb2400", "arc", 6),
+    ("irb2400", "circle", 2),
     ("ur5_dh", "line", 1), ("ur5_dh", "polyline", 1), ("ur5_dh", "arc", 1), ("ur5_dh", "circle", 1),
     ("lrmate100ib", "line", 26),
 ]
@@ -652,6 +660,16 @@ def campaign(arm: Arm, kind: str, n: int, seed: int, body: Any) -> None:
     hseed(seed)(run)()
 
 
+#: The slow share's size: this many times the fast share on the reference (200 seams), and this
+#: many simulated per arm and kind (20). Issue 25 asks for 1000 and 100; the fast share (100 on
+#: the reference, 10 simulated, with the draws refused as out of reach) took 602 s alone on
+#: this 2-core machine, so those would take over an hour, past CI's 90 minutes with the rest
+#: of the suite: the sizes grow when the generator wastes fewer draws and planning is faster
+#: (issue 29).
+SLOW_FACTOR = 2
+SLOW_SIMULATED = 2
+
+
 def _seed(*key: Any) -> int:
     return int.from_bytes(repr(key).encode(), "little") % (1 << 32)
 
@@ -666,8 +684,8 @@ def test_generated_seams_on_the_reference_motion(arm, kind, n):
 @pytest.mark.slow
 @pytest.mark.parametrize("arm,kind,n", FAST_SHARE)
 def test_many_generated_seams_on_the_reference_motion(arm, kind, n):
-    """The slow share: 1000 more generated seams (ten times the fast share's mix)."""
-    campaign(ARMS[arm], kind, 10 * n, _seed("slow", arm, kind), check_reference)
+    """The slow share: :data:`SLOW_FACTOR` times the fast share's mix, drawn anew."""
+    campaign(ARMS[arm], kind, SLOW_FACTOR * n, _seed("slow", arm, kind), check_reference)
 
 
 # ---------------------------------------------------------------------------- with dynamics
@@ -762,8 +780,9 @@ def test_generated_seams_simulated(arm, kind):
 @pytest.mark.slow
 @pytest.mark.parametrize("arm,kind", SIM_SHARE)
 def test_many_generated_seams_simulated(arm, kind):
-    """The slow simulated share: 100 more (ten per arm and kind of :data:`SIM_SHARE`)."""
-    campaign(ARMS[arm], kind, 11, _seed("sim-slow", arm, kind),
+    """The slow simulated share: :data:`SLOW_SIMULATED` more per arm and kind of
+    :data:`SIM_SHARE`."""
+    campaign(ARMS[arm], kind, SLOW_SIMULATED + 1, _seed("sim-slow", arm, kind),
              after_the_first(check_simulated))
 
 
