@@ -39,6 +39,14 @@ Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 PlannerName = Literal[PLANNERS.names()]  # type: ignore[valid-type]
 
 
+#: ``approach_mm`` / ``retract_mm`` of a phase that goes ``to_seam`` (joint or linear).
+ApproachMm = Annotated[float | None, Field(ge=0, le=5000, description="with to_seam: stop this "
+                                           "far before the seam's start, back along its torch "
+                                           "axis, mm")]
+RetractMm = Annotated[float | None, Field(ge=0, le=5000, description="with to_seam: go this far "
+                                          "back from the seam's end along its torch axis, mm")]
+
+
 class JointPhaseSpec(_Strict):
     """A joint-space phase: via points, joined by a piecewise polynomial."""
 
@@ -65,12 +73,8 @@ class JointPhaseSpec(_Strict):
     end_jerk_rad_s3: list[float] | None = None
     to_mm: Vec3 | None = None
     to_seam: str | None = None
-    approach_mm: float | None = Field(None, ge=0, le=5000, description="with to_seam: "
-                                      "stop this far before the seam's start, back along "
-                                      "its torch axis, mm")
-    retract_mm: float | None = Field(None, ge=0, le=5000, description="with to_seam: go "
-                                     "this far back from the seam's end along its torch "
-                                     "axis, mm")
+    approach_mm: ApproachMm = None
+    retract_mm: RetractMm = None
     euler_zyx_deg: Vec3 | None = None
     frame: str = Field("frame0", description='frame of to_mm and euler_zyx_deg: "frame0", '
                        '"world" or a cell object')
@@ -116,12 +120,8 @@ class LinearPhaseSpec(_CartesianSpec):
     orientation: Literal["keep", "seam", "euler"] = "keep"
     to_seam: str | None = Field(None, description="end at a seam's start (or, with "
                                 "retract_mm, back from its end) in its torch posture")
-    approach_mm: float | None = Field(None, ge=0, le=5000, description="with to_seam: "
-                                      "stop this far before the seam's start, back along "
-                                      "its torch axis, mm")
-    retract_mm: float | None = Field(None, ge=0, le=5000, description="with to_seam: go "
-                                     "this far back from the seam's end along its torch "
-                                     "axis, mm")
+    approach_mm: ApproachMm = None
+    retract_mm: RetractMm = None
 
 
 class CircularPhaseSpec(_CartesianSpec):
