@@ -408,11 +408,14 @@ class Verdict:
         return not self.failures
 
 
-def fit_sine(t: Array, y: Array) -> tuple[float, float, Array]:
+def fit_sine(t: Array, y: Array, band: tuple[float, float] | None = None
+             ) -> tuple[float, float, Array]:
     """Amplitude, frequency and the sine ``A sin(2 pi f t + phi)`` of the fit ``y = A sin(2 pi f
     t + phi) + c`` (the offset ``c`` is not returned: it is a deviation, not weave) for samples
     on a regular grid with gaps (the corner zones left out): the FFT peak of the samples on
-    the grid, the gaps zero (zero-padded 16 times), as the start, then least squares."""
+    the grid, the gaps zero (zero-padded 16 times), as the start, then least squares. ``band``
+    (Hz): look for the peak there only (the gaps of a polyline's corner zones put spurious
+    low-frequency peaks in the spectrum)."""
     from scipy.optimize import least_squares
 
     dt = float(np.median(np.diff(t)))
@@ -421,7 +424,9 @@ def fit_sine(t: Array, y: Array) -> tuple[float, float, Array]:
     grid[k] = y - y.mean()
     n = 1 << math.ceil(math.log2(16 * len(grid)))
     spec = np.abs(np.fft.rfft(grid, n))
-    f0 = float(np.fft.rfftfreq(n, dt)[int(np.argmax(spec[1:])) + 1])
+    freqs = np.fft.rfftfreq(n, dt)
+    keep = freqs > 0 if band is None else (freqs >= band[0]) & (freqs <= band[1])
+    f0 = float(freqs[int(np.argmax(np.where(keep, spec, -np.inf)))])
     tc = t - t.mean()
     basis = np.column_stack([np.sin(2 * np.pi * f0 * tc), np.cos(2 * np.pi * f0 * tc),
                              np.ones_like(tc)])
@@ -486,7 +491,8 @@ def judge_weld(seam: SeamGeom, fr: Frames, t0: float, t1: float, speed: float,
         fade = max(DEFAULT_RAMP_S, 0.5 / weave.frequency_hz) + 0.1
         body = (t > t0 + fade) & (t < t1 - fade)
         check &= body
-        amp, freq, fit = fit_sine(t[check], y[check])  # the weave: its centre is the seam's
+        amp, freq, fit = fit_sine(t[check], y[check],  # the weave: its centre is the seam's
+                                  band=(0.5 * weave.frequency_hz, 2.0 * weave.frequency_hz))
         v.figures.update(weave_amplitude_mm=amp * 1e3, weave_frequency_hz=freq)
         ea, ef = abs(amp / weave.amplitude_m - 1), abs(freq / weave.frequency_hz - 1)
         if ea > WEAVE_AMP_TOL:
