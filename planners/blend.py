@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
 
 from planners.errors import InvalidMoveError
 
@@ -192,30 +193,71 @@ def _h(x):  # quintic smoothstep and its derivatives and integral
 
 
 class CornerOrientation:
-    """The tool turning from one move's orientation to the next inside a corner blend: the
-    shortest rotation from ``start`` to ``end``, its angle a quintic smoothstep of the corner's
-    own parameter ``u`` (0..1 by arc length along the corner curve). The turn's rate and
-    acceleration are zero where the corner meets the moves, so the tool's angular velocity
-    and acceleration stay continuous there (a uniform slerp would jump both).
+    """The tool turning from one move's orientation to the next inside a corner blend.
+
+    Without rates: the shortest rotation from ``start`` to ``end``, its angle a quintic
+    smoothstep of the corner's own parameter ``u`` (0..1 by arc length along the corner
+    curve); the turn's rate and acceleration are zero where the corner meets the moves.
+
+    With the moves' own turning rates at the corner's ends (``rate_start``, ``rate_end``:
+    angular velocity per metre of path, world frame; a TP linear move turns its tool evenly
+    from one point to the next), each move's orientation is carried on at its rate through
+    the corner and the two are blended as a controller blends them: ``R = R_a exp(h(u)
+    log(R_a^T R_b))`` with ``R_a`` the first move continued, ``R_b`` the next one begun early
+    and ``h`` the smoothstep. The tool's angular velocity and acceleration then stay
+    continuous where the corner meets the moves (a smoothstep from rest would jump the rate
+    a turning move has there; so would a uniform slerp).
 
     Args:
         start, end: Tool frames where the corner leaves the first move and joins the next,
             (3, 3).
+        rate_start, rate_end: The moves' angular velocities there, rad per metre of path, (3,)
+            (default: not turning).
+        length: The corner curve's arc length, m (needed with rates).
     """
 
     name = "corner"
 
-    def __init__(self, start: ArrayLike, end: ArrayLike) -> None:
+    def __init__(self, start: ArrayLike, end: ArrayLike, rate_start: ArrayLike | None = None,
+                 rate_end: ArrayLike | None = None, length: float = 0.0) -> None:
         from planners.rotations import GeodesicOrientation
 
         self._geo = GeodesicOrientation(start, end)
         self.start, self.end, self.angle = self._geo.start, self._geo.end, self._geo.angle
+        wa = np.zeros(3) if rate_start is None else np.asarray(rate_start, dtype=float)
+        wb = np.zeros(3) if rate_end is None else np.asarray(rate_end, dtype=float)
+        self.length = float(length)
+        #: The turn each move carries into the corner, rad per unit of u (world frame).
+        self._wa, self._wb = wa * self.length, wb * self.length
+        # a turn under a micro-radian over the corner is none (a straight seam leg's law)
+        self._turning = bool(max(np.linalg.norm(self._wa), np.linalg.norm(self._wb)) > 1e-9)
+
+    def _blended(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
+        from planners.rotations import axis_angle_matrix
+
+        def carried(R0: NDArray[np.float64], w: NDArray[np.float64],
+                    x: NDArray[np.float64]) -> NDArray[np.float64]:
+            n = float(np.linalg.norm(w))
+            if n == 0.0:
+                return np.broadcast_to(R0, x.shape + (3, 3))
+            return axis_angle_matrix(w / n, x * n) @ R0
+
+        Ra = carried(self.start, self._wa, u)
+        Rb = carried(self.end, self._wb, u - 1.0)
+        v = Rotation.from_matrix(np.swapaxes(Ra, -1, -2) @ Rb).as_rotvec()
+        h = _h(u)[0]
+        return Ra @ Rotation.from_rotvec(v * h[..., None]).as_matrix()
 
     def evaluate(self, u: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         u = np.asarray(u, dtype=float)
-        h, h1 = _h(u)[:2]
-        R, dR = self._geo.evaluate(h)
-        return R, dR * h1[..., None, None]
+        if not self._turning:
+            h, h1 = _h(u)[:2]
+            R, dR = self._geo.evaluate(h)
+            return R, dR * h1[..., None, None]
+        e = 1e-6  # dR/du by central differences (the carried rotations are smooth past 0, 1)
+        R = self._blended(u)
+        dR = (self._blended(u + e) - self._blended(u - e)) / (2.0 * e)
+        return R, dR
 
 
 @dataclass(frozen=True)

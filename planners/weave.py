@@ -19,7 +19,9 @@ Patterns, per cycle of period ``P = 1 / frequency`` (``v`` the cycle's progress,
 ``frequency`` is the number of whole cycles per second and the moving part of a cycle lasts
 ``P - 2 dwell``. The weave fades in and out with the move's start and stop ramps (a smooth
 envelope from 0 to 1 over each ramp, at least half a cycle), so it starts and ends on the
-seam.
+seam. Moves that blend into each other under one weave (a TP program's CNT moves between
+``Weave`` and ``Weave End``) carry it on: the next move continues the cycle (``clock``) and
+neither fades where they join.
 
 :class:`WeavingTrajectory` wraps a :class:`planners.adnia.CartesianTrajectory`: ``at(t)`` and
 ``sample(dt)`` as for any trajectory, and :meth:`WeavingTrajectory.breakpoints` gives the times
@@ -127,14 +129,22 @@ class WeavingTrajectory:
             tool frame, 0 for the 5-axis family's x).
     """
 
-    def __init__(self, base, weave: Weave, approach_column: int = 2) -> None:
+    def __init__(self, base, weave: Weave, approach_column: int = 2, *, clock: float = 0.0,
+                 fade_in: bool = True, fade_out: bool = True) -> None:
         self.base = base
         self.weave = weave
         self.approach_column = int(approach_column)
+        #: The weave's own time at the move's start, s: a move that a weave carries on into
+        #: (a TP program's CNT moves between ``Weave`` and ``Weave End``) continues its cycle.
+        self.clock = float(clock)
         ramp = float(getattr(base.profile, "ramp_time", 0.0))
         # fade over the move's ramps, and over half a cycle at least (a phase that blends in
         # or out has no ramp)
         self.fade = min(max(ramp, 0.5 * weave.period), 0.5 * base.duration)
+        #: How long the weave fades in at the start and out at the end, s (0 where it
+        #: carries on from the move before or into the move after).
+        self.fade_in = self.fade if fade_in else 0.0
+        self.fade_out = self.fade if fade_out else 0.0
 
     @property
     def duration(self) -> float:
@@ -174,9 +184,21 @@ class WeavingTrajectory:
         return self.base.profile
 
     def envelope(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
-        """0 at the start and end, 1 between the ramps."""
+        """0 at a start and an end the weave fades at, 1 between (and at the ends it carries
+        on through)."""
+        t = np.asarray(t, dtype=float)
         T = self.duration
-        return _smoothstep(t / self.fade) * _smoothstep((T - t) / self.fade)
+        e = _smoothstep(t / self.fade_in) if self.fade_in > 0 else np.ones_like(t)
+        return e * (_smoothstep((T - t) / self.fade_out) if self.fade_out > 0 else 1.0)
+
+    def travel_direction(self, t: ArrayLike) -> NDArray[np.float64]:
+        """The unit tangent of the base path at times ``t``, (..., 3): the direction of travel
+        (the weave's longitudinal direction is its part normal to the torch axis, shorter by
+        the cosine of the travel angle)."""
+        t = np.asarray(t, dtype=float)
+        s = self.base.at(t).path_length.reshape(-1)
+        d1 = self.base.path.evaluate(s)[1].reshape(t.shape + (3,))
+        return d1 / np.linalg.norm(d1, axis=-1, keepdims=True)
 
     def frame(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Unit lateral and longitudinal directions at times ``t``, (..., 3) each."""
@@ -195,7 +217,7 @@ class WeavingTrajectory:
         """The weave's displacement of the tool point at times ``t``, m, (..., 3)."""
         t = np.asarray(t, dtype=float)
         lat, lon = self.frame(t)
-        y, x = self.weave.shape(self.weave.progress(t))
+        y, x = self.weave.shape(self.weave.progress(self.clock + t))
         e = self.envelope(t)
         return (e * y)[..., None] * lat + (e * x)[..., None] * lon
 
@@ -213,8 +235,9 @@ class WeavingTrajectory:
                        acceleration=st.acceleration + (op - 2 * o0 + om) / (h * h))
 
     def breakpoints(self) -> NDArray[np.float64]:
-        """Times where the pattern turns (its extremes and dwell ends), s."""
-        return self.weave.turn_times(self.duration)
+        """Times where the pattern turns (its extremes and dwell ends), on the move's clock, s."""
+        t = self.weave.turn_times(self.clock + self.duration) - self.clock
+        return t[t > 0.0]
 
     def sample(self, dt: float):
         from planners.base import sample_times

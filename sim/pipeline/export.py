@@ -139,9 +139,6 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
             elif ph.weave is not None:
                 k_weave = schedule_of(ph.weave)
                 ins.append(LSOther("weave", LSWeave(tp_pattern[ph.weave.pattern], k_weave)))
-                if len(pm.programmed) > 1:
-                    notes.append(f"{ph.name}: its weave spans {len(pm.programmed)} TP moves; "
-                                 "run back, each move weaves on its own (fading in and out)")
             q_near = np.asarray(motion.at(pm.t0).q[0], dtype=float)
             for j, mv in enumerate(pm.programmed):
                 k = cart_pos(mv.end, q_end if mv.blend == 0 else q_near, f"{ph.name} end")

@@ -11,7 +11,11 @@
   :mod:`sim.robots.maker`). ``sec`` instead of ``%``: the move's time.
 * ``L P[n] v mm/sec`` (or ``cm/min``, ``inch/min``; ``sec``: the move's time, its ramps
   included; ``WELD_SPEED``: the scenario's ``program_weld_speed_mm_s``): a linear phase at that
-  speed, the orientation turned from the start's to the position's.
+  speed, the orientation turned evenly (in proportion to the path) from the start's to the
+  position's; where a CNT rounds the corner into the next move the two moves' turns are
+  blended (each carried on at its rate, :class:`planners.blend.CornerOrientation`), so the
+  wrist's speed does not jump there, and a corner whose joints would pass their limits at the
+  programmed speed is slowed inside its rounding only.
 * ``C P[via] : P[end] v``: a circular phase through the via point.
 * ``FINE``: the move ends at rest on the point. ``CNTx``: the move blends into the next move of
   the same kind without stopping: for L and C moves a corner zone of radius
@@ -32,8 +36,10 @@
 * ``Weave Sine[n]`` / ``Weave Circle[n]`` ... ``Weave End``: the L and C moves between them
   weave (:class:`planners.weave.Weave`, ``"sine"`` / ``"circle"``) with schedule ``n`` of the
   program's weave table (``prog.weave.toml``, :func:`sim.scenario.fanuc_ls.weave_table_path`) or
-  the values written in the instruction; each move weaves on its own (fading in and out over
-  its ramps or half a cycle, as a scenario phase does). The left and right dwells must be equal
+  the values written in the instruction. Moves that blend into each other (CNT) carry the
+  weave on without a break (one cycle clock, no fade where they join); it fades in where
+  the weaving starts and out where it stops or the robot stops (FINE), over the ramps or
+  half a cycle, as a scenario phase's does. The left and right dwells must be equal
   (cellsim's weave holds one dwell at both extremes). J moves in between do not weave, and the
   other patterns (``Figure 8``, ``Sine 2``, ``L``) are not run; a warning says so.
 

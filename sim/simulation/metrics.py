@@ -338,7 +338,7 @@ def _woven_travel_speed(cart: Any, ts: NDArray[np.float64], p: NDArray[np.float6
     """Travel speed along the path of a weaving phase, m/s: the tool point's velocity along the
     travel direction, the weave's planned longitudinal motion taken out (the lateral motion,
     which the joints' polynomial rounds between its samples, does not count)."""
-    lon = cart.frame(np.clip(ts, 0.0, cart.duration))[1] @ T[:3, :3].T
+    lon = cart.travel_direction(np.clip(ts, 0.0, cart.duration)) @ T[:3, :3].T
     travel = p - _weave_offset(cart, ts, T)
     return np.einsum("ij,ij->i", np.gradient(travel, ts, axis=0), lon)
 
@@ -382,7 +382,7 @@ def measure_seam_phases(arrays: Mapping[str, NDArray[Any]], motion: Motion,
             kw = {"weave_offset": lambda tt, c=cart, t0=pm.t0: c.offset(
                       np.clip(tt - t0, 0.0, c.duration)) @ R0.T,
                   "weave_period": cart.weave.period,
-                  "weave_window": (pm.t0 + cart.fade, pm.t1 - cart.fade)}
+                  "weave_window": (pm.t0 + cart.fade_in, pm.t1 - cart.fade_out)}
         rot = Rotation.from_quat(arrays["tcp_quat"][idx], scalar_first=True).as_matrix()
         out[k] = measure_seam(ts, arrays["tcp_pos"][idx], rot, pm.seam, axis_column=torch_axis,
                               corner_zones=pm.corner_zones, cruise=(pm.t0 + lo, pm.t0 + hi),
@@ -411,8 +411,10 @@ def weave_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltC
         else:
             sel = arrays["phase"] == k
             tl = t[sel] - pm.t0
-            full = (tl >= cart.fade) & (tl <= cart.duration - cart.fade)
-            if np.count_nonzero(full) < 16:
+            full = (tl >= cart.fade_in) & (tl <= cart.duration - cart.fade_out)
+            # two whole cycles at least (as along a seam): a shorter window, such as a TP
+            # program's move across a corner zone, cannot tell the weave's frequency
+            if np.count_nonzero(full) < 16 or np.ptp(tl[full]) < 2.0 * cart.weave.period:
                 continue
             tl = tl[full]
             p = arrays["tcp_pos"][sel][full]

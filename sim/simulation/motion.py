@@ -1197,6 +1197,7 @@ def _blend_geometry(moves: list[CartesianPhase], move_labels: list[str], of: lis
         SubOrientation,
         SubPath,
     )
+    from planners.rotations import angular_velocity
 
     T0 = np.asarray(ctx.kinematics.fk(q0), dtype=float)
     p, R = T0[:3, 3], T0[:3, :3]
@@ -1246,9 +1247,13 @@ def _blend_geometry(moves: list[CartesianPhase], move_labels: list[str], of: lis
                 pieces.append(BlendCurve(pa, ta, pb, tb, r_out / 4))
             except PlannerError as exc:
                 raise ScenarioError(f"{move_labels[k]}.blend_mm: {exc}") from None
-            Ra = cart.orientation.evaluate(np.array([(L - r_out) / L]))[0][0]
-            Rb = nxt.orientation.evaluate(np.array([r_out / nxt.length]))[0][0]
-            laws.append(CornerOrientation(Ra, Rb))
+            # each move's turning rate where the corner meets it (rad/m), carried into the
+            # corner so the tool's angular velocity stays continuous there
+            Ra, dRa = (v[0] for v in cart.orientation.evaluate(np.array([(L - r_out) / L])))
+            Rb, dRb = (v[0] for v in nxt.orientation.evaluate(np.array([r_out / nxt.length])))
+            laws.append(CornerOrientation(Ra, Rb, angular_velocity(Ra, dRa) / L,
+                                          angular_velocity(Rb, dRb) / nxt.length,
+                                          pieces[-1].length))
             owner.append(k)
     return _BlendGeometry(carts, radii, pieces, laws, owner, CompositePath(pieces))
 
@@ -1446,7 +1451,14 @@ def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[C
         if phases[j].weave is not None:
             from planners.weave import WeavingTrajectory
 
-            win = WeavingTrajectory(win, phases[j].weave, kin.family.approach_column)
+            # a weave carries on into and out of the phases beside it that weave alike
+            first_j = j
+            while first_j > 0 and phases[first_j - 1].weave == phases[j].weave:
+                first_j -= 1
+            win = WeavingTrajectory(
+                win, phases[j].weave, kin.family.approach_column,
+                clock=bounds[j] - bounds[first_j], fade_in=first_j == j,
+                fade_out=j == m - 1 or phases[j + 1].weave != phases[j].weave)
         windows.append(win)
     # samples: every period (finer where the tool turns fast), at the phase ends, and at the
     # weaves' turns
