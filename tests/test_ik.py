@@ -277,3 +277,60 @@ def test_5axis_orientation_tolerance_for_typed_angles():
         else:
             with pytest.raises(UnreachableError, match="deg out of the vertical plane"):
                 solve_ik(kin, Tt, current=q)
+
+
+@pytest.mark.parametrize("name", ALL_ROBOTS)
+def test_ik_path_takes_the_solution_solve_ik_ranks_first(name):
+    """``ik_path`` picks each point's solution in O(n) per branch (each joint's nearest
+    in-range turn on its own); the oracle is :func:`solve_ik`'s solutions, every whole-turn
+    representation enumerated, the nearest taken (inside the ranges where they are
+    respected): the same joints at every point of generated paths (random configurations,
+    random starting configurations, with and without the ranges)."""
+    rng = np.random.default_rng(sum(map(ord, name)))
+    for model in (_model_with_ranges(name), closed_form_model(ROBOTS[name])):
+        Q = _random_in_range(model, rng, 12)
+        poses = model.fk(Q)
+        for respect in (True, False):
+            prev = _random_in_range(model, rng, 1)[0] * 1.5
+            got = ik_path(model, poses, q_start=prev, respect_limits=respect)
+            for k, T in enumerate(poses):
+                sols = solve_ik(model, T, prev)
+                if respect:
+                    sols = [s for s in sols if s.within_limits]
+                want = min(sols, key=lambda s: s.cost).q
+                np.testing.assert_allclose(got[k], want, atol=1e-9, err_msg=f"point {k}")
+                prev = want
+
+
+def test_a_chains_batched_forward_kinematics_is_the_dh_product():
+    """``Chain.fk_many`` (the path IK's check of the closed form's branches) against the
+    standard DH product ``Rz(theta) Tz(d) Tx(a) Rx(alpha)`` written here, on random tables and
+    configurations; and row by row equal to ``Chain.fk``."""
+    from sim.robots.chain import chain_from_dh
+
+    def rz(t):
+        c, s = np.cos(t), np.sin(t)
+        return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+
+    def rx(t):
+        c, s = np.cos(t), np.sin(t)
+        return np.array([[1.0, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
+
+    def tr(x, z):
+        T = np.eye(4)
+        T[0, 3], T[2, 3] = x, z
+        return T
+
+    rng = np.random.default_rng(11)
+    for _ in range(4):
+        rows = np.c_[rng.uniform(-0.5, 0.5, (6, 1)), rng.uniform(-np.pi, np.pi, (6, 1)),
+                     rng.uniform(-0.5, 0.5, (6, 1)), rng.uniform(-np.pi, np.pi, (6, 1))]
+        chain = chain_from_dh(rows)
+        Q = rng.uniform(-np.pi, np.pi, (9, 6))
+        got = chain.fk_many(Q)
+        for q, T in zip(Q, got):
+            want = np.eye(4)
+            for (a, alpha, d, off), qi in zip(rows, q):
+                want = want @ rz(qi + off) @ tr(0.0, d) @ tr(a, 0.0) @ rx(alpha)
+            np.testing.assert_allclose(T, want, atol=1e-12)
+            np.testing.assert_allclose(T, chain.fk(q), atol=1e-12)

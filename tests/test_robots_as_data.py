@@ -999,3 +999,35 @@ def test_a_second_load_of_a_dh_robot_reuses_its_cache_without_mujoco(dh_robot):
     accel, imported = json.loads(r.stdout.strip().splitlines()[-1])
     assert accel == list(first.max_accel)
     assert imported is False
+
+
+def test_a_numeric_arms_path_ik_continues_its_branch_as_the_global_search_would(tmp_path):
+    """Along generated smooth paths of a UR5 (numeric IK), ``ik_path`` continues each point
+    from the one before with one local Newton run: every pose is reached (FK of the result),
+    and each point's joints are those the global search (every seed, the nearest taken)
+    gives from the point before."""
+    from sim.robots.families.chain_family import ChainFamily
+    from sim.robots.ik import ik_path
+    from sim.robots.model import KinematicModel
+
+    (tmp_path / "robot.toml").write_text(robot_toml(UR5_DH, "ur5"))
+    arm = load_arm(tmp_path)
+    assert arm.solver == "numeric"
+    model = KinematicModel("ur5", ChainFamily(arm), lower=arm.chain.lower,
+                           upper=arm.chain.upper)
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        q0 = random_q(arm.chain, 1, seed=int(rng.integers(1000)))[0]
+        q1 = q0 + rng.uniform(-0.4, 0.4, 6)
+        Q = np.linspace(q0, q1, 15)
+        poses = np.array([arm.chain.fk(q) for q in Q])
+        got = ik_path(model, poses, q_start=q0)
+        prev = q0
+        for k, T in enumerate(poses):
+            np.testing.assert_allclose(arm.chain.fk(got[k]), T, atol=1e-9)
+            sols = numeric_ik(arm.chain, T, prev)
+            want = min(sols, key=lambda s: float(np.sum(((s - prev) / model.max_speed) ** 2)))
+            # the same configuration (the global search gives each joint's lowest turn in range)
+            np.testing.assert_allclose(np.angle(np.exp(1j * (got[k] - want))), 0.0, atol=1e-6,
+                                       err_msg=f"point {k}")
+            prev = got[k]

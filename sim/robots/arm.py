@@ -76,6 +76,13 @@ class Arm:
         """Flange pose in frame 0 (the chain's base), (4, 4)."""
         return self.chain.fk(q)
 
+    def branches(self, T: ArrayLike, current: ArrayLike | None = None
+                 ) -> list[NDArray[np.float64]]:
+        """The solutions of a flange pose, one per branch (no whole-turn variants, unsorted):
+        for path inverse kinematics, which picks each joint's turn itself."""
+        cur = np.zeros(self.chain.n) if current is None else np.asarray(current, dtype=float)
+        return _branch_solutions(self, np.asarray(T, dtype=float), cur)
+
     def ik(self, T: ArrayLike, current: ArrayLike | None = None) -> list[Solution]:
         """Every solution of a flange pose: in the limits first, then nearest ``current``.
 
@@ -115,6 +122,24 @@ class Arm:
         out = _dedupe(out)
         out.sort(key=lambda s: (not s.within_limits, float(np.sum(np.abs(s.q - cur)))))
         return out
+
+
+def _branch_solutions(arm: Arm, T: NDArray[np.float64], current: NDArray[np.float64]
+                      ) -> list[NDArray[np.float64]]:
+    """The arm's solutions of a flange pose as its solver gives them (one per branch, no
+    whole-turn variants, unsorted): what :meth:`Arm.ik` expands and ranks. The closed form's
+    branches are checked against the forward kinematics all at once."""
+    if arm.opw is not None:
+        Q = opw.inverse(arm.opw, T)
+        Q = Q[~np.isnan(Q).any(axis=1)]
+        if len(Q) == 0:
+            return []
+        ok = np.abs(arm.chain.fk_many(Q) - T).max(axis=(1, 2)) <= 1e-7
+        return list(Q[ok])
+    if arm.five is not None:
+        return [q for q, _ in arm.five.inverse(T)
+                if np.abs(arm.chain.fk(q)[:3, 3] - T[:3, 3]).max() <= 1e-7]
+    return list(numeric_solve(arm.chain, T, current))
 
 
 def _turns(q: float, lo: float, hi: float) -> list[float]:

@@ -108,6 +108,21 @@ class Chain:
         """Flange pose in the base frame, (4, 4)."""
         return self.frames(q)[2]
 
+    def fk_many(self, Q: ArrayLike) -> NDArray[np.float64]:
+        """Flange poses of many configurations at once, (m, 4, 4), from ``Q`` (m, n) rad (the
+        product of :meth:`frames`, each joint's rotation for all rows by Rodrigues)."""
+        Q = np.atleast_2d(np.asarray(Q, dtype=float))
+        T = np.broadcast_to(np.eye(4), (len(Q), 4, 4))
+        for i in range(self.n):
+            x, y, z = self.axes[i]
+            K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+            th = Q[:, i][:, None, None]
+            J = np.zeros((len(Q), 4, 4))
+            J[:, :3, :3] = np.eye(3) + np.sin(th) * K + (1.0 - np.cos(th)) * (K @ K)
+            J[:, 3, 3] = 1.0
+            T = T @ self.origins[i] @ J
+        return T @ self.flange
+
     def jacobian(self, q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Geometric Jacobian (6, n) (linear rows first, base frame) and the flange pose."""
         axes, points, T = self.frames(q)

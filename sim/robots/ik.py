@@ -117,7 +117,10 @@ def ik_path(model: KinematicModel, poses: Sequence[ArrayLike] | NDArray[np.float
     """Branch-continuous IK along a sequence of tcp poses.
 
     At each point the solution closest (ranking criterion) to the previous point's solution is
-    taken; the first point is compared with ``q_start`` (default home).
+    taken; the first point is compared with ``q_start`` (default home). An arm solved
+    numerically continues from the previous point by one local Newton run where that lands
+    near it (:meth:`~sim.robots.families.KinematicFamily.ik_continue`), and searches every
+    branch elsewhere.
 
     Args:
         model: The robot's kinematic model.
@@ -136,18 +139,70 @@ def ik_path(model: KinematicModel, poses: Sequence[ArrayLike] | NDArray[np.float
     if P.ndim != 3 or P.shape[1:] != (4, 4):
         raise KinematicsError(f"poses must have shape (N, 4, 4), got {P.shape}")
     prev = np.zeros(model.n_joints) if q_start is None else np.asarray(q_start, dtype=float)
+    if prev.shape != (model.n_joints,):
+        raise KinematicsError(f"current configuration must have {model.n_joints} values")
+    bad = ~np.all(np.isfinite(P), axis=(1, 2))
+    if np.any(bad):
+        raise KinematicsError(f"path point {int(np.argmax(bad))}: pose must be a finite 4x4 "
+                              "transform")
+    R = P[:, :3, :3]
+    skewed = np.abs(R @ np.swapaxes(R, 1, 2) - np.eye(3)).max(axis=(1, 2)) > 1e-6
+    if np.any(skewed):
+        raise KinematicsError(f"path point {int(np.argmax(skewed))}: pose rotation is not "
+                              "orthonormal")
+    seeds = P @ invert_transform(model.tcp_offset)
     out = np.empty((P.shape[0], model.n_joints))
-    for k, T in enumerate(P):
-        try:
-            sols = solve_ik(model, T, prev)
-        except UnreachableError as exc:
-            raise UnreachableError(f"path point {k}: {exc}", exc.distance) from None
-        if respect_limits:
-            sols = [s for s in sols if s.within_limits]
-            if not sols:
-                raise UnreachableError(f"path point {k}: no IK solution inside the joint ranges",
-                                       0.0)
-        best = min(sols, key=lambda s: s.cost)
-        out[k] = best.q
-        prev = best.q
+    for k, T_seed in enumerate(seeds):
+        # a numeric arm continues its branch locally where it can (one Newton run, not a
+        # global search); a closed form lists every branch
+        q = None
+        near = model.family.ik_continue(T_seed, prev) if k > 0 else None
+        if near is not None:
+            q = _nearest_representation(model, [near], prev, respect_limits)
+        if q is None:
+            try:
+                raw = model.family.ik_branches(T_seed, prev)
+            except UnreachableError as exc:
+                raise UnreachableError(f"path point {k}: {exc}", exc.distance) from None
+            q = _nearest_representation(model, raw, prev, respect_limits)
+        if q is None:
+            raise UnreachableError(f"path point {k}: no IK solution inside the joint ranges",
+                                   0.0)
+        out[k] = q
+        prev = q
     return out
+
+
+#: Whole turns tried for a joint with a finite range (as :func:`_representations`).
+_TURNS = 2.0 * np.pi * np.arange(-3, 4)
+
+
+def _nearest_representation(model: KinematicModel, raw: list[NDArray[np.float64]],
+                            current: NDArray[np.float64], respect_limits: bool
+                            ) -> NDArray[np.float64] | None:
+    """The nearest of :func:`solve_ik`'s solutions (least ranking cost; with
+    ``respect_limits`` among those inside the ranges, None when there is none) from ``raw``
+    (the family's solutions), in O(n) per solution: the ranking cost is a sum over the
+    joints, so each joint takes on its own the in-range ``theta + 2 k pi`` nearest
+    ``current`` (the nearest one where the range is unknown)."""
+    if not raw:
+        return None
+    lo, hi = model.lower, model.upper
+    W = wrap_to_pi(np.asarray(raw, dtype=float))  # (b, n)
+    rep = W + 2 * np.pi * np.round((current - W) / (2 * np.pi))  # nearest turn, any range
+    if lo is not None and hi is not None:
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        cands = W[..., None] + _TURNS  # (b, n, 7)
+        inside = (cands >= lo[:, None] - 1e-9) & (cands <= hi[:, None] + 1e-9)
+        dist = np.where(inside, np.abs(cands - current[:, None]), np.inf)
+        pick = np.take_along_axis(cands, np.argmin(dist, axis=2)[..., None], axis=2)[..., 0]
+        rep = np.where(finite, np.where(inside.any(axis=2), pick, W), rep)
+        within = np.all((rep >= lo - 1e-9) & (rep <= hi + 1e-9), axis=1)
+    else:
+        within = np.ones(len(rep), dtype=bool)
+    cost = np.sqrt(np.sum(((rep - current) / model.max_speed) ** 2, axis=1))
+    if respect_limits:
+        if not np.any(within):
+            return None
+        cost = np.where(within, cost, np.inf)
+    return rep[int(np.argmin(cost))]

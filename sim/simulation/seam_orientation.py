@@ -76,6 +76,11 @@ class SeamOrientation:
         self._roll = axis_angle_matrix(axis, float(roll)) if roll else np.eye(3)
         self._delta = np.zeros(3)
         self.settle = max(float(settle), 1e-9)
+        # the torch frame on a line, where it does not change (a 5-axis arm's turns with the
+        # point about J1)
+        self._constant = None
+        if getattr(seam, "kind", None) == "line" and getattr(seam, "tool_axis", 2) == 2:
+            self._constant = self.to_frame0 @ seam.torch_rotation(self.s0) @ self._roll
         if start is not None:
             R0 = np.asarray(start, dtype=float)
             self._delta = rotation_log(self._frame(np.array([0.0]))[0].T @ R0)
@@ -89,6 +94,8 @@ class SeamOrientation:
 
     def _frame(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
         s = self.s0 + np.clip(u, 0.0, 1.0) * (self.s1 - self.s0)
+        if self._constant is not None:  # a line's torch frame is the same all along it
+            return np.broadcast_to(self._constant, u.shape + (3, 3)).copy()
         R = np.array([self.seam.torch_rotation(float(x)) for x in s.ravel()])
         return (self.to_frame0 @ R @ self._roll).reshape(u.shape + (3, 3))
 

@@ -139,6 +139,25 @@ class KinematicFamily(ABC):
                 than six axes, an orientation the arm cannot take.
         """
 
+    def ik_branches(self, T: NDArray[np.float64], current: NDArray[np.float64]
+                    ) -> list[NDArray[np.float64]]:
+        """The joints of :meth:`ik`'s solutions, at least one per branch (whole-turn variants
+        may be left out: path inverse kinematics picks each joint's turn itself); a family
+        whose :meth:`ik` expands turns overrides this with a cheaper one.
+
+        Raises:
+            UnreachableError: As :meth:`ik`.
+        """
+        return [q for q, _ in self.ik(T, current)]
+
+    def ik_continue(self, T: NDArray[np.float64], current: NDArray[np.float64]
+                    ) -> NDArray[np.float64] | None:
+        """The solution that continues ``current`` to the nearby pose ``T``, found locally, or
+        None to have path inverse kinematics search every branch (:meth:`ik_branches`). A
+        closed form needs no shortcut; a numeric solver's global search costs tens of Newton
+        runs per pose, so it overrides this."""
+        return None
+
     # ------------------------------------------------------------------ Jacobian
     @abstractmethod
     def task_jacobian(self, J: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -22,6 +22,11 @@ from sim.errors import KinematicsError, UnreachableError
 from sim.robots.families.base import KinematicFamily
 
 
+#: Largest joint change, rad, a numeric arm's path point may take from the one before when
+#: found locally (:meth:`ChainFamily.ik_continue`); a larger one is searched globally.
+CONTINUE_STEP = 0.1
+
+
 class ChainFamily(KinematicFamily):
     """A 6-axis (or other) arm from its chain (module docstring)."""
 
@@ -74,6 +79,29 @@ class ChainFamily(KinematicFamily):
             raise UnreachableError(f"{self.arm.name}: no inverse-kinematics solution "
                                    f"({self.arm.solver} solver)", 0.0)
         return [(s.q, s.branch) for s in sols]
+
+    def ik_continue(self, T, current):
+        """A numeric arm's next path point: damped Newton from ``current``, kept when it
+        converges within :data:`CONTINUE_STEP` of it on every joint (the branch it is on);
+        otherwise None (the global search decides)."""
+        if self.arm.solver != "numeric":
+            return None
+        from sim.robots.numeric_ik import solve_one
+
+        flange = np.asarray(T, dtype=float) @ np.linalg.inv(self._tool_T())
+        cur = np.asarray(current, dtype=float)
+        q, err = solve_one(self.arm.chain, flange, cur)
+        if err < 1e-12 and float(np.max(np.abs(q - cur))) <= CONTINUE_STEP:
+            return q
+        return None
+
+    def ik_branches(self, T, current):
+        flange = np.asarray(T, dtype=float) @ np.linalg.inv(self._tool_T())
+        sols = self.arm.branches(flange, current)
+        if not sols:
+            raise UnreachableError(f"{self.arm.name}: no inverse-kinematics solution "
+                                   f"({self.arm.solver} solver)", 0.0)
+        return sols
 
     # ------------------------------------------------------------------ Jacobian
     def task_jacobian(self, J):
