@@ -21,7 +21,6 @@ import time
 import mujoco
 import numpy as np
 
-from sim.analysis.sizing import apply_overrides
 from sim.core.resources import shipped_scenarios
 from sim.scenario import load_scenario
 from sim.simulation.compile import build
@@ -53,7 +52,7 @@ def main() -> None:
         built = build(sc)
         motion = build_motion(sc, built.context)
         # the drives as the runner passes them (their torque-speed curves limit the actuators)
-        drives = apply_overrides(sc.robot.drives, sc.drives, sc.robot.joints)
+        drives = sc.drive_train
         drives = drives if sc.simulation.motor_speed_limits and drives else None
         best_sim = best_total = best_bare = np.inf
         steps = 0

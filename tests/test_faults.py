@@ -269,9 +269,22 @@ def test_a_full_disk_is_one_line_and_the_previous_result_stays(tmp_path, capsys,
     assert _hidden(out) == []
 
 
+_FINISHED: list[Path] = []
+
+
 def _finished_run(tmp_path) -> Path:
+    """A finished run folder of :data:`QUICK` at ``tmp_path / "run"``: the module's one run,
+    copied (each test may spoil its copy)."""
+    import shutil
+    import tempfile
+
+    if not _FINISHED:
+        first = Path(tempfile.mkdtemp(prefix="cellsim-faults-")) / "run"
+        assert main(["run", QUICK, "--out", str(first), "--no-video", "--no-plots",
+                     "--quiet"]) == 0
+        _FINISHED.append(first)
     out = tmp_path / "run"
-    assert main(["run", QUICK, "--out", str(out), "--no-video", "--no-plots", "--quiet"]) == 0
+    shutil.copytree(_FINISHED[0], out)
     return out
 
 
@@ -317,6 +330,7 @@ def test_render_refuses_nan_arrays_and_a_plots_symlink(tmp_path, capsys):
     rc = main(["render", str(out2), "--plots", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and "symbolic link" in err and list(elsewhere.iterdir()) == []
+    assert not (out2 / "video.mp4").exists()  # refused before rendering, not after
 
 
 @pytest.mark.parametrize("time_s", [-1.0, 1e9])
@@ -458,6 +472,7 @@ print(json.dumps(seen))
 """
 
 
+@pytest.mark.slow  # five cellsim processes, one encoding a video until the disk is full
 @needs_mounts
 def test_a_real_full_disk_and_a_read_only_parent(tmp_path):
     """A 20 MB tmpfs as --out: a first result fits; with the disk filled, a second run (failing

@@ -666,8 +666,8 @@ def campaign(arm: Arm, kind: str, n: int, seed: int, body: Any) -> None:
 #: this 2-core machine, so those would take over an hour, past CI's 90 minutes with the rest
 #: of the suite: the sizes grow when the generator wastes fewer draws and planning is faster
 #: (issue 29).
-SLOW_FACTOR = 2
-SLOW_SIMULATED = 2
+SLOW_FACTOR = 10
+SLOW_SIMULATED = 10
 
 
 def _seed(*key: Any) -> int:

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from scipy import integrate, optimize
 
+from sim.robots.drives import apply_overrides
 from sim.analysis.sizing import (
     PEAK_KNEE_FRACTION,
-    apply_overrides,
     armature_from_model,
     continuous_envelope,
     forcerange_from_model,

@@ -270,6 +270,19 @@ def torque_figure(record: RunRecord) -> Any:
     return fig
 
 
+def check_plots_dir(out: Path) -> None:
+    """Refuses a plots folder that is a symbolic link (cellsim never writes through one).
+
+    Raises:
+        RunFolderError: One line naming it.
+    """
+    if Path(out).is_symlink():
+        from sim.errors import RunFolderError
+
+        raise RunFolderError(f"{out}: is a symbolic link; cellsim writes plots only into a real "
+                             "folder (remove the link)")
+
+
 def write_plots(run: str | Path | RunRecord, out_dir: str | Path | None = None) -> list[Path]:
     """Writes every plot of a run as PNG.
 
@@ -294,11 +307,7 @@ def write_plots(run: str | Path | RunRecord, out_dir: str | Path | None = None) 
             raise UsageError("out_dir is required for a run that was not read from a folder")
         out_dir = record.source / PLOTS_DIR
     out = Path(out_dir)
-    if out.is_symlink():
-        from sim.errors import RunFolderError
-
-        raise RunFolderError(f"{out}: is a symbolic link; cellsim writes plots only into a real "
-                             "folder (remove the link)")
+    check_plots_dir(out)
     out.mkdir(parents=True, exist_ok=True)
     jobs: list[tuple[str, Any]] = [
         (f"joint_{re.sub(r'[^A-Za-z0-9_.-]', '_', name)}.png", lambda j=j: joint_figure(record, j))

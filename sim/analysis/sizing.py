@@ -65,7 +65,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sim.errors import CellsimError, ScenarioError, UnknownNameError
+from sim.errors import CellsimError, UnknownNameError
 from sim.robots.registry import PEAK_KNEE_FRACTION as _PEAK_KNEE_FRACTION
 from sim.robots.registry import RPM_PER_RAD_S, Drive, RobotSpec
 from sim.simulation.runfolder import SUMMARY_JSON, TRAJECTORY_NPZ, RunRecord
@@ -581,108 +581,6 @@ def motor_stats(t: ArrayLike, tau_m: ArrayLike, speed_rpm: ArrayLike, drive: Dri
 
 
 # --------------------------------------------------------------------------------------------
-# Drive overrides
-# --------------------------------------------------------------------------------------------
-
-_DRIVE_FIELDS = tuple(f.name for f in dataclasses.fields(Drive))
-
-#: Key names of a scenario's ``[drives.jN]`` table (docs/scenario-format.md) -> Drive fields.
-#: The bare Drive field names are accepted too.
-DRIVE_KEYS = {
-    "gear_ratio": "gear_ratio",
-    "efficiency": "efficiency",
-    "rotor_inertia_kg_m2": "rotor_inertia",
-    "rated_torque_nm": "rated_torque",
-    "peak_torque_nm": "peak_torque",
-    "max_speed_rpm": "max_speed_rpm",
-}
-_KEY_OF_FIELD = {v: k for k, v in DRIVE_KEYS.items()}
-
-
-def _check_drive(d: Drive, where: str) -> None:
-    k = _KEY_OF_FIELD
-    for name in _DRIVE_FIELDS:
-        v = getattr(d, name)
-        if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
-            raise ScenarioError(f"{where}.{k[name]}: must be a finite number, got {v!r}")
-    if d.gear_ratio <= 0:
-        raise ScenarioError(f"{where}.gear_ratio: must be > 0, got {d.gear_ratio!r}")
-    if not 0 < d.efficiency <= 1:
-        raise ScenarioError(f"{where}.efficiency: must be in (0, 1], got {d.efficiency!r}")
-    if d.rotor_inertia < 0:
-        raise ScenarioError(f"{where}.rotor_inertia_kg_m2: must be >= 0, got {d.rotor_inertia!r}")
-    for name in ("rated_torque", "peak_torque", "max_speed_rpm"):
-        if getattr(d, name) <= 0:
-            raise ScenarioError(f"{where}.{k[name]}: must be > 0, got {getattr(d, name)!r}")
-    if d.peak_torque < d.rated_torque:
-        raise ScenarioError(f"{where}.peak_torque_nm: {d.peak_torque!r} N m is below "
-                            f"rated_torque_nm {d.rated_torque!r} N m")
-
-
-def apply_overrides(drives: Sequence[Drive], overrides: Mapping[str, Any] | None,
-                    joint_names: Sequence[str]) -> tuple[Drive, ...]:
-    """Drives with a scenario's ``[drives.jN]`` tables applied.
-
-    Args:
-        drives: Default drive per joint (``RobotSpec.drives``), same order as ``joint_names``.
-            May be empty when the robot has no drive data; then every joint named in
-            ``overrides`` must give all fields.
-        overrides: ``{"j2": {"gear_ratio": 120, "rated_torque_nm": 1.3}, ...}`` (the parsed
-            ``[drives]`` table, keys as in docs/scenario-format.md: :data:`DRIVE_KEYS`; the bare
-            :class:`Drive` field names are accepted too); None or empty leaves the defaults.
-        joint_names: The robot's joint names.
-
-    Returns:
-        One :class:`Drive` per joint (``len(joint_names)``), or ``()`` when there are neither
-        defaults nor overrides.
-
-    Raises:
-        UnknownNameError: An unknown joint or field name (lists the valid ones).
-        ScenarioError: A bad value (non-number, efficiency outside (0, 1], ...) or a missing
-            field when there is no default to complete it.
-    """
-    names = tuple(joint_names)
-    base: list[Drive | None] = list(drives) if drives else [None] * len(names)
-    if len(base) != len(names):
-        raise CellsimError(f"{len(base)} drives for {len(names)} joints ({', '.join(names)})")
-    overrides = overrides or {}
-    if not isinstance(overrides, Mapping):
-        raise ScenarioError(f"drives: must be a table of joint tables, got {type(overrides).__name__}")
-    for joint, table in overrides.items():
-        if joint not in names:
-            raise UnknownNameError("joint in [drives]", str(joint), names)
-        where = f"drives.{joint}"
-        if not isinstance(table, Mapping):
-            raise ScenarioError(f"{where}: must be a table of drive keys "
-                                f"({', '.join(DRIVE_KEYS)}), got {table!r}")
-        values: dict[str, float] = {}
-        for key, value in table.items():
-            fname = DRIVE_KEYS.get(key, key if key in _DRIVE_FIELDS else None)
-            if fname is None:
-                raise UnknownNameError(f"key in [{where}]", str(key), DRIVE_KEYS)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ScenarioError(f"{where}.{key}: must be a number, got {value!r}")
-            values[fname] = float(value)
-        i = names.index(joint)
-        if base[i] is None:
-            missing = [_KEY_OF_FIELD[f] for f in _DRIVE_FIELDS if f not in values]
-            if missing:
-                raise ScenarioError(f"{where}: the robot has no default drive, give "
-                                    f"{', '.join(missing)} too")
-            base[i] = Drive(**values)
-        else:
-            base[i] = dataclasses.replace(base[i], **values)
-        _check_drive(base[i], where)
-    if all(d is None for d in base):
-        return ()
-    if any(d is None for d in base):
-        missing = [n for n, d in zip(names, base) if d is None]
-        raise ScenarioError(f"drives: no drive data for {', '.join(missing)}; give a full "
-                            f"[drives.{missing[0]}] table ({', '.join(DRIVE_KEYS)})")
-    return tuple(base)  # type: ignore[arg-type]
-
-
-# --------------------------------------------------------------------------------------------
 # Reading limits from the MuJoCo model
 # --------------------------------------------------------------------------------------------
 
@@ -720,14 +618,20 @@ def _joint_ids(model: Any, joint_names: Sequence[str]) -> list[int]:
 
 
 def joint_forcerange(model: Any, joint_ids: Sequence[int]) -> NDArray[np.float64]:
-    """:func:`forcerange_from_model` for joints given by id (resolved once by the caller)."""
+    """:func:`forcerange_from_model` for joints given by id (resolved once by the caller). The
+    joints' Coulomb friction actuators (cellsim's ``friction_<joint>``) are friction, not drive:
+    they are left out."""
     import mujoco
+
+    from sim.cells.compose import FRICTION_PREFIX
 
     out = np.empty((len(joint_ids), 2))
     for k, jid in enumerate(joint_ids):
         lo, hi, driven = 0.0, 0.0, False
         for a in range(model.nu):
             if model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT or model.actuator_trnid[a, 0] != jid:
+                continue
+            if model.actuator(a).name.rsplit("/", 1)[-1].startswith(FRICTION_PREFIX):
                 continue
             driven = True
             if model.actuator_forcelimited[a]:

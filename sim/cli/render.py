@@ -78,6 +78,11 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path(args.run_dir) / VIDEO_MP4
     if out.suffix.lower() != ".mp4":
         raise RenderError(f"--out {str(out)!r} must end in .mp4")
+    if args.plots:  # refused before the video is rendered, not after
+        from sim.analysis.plots import check_plots_dir
+        from sim.simulation.runfolder import PLOTS_DIR
+
+        check_plots_dir(Path(args.run_dir) / PLOTS_DIR)
     result = write_video(
         record, out, cameras=tuple(args.cameras or ("overview",)), width=args.width,
         height=args.height, fps=args.fps, gl=backend, progress=not args.quiet,

@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim import __version__
-from sim.analysis.sizing import SizingResult, apply_overrides
+from sim.analysis.sizing import SizingResult
 from sim.analysis.verdict import run_checks, verdict, warnings_count
 from sim.errors import InternalError, RenderError, RunFolderError
 from sim.pipeline.stages import Stages
@@ -193,7 +193,7 @@ def _feedforward(scenario: Scenario, options: RunOptions) -> bool:
 
 def _drives(scenario: Scenario) -> Any:
     """The drives whose torque-speed curves limit the simulation, or None."""
-    drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
+    drives = scenario.drive_train
     return drives if scenario.simulation.motor_speed_limits and drives else None
 
 
@@ -515,16 +515,11 @@ def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:
 def _size(scenario: Scenario, built: BuiltCell, record: runfolder.RunRecord,
           summary: dict[str, Any]) -> SizingResult:
     """Size the run's drives; the summary gets the ``sizing`` headline."""
-    from sim.analysis.sizing import (
-        apply_overrides,
-        joint_armature,
-        joint_forcerange,
-        size_record,
-    )
+    from sim.analysis.sizing import joint_armature, size_record
 
-    drives = apply_overrides(scenario.robot.drives, scenario.drives, scenario.robot.joints)
-    result = size_record(record, scenario.robot, drives,
-                         joint_forcerange(built.model, built.joint_ids),
+    # the compiled model's drive force range and armature are the same drives'
+    # (Scenario.drive_train): the joint torque is checked against the drive's own limit
+    result = size_record(record, scenario.robot, scenario.drive_train, built.force_limits,
                          armature=joint_armature(built.model, built.joint_ids))
     summary["sizing"] = {"hardest_joint": result.hardest_joint,
                          "hardest_margin_pct": result.hardest_margin_pct,

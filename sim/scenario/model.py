@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import ScenarioError, UsageError
-from sim.robots.registry import RobotSpec
+from sim.robots.registry import Drive, RobotSpec
 from sim.scenario.schema import SimulationSpec, SizingSpec, VideoSpec
 
 if TYPE_CHECKING:
@@ -256,6 +256,21 @@ class Scenario:
     @property
     def sha256(self) -> str:
         return hashlib.sha256(self.text.encode()).hexdigest()
+
+    @property
+    def drive_train(self) -> tuple[Drive, ...]:
+        """The drive each joint really has: the robot's (its defaults, or its robot folder's
+        ``[[drives]]``) with this scenario's ``[drives.jN]`` applied; ``()`` for a robot
+        without drive data. The compiled model's ``forcerange`` and ``armature``, the
+        simulation's torque-speed limit and sizing all take it from here
+        (:func:`sim.robots.drives.apply_overrides`).
+
+        Raises:
+            ScenarioError: A bad override value (one line naming ``drives.<joint>.<key>``).
+        """
+        from sim.robots.drives import apply_overrides
+
+        return apply_overrides(self.robot.drives, self.drives, self.robot.joints)
 
     def scaled(self, speed_scale: float = 1.0, payload_kg: float | None = None) -> "Scenario":
         """This scenario run ``speed_scale`` times faster, optionally with another payload.

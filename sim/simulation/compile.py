@@ -23,6 +23,7 @@ from sim.simulation.motion import CartesianContext
 if TYPE_CHECKING:  # sim.cells imports mujoco: the command line picks MUJOCO_GL first
     from sim.cells import Cell
     from sim.robots.model import KinematicModel
+    from sim.robots.registry import Drive
 
 
 @dataclass
@@ -83,9 +84,14 @@ def build(scenario: Scenario) -> BuiltCell:
     root = cell.mjcf
     if scenario.simulation.timestep_s is not None:
         root.option.timestep = scenario.simulation.timestep_s
+    # the drive each joint really has (a scenario's [drives] override included) sets its
+    # actuator's force range and its joint's armature: one drive everywhere
+    drives = scenario.drive_train
     sensors: list[tuple[str, int]] = []
     for i, name in enumerate(cell.actuator_names):
         actuator = root.find("actuator", name)
+        if drives:
+            _apply_drive(actuator, root.find("joint", cell.joint_names[i]), drives[i])
         # the control carries the feed-forward torque (ctrl = q_ref + kv/kp qd_ref + tau_ff/kp):
         # no clamp on it; the drive's limit is its forcerange
         actuator.ctrllimited = False
@@ -145,6 +151,17 @@ def build(scenario: Scenario) -> BuiltCell:
                          if model.actuator(a).name.startswith(f"robot/{FRICTION_PREFIX}")], dtype=int)
     return BuiltCell(cell, model, saved_xml, robot_qpos, robot_dof, robot_act, suction, slices,
                      part_qpos, ctx, jids, tcp_site, frame0_site, limits, friction)
+
+
+def _apply_drive(actuator: Any, joint: Any, drive: Drive) -> None:
+    """A joint's drive in its MJCF: the actuator's force range is the drive's peak torque at the
+    joint (peak motor torque x ratio x efficiency, through the actuator's gear) and the joint's
+    armature the rotor's reflected inertia ``J_r N^2``."""
+    gear = float(actuator.gear[0]) if actuator.gear is not None else 1.0
+    peak = drive.peak_torque * drive.gear_ratio * drive.efficiency / gear
+    actuator.forcelimited = True
+    actuator.forcerange = [-peak, peak]
+    joint.armature = drive.rotor_inertia * drive.gear_ratio ** 2
 
 
 def _tool_kinematics(kin: KinematicModel, model: Any, f0: int, tcp: int,

@@ -1,0 +1,121 @@
+"""One drive everywhere (issue 26): the drive a joint really has, from whichever source (the
+shipped robot's defaults, a robot folder's ``[[drives]]``, a scenario's ``[drives.jN]``
+override), sets the compiled model's force range and armature, the simulated clamp and the
+torque range sizing checks against.
+
+The oracle is the input's own numbers: peak motor torque x gear ratio x efficiency, and
+``J_r N^2``, computed here from the values the test writes or the robot's published table.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from sim.pipeline.run import RunOptions, evaluate_scenario
+from sim.scenario import load_scenario
+
+SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
+#: The 5R's J2 drive (models/robot_5r/README.md): peak motor torque N m, ratio, efficiency,
+#: rotor inertia kg m^2.
+J2_5R = (46.0, 160.0, 0.8, 2.3e-3)
+
+UR5_TOML = """name = "ur5_drives"
+description = "a UR5-like DH arm with its own drives"
+[kinematics]
+convention = "dh"
+dh = [[0.0, 90.0, 89.159, 0.0], [-425.0, 0.0, 0.0, 0.0], [-392.25, 0.0, 0.0, 0.0],
+      [0.0, 90.0, 109.15, 0.0], [0.0, -90.0, 94.65, 0.0], [0.0, 0.0, 82.3, 0.0]]
+[joints]
+range_deg = [[-360, 360], [-360, 360], [-180, 180], [-360, 360], [-360, 360], [-360, 360]]
+max_speed_deg_s = [180, 180, 180, 180, 180, 180]
+[mass]
+total_kg = 18
+payload_kg = 5
+""" + "".join(f"""[[drives]]
+gear_ratio = {r}
+efficiency = {e}
+rotor_inertia_kg_m2 = {i}
+rated_torque_nm = {t}
+peak_torque_nm = {p}
+max_speed_rpm = 6000
+""" for r, e, i, t, p in ((101, 0.75, 2e-5, 0.8, 3.0), (121, 0.7, 4.5e-5, 1.6, 5.0),
+                          (101, 0.75, 2e-5, 0.8, 3.0), (81, 0.8, 5e-6, 0.3, 1.0),
+                          (81, 0.8, 5e-6, 0.3, 1.0), (51, 0.85, 5e-6, 0.3, 1.0)))
+UR5_DRIVES = ((101, 0.75, 2e-5, 3.0), (121, 0.7, 4.5e-5, 5.0), (101, 0.75, 2e-5, 3.0),
+              (81, 0.8, 5e-6, 1.0), (81, 0.8, 5e-6, 1.0), (51, 0.85, 5e-6, 1.0))
+
+
+def model_drive(ev, joint: int) -> tuple[float, float]:
+    """The compiled model's (as written to model.xml) force range and armature of a joint."""
+    m = mujoco.MjModel.from_xml_string(ev.built.xml)
+    a = int(ev.built.robot_act[joint])
+    dof = int(ev.built.robot_dof[joint])
+    lo, hi = m.actuator_forcerange[a] * m.actuator_gear[a, 0]
+    assert lo == pytest.approx(-hi)
+    return float(hi), float(m.dof_armature[dof])
+
+
+def run(path: Path):
+    return evaluate_scenario(load_scenario(path), RunOptions(video=False, plots=False,
+                                                             progress=False))
+
+
+def five_r(tmp_path: Path, override: str = "") -> Path:
+    text = (SCENARIOS / "bugnar_5r_phase1.toml").read_text()
+    path = tmp_path / "s.toml"
+    path.write_text(text + "\n" + override)
+    return path
+
+
+def ur5(tmp_path: Path, override: str = "") -> Path:
+    (tmp_path / "robots" / "ur5").mkdir(parents=True)
+    (tmp_path / "robots" / "ur5" / "robot.toml").write_text(UR5_TOML)
+    path = tmp_path / "s.toml"
+    path.write_text(f"""name = "ur5_move"
+description = "a joint move of a robot folder's arm"
+robot = "robots/ur5"
+{override}
+[[phases]]
+name = "move"
+planner = "434"
+time_s = [0.0, 1.0, 2.0]
+joints_deg = [[0, -90, 90, -90, -90, 0], [20, -80, 80, -80, -80, 10], [40, -70, 70, -70, -70, 20]]
+""")
+    return path
+
+
+@pytest.mark.parametrize("source", ["robot defaults", "robot folder", "scenario override"])
+def test_the_drive_a_joint_has_sets_the_model_the_clamp_and_sizing(tmp_path, source):
+    """Each source of a drive: model.xml's force range and armature, the simulated torque
+    limit (``tau_limit``), the actuator's clamped force and sizing's torque range are the
+    drive's."""
+    if source == "robot defaults":
+        path, joint, (peak, ratio, eta, rotor) = five_r(tmp_path), 1, J2_5R
+    elif source == "robot folder":
+        (ratio, eta, rotor, peak), joint = UR5_DRIVES[1], 1
+        path = ur5(tmp_path)
+    else:  # a twentieth of the 5R's J2 peak and another rotor: the arm sags under gravity
+        peak, ratio, eta, rotor = J2_5R[0] / 20, J2_5R[1], J2_5R[2], 1.0e-3
+        path, joint = five_r(tmp_path, f"[drives.j2]\npeak_torque_nm = {peak}\n"
+                                       f"rated_torque_nm = {peak / 2}\n"
+                                       f"rotor_inertia_kg_m2 = {rotor}\n"), 1
+    limit = peak * ratio * eta
+    ev = run(path)
+    got_limit, got_armature = model_drive(ev, joint)
+    assert got_limit == pytest.approx(limit, rel=1e-9)
+    assert got_armature == pytest.approx(rotor * ratio**2, rel=1e-9)
+    a = ev.record.arrays
+    assert np.allclose(a["tau_limit"][:, joint], limit, rtol=1e-9) or \
+        a["tau_limit"][:, joint].max() <= limit * (1 + 1e-9)
+    assert np.abs(a["tau_actuator"][:, joint]).max() <= limit * (1 + 1e-9)
+    sized = {j["joint"]: j for j in ev.sizing.to_dict()["joints"]}
+    name = list(sized)[joint]
+    assert sized[name]["torque_range_nm"] == pytest.approx([-limit, limit], rel=1e-9)
+    if source == "scenario override":  # the arm cannot be held: a saturated drive fails
+        assert np.abs(a["tau_actuator"][:, joint]).max() == pytest.approx(limit, rel=1e-9)
+        assert ev.summary["verdict"] == "fail"
+        assert "saturation" in {c["name"] for c in ev.summary["checks"] if not c["pass"]}
