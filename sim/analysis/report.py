@@ -350,12 +350,41 @@ def _md_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     return "\n".join(lines)
 
 
-def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = ()) -> str:
-    """Text of ``sizing.md``: header, verdict paragraph, table, checks, chart links."""
+def run_verdict_text(summary: Mapping[str, Any]) -> str | None:
+    """The run's verdict in one line, as every report gives it (``report.html``,
+    ``sizing.md``, the console): ``Run verdict: FAIL: 51 checks, 2 failed, 3 warning(s).``;
+    None for a summary without a verdict."""
+    if "verdict" not in summary:
+        return None
+    checks = summary.get("checks", [])
+    failed = [c for c in checks if not c["pass"] and c.get("severity", "error") == "error"]
+    warned = [c for c in checks if not c["pass"] and c.get("severity") == "warning"]
+    return (f"Run verdict: {str(summary['verdict']).upper()}: {len(checks)} checks, "
+            f"{len(failed)} failed, {len(warned)} warning(s).")
+
+
+def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
+                    summary: Mapping[str, Any] | None = None) -> str:
+    """Text of ``sizing.md``: header, the run's verdict (``summary``'s: the same as
+    ``report.html`` and ``summary.json``, with its failed checks and warnings), the sizing's
+    own verdict paragraph, table, checks, chart links."""
     parts = [f"# Actuator sizing: {result.scenario or 'run'}", ""]
     parts.append(f"Robot: {result.robot or 'n/a'}; cycle duration {result.duration:.3f} s; checks "
                  f"on basis '{result.basis}'.")
-    parts += ["", "## Verdict", "", result.verdict, "", "## Per joint", ""]
+    run_line = run_verdict_text(summary or {})
+    if run_line is not None:
+        checks = (summary or {}).get("checks", [])
+        listed = [c for c in checks if not c["pass"]]
+        parts += ["", "## Run verdict", "", run_line]
+        if listed:
+            parts += ["", _md_table(("check", "subject", "value", "limit", "unit", "severity"), [
+                (str(c["name"]), str(c.get("subject") or c.get("joint", "")),
+                 _f(float(c["value"])), _f(float(c["limit"])), str(c["unit"]),
+                 str(c.get("severity", "error"))) for c in listed])]
+        parts += ["", "The sizing below is one part of it (the drives' torque, speed and "
+                  "envelope checks)."]
+    parts += ["", "## Sizing verdict" if run_line is not None else "## Verdict", "",
+              result.verdict, "", "## Per joint", ""]
     parts.append(_md_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
     parts += ["", "## Checks", ""]
     parts.append(_md_table(_CHECK_HEAD, [r for j in result.joints for r in _checks_cells(j)]))
@@ -520,8 +549,7 @@ def _run_verdict_html(summary: Mapping[str, Any]) -> list[str]:
     failed = [c for c in checks if not c["pass"] and c.get("severity", "error") == "error"]
     warned = [c for c in checks if not c["pass"] and c.get("severity") == "warning"]
     cls = "verdict" if summary["verdict"] == "pass" else "verdict fail"
-    text = (f"Run verdict: {summary['verdict'].upper()}: {len(checks)} checks, "
-            f"{len(failed)} failed, {len(warned)} warning(s).")
+    text = run_verdict_text(summary)
     out = [f'<h2>Run verdict</h2><p class="{cls}">{html.escape(text)}</p>']
     if failed or warned:
         out.append(_html_table(("check", "subject", "value", "limit", "unit", "severity"), [
@@ -629,12 +657,12 @@ def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = Tr
     pngs = sizing_charts(result) if charts else {}
     for name, png in pngs.items():
         written[name] = write_atomic(run_dir / PLOTS_DIR / name, png)
-    written["md"] = write_atomic(run_dir / SIZING_MD, sizing_markdown(result, list(pngs)))
     if summary is None:  # a finished folder: read what it holds
         summary = load_summary(run_dir)
         video = VIDEO_MP4 if (run_dir / VIDEO_MP4).is_file() else None
     else:  # the runner's summary in memory names the video when it wrote one
         video = summary.get("video")
+    written["md"] = write_atomic(run_dir / SIZING_MD, sizing_markdown(result, list(pngs), summary))
     written["html"] = write_atomic(run_dir / REPORT_HTML,
                                    sizing_html(result, pngs, summary, video, selection))
     return written

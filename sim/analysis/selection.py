@@ -26,7 +26,8 @@ Checks (``error`` severity unless said):
   (the dwell adds time, no revolutions);
 * ``estop_torque`` (warning): the motor's peak torque braking the load through the reducer,
   ``T_peak N / eta``, against the momentary peak torque (an emergency stop, a collision);
-* ``inertia_ratio`` (warning): ``(J_load / N^2 + J_in) / J_r`` against ``inertia_ratio_max``,
+* ``inertia_ratio`` (error, or a warning where ``[sizing] inertia_ratio = "warning"``):
+  ``(J_load / N^2 + J_in) / J_r`` against ``inertia_ratio_max``,
   ``J_load`` the joint's largest diagonal of the joint-space inertia matrix along the cycle
   (armature excluded, every 10 ms);
 * ``braking_energy`` (information, no limit): the energy the motor gives back per cycle,
@@ -83,7 +84,10 @@ class SelectionOptions:
         life_h: Reducer L10 life target, h.
         dwell_s: Standstill after each cycle, s (holding the last sample's torque).
         rank: How passing pairs are ranked (:data:`RANKS`).
-        inertia_ratio_max: Load-to-rotor inertia ratio above which a pair gets a warning.
+        inertia_ratio_max: Largest load-to-rotor inertia ratio a pair may have.
+        inertia_ratio: ``"error"``: a pair over ``inertia_ratio_max`` does not pass (the
+            default: the servo of a drive far over it cannot be tuned stiff); ``"warning"``:
+            it passes with a warning.
     """
 
     catalog: Catalog
@@ -91,6 +95,7 @@ class SelectionOptions:
     dwell_s: float = 0.0
     rank: str = "mass"
     inertia_ratio_max: float = DEFAULT_INERTIA_RATIO_MAX
+    inertia_ratio: str = "error"
 
 
 @dataclass(frozen=True)
@@ -377,7 +382,7 @@ def check_pair(sources: Sequence[_Source], motor: Motor, reducer: Reducer,
                             r.momentary_peak_torque_nm, "N m", "catalogue", "warning"))
     ratio = (j_load / r.ratio**2 + r.input_inertia_kg_m2) / m.rotor_inertia_kg_m2
     checks.append(PairCheck("inertia_ratio", ratio, opts.inertia_ratio_max, "-", "model",
-                            "warning"))
+                            opts.inertia_ratio))
     if with_energy:
         energy = max(_braking_energy(s, motor, reducer) for s in sources)
         checks.append(PairCheck("braking_energy", energy, math.inf, "J per cycle", "worst",

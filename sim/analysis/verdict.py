@@ -128,6 +128,12 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                        else f"{j.joint}: {j.reason}")
             checks.append(RunCheck("selection", j.joint, float(margin), 0.0, "% margin",
                                    j.chosen is not None, subject=subject))
+            # the chosen pair's warnings are the run's warnings (counted and listed with them)
+            for c in (j.chosen.checks if j.chosen is not None else ()):
+                if c.severity == "warning" and not c.passed:
+                    checks.append(RunCheck(f"selection_{c.name}", j.joint, float(c.value),
+                                           float(c.limit), c.unit, False, severity="warning",
+                                           subject=f"{subject}"))
     return checks
 
 

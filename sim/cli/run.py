@@ -136,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"  warning: {c['name']} {c.get('subject') or c['joint']}: {c['value']:.4g} "
               f"{c['unit']} (below {c['limit']:.4g} {c['unit']})")
     if failed:
-        print(f"  verdict: FAIL ({len(failed)} check(s) failed)")
+        print(f"  verdict: FAIL ({len(failed)} check(s) failed, {len(warned)} warning(s))")
         for c in failed:
             print(f"    {c['name']} {c.get('subject') or c['joint']}: {c['value']:.4g} "
                   f"{c['unit']} against the limit {c['limit']:.4g} {c['unit']}")

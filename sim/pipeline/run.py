@@ -497,7 +497,8 @@ def selection_options(scenario: Scenario, *, catalog: str | Path | None = None,
     rank = spec.rank if rank is None else rank
     if rank not in RANKS:
         raise ScenarioError(f"--rank: must be one of {', '.join(RANKS)}, got {rank!r}")
-    return SelectionOptions(load_catalog(path), rank=rank, **values)
+    return SelectionOptions(load_catalog(path), rank=rank, inertia_ratio=spec.inertia_ratio,
+                            **values)
 
 
 def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:

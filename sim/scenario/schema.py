@@ -219,7 +219,11 @@ class SizingSpec(_Strict):
     life_h: float = Field(20000.0, gt=0, description="reducer L10 life target, h")
     dwell_s: float = Field(0.0, ge=0, le=1e6, description="standstill after each cycle, s")
     rank: Literal["mass", "inertia", "margin"] = "mass"
-    inertia_ratio_max: float = Field(10.0, gt=0, description="load/rotor inertia warning limit")
+    inertia_ratio_max: float = Field(10.0, gt=0, description="largest load-to-rotor inertia "
+                                     "ratio a pair may have")
+    inertia_ratio: Literal["error", "warning"] = Field(
+        "error", description="a pair over inertia_ratio_max fails (error) or passes with a "
+        "warning")
 
 
 class ScenarioSpec(_Strict):
