@@ -130,21 +130,7 @@ def _independent(traj, model, k: int, motor: dict, reducer: dict) -> dict[str, b
     J = motor["rotor_inertia_kg_m2"] + reducer["input_inertia_kg_m2"]
     out = {"motor_rms": True, "motor_peak": True, "motor_speed": True, "reducer_peak": True,
            "reducer_life": True}
-    # the load's inertia seen by the motor: the joint's largest joint-space inertia along the
-    # cycle (MuJoCo's mass matrix every 10 ms, the drive's armature taken out)
-    import mujoco
-
-    data = mujoco.MjData(model)
-    full = np.zeros((model.nv, model.nv))
-    j_load = 0.0
-    step = max(1, int(round(0.01 / float(np.median(dt)))))
-    for q in traj["qpos"][::step]:
-        data.qpos[:] = q
-        mujoco.mj_forward(model, data)
-        mujoco.mj_fullM(model, data, full)
-        j_load = max(j_load, full[dof, dof] - arm)
-    out["inertia_ratio"] = (j_load / N**2 + reducer["input_inertia_kg_m2"]) / \
-        motor["rotor_inertia_kg_m2"] <= 10.0 * (1 + 1e-9)
+    out["inertia_ratio"] = _inertia_ratio(traj, model, k, motor, reducer) <= 10.0 * (1 + 1e-9)
     for tau, qd, qdd in ((traj["tau_id"][:, k], traj["qd_ref"][:, k], traj["qdd_ref"][:, k]),
                          (traj["tau"][:, k], traj["qd"][:, k], traj["qdd"][:, k])):
         tau_l = tau - arm * qdd

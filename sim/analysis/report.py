@@ -381,8 +381,8 @@ def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
                 (str(c["name"]), str(c.get("subject") or c.get("joint", "")),
                  _f(float(c["value"])), _f(float(c["limit"])), str(c["unit"]),
                  str(c.get("severity", "error"))) for c in listed])]
-        parts += ["", "The sizing below is one part of it (the drives' torque, speed and "
-                  "envelope checks)."]
+        parts += ["", ("The sizing below is one part of it (the drives' torque, speed and "
+                       "envelope checks).")]
     parts += ["", "## Sizing verdict" if run_line is not None else "## Verdict", "",
               result.verdict, "", "## Per joint", ""]
     parts.append(_md_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))

@@ -21,7 +21,6 @@ from numpy.typing import NDArray
 from sim.errors import KinematicsError, UnreachableError
 from sim.robots.families.base import KinematicFamily
 
-
 #: Largest joint change, rad, a numeric arm's path point may take from the one before when
 #: found locally (:meth:`ChainFamily.ik_continue`); a larger one is searched globally.
 CONTINUE_STEP = 0.1
@@ -72,12 +71,17 @@ class ChainFamily(KinematicFamily):
         return self.arm.chain.fk(np.zeros(self.arm.chain.n))[:3, 2].copy()
 
     # ------------------------------------------------------------------ inverse
+    def _flange(self, T) -> NDArray[np.float64]:
+        return np.asarray(T, dtype=float) @ np.linalg.inv(self._tool_T())
+
+    def _none(self) -> UnreachableError:
+        return UnreachableError(f"{self.arm.name}: no inverse-kinematics solution "
+                                f"({self.arm.solver} solver)", 0.0)
+
     def ik(self, T, current):
-        flange = np.asarray(T, dtype=float) @ np.linalg.inv(self._tool_T())
-        sols = self.arm.ik(flange, current)
+        sols = self.arm.ik(self._flange(T), current)
         if not sols:
-            raise UnreachableError(f"{self.arm.name}: no inverse-kinematics solution "
-                                   f"({self.arm.solver} solver)", 0.0)
+            raise self._none()
         return [(s.q, s.branch) for s in sols]
 
     def ik_continue(self, T, current):
@@ -88,19 +92,16 @@ class ChainFamily(KinematicFamily):
             return None
         from sim.robots.numeric_ik import solve_one
 
-        flange = np.asarray(T, dtype=float) @ np.linalg.inv(self._tool_T())
         cur = np.asarray(current, dtype=float)
-        q, err = solve_one(self.arm.chain, flange, cur)
+        q, err = solve_one(self.arm.chain, self._flange(T), cur)
         if err < 1e-12 and float(np.max(np.abs(q - cur))) <= CONTINUE_STEP:
             return q
         return None
 
     def ik_branches(self, T, current):
-        flange = np.asarray(T, dtype=float) @ np.linalg.inv(self._tool_T())
-        sols = self.arm.branches(flange, current)
+        sols = self.arm.branches(self._flange(T), current)
         if not sols:
-            raise UnreachableError(f"{self.arm.name}: no inverse-kinematics solution "
-                                   f"({self.arm.solver} solver)", 0.0)
+            raise self._none()
         return sols
 
     # ------------------------------------------------------------------ Jacobian
