@@ -390,21 +390,30 @@ def test_a_pair_over_the_inertia_ratio_limit_does_not_pass_unless_declared_a_war
     assert excluded > 0  # the limit bites somewhere (the test compares, not only passes)
 
 
+_J_LOAD: dict[tuple[str, int], float] = {}
+
+
 def _inertia_ratio(traj, model, k: int, motor: dict, reducer: dict) -> float:
-    """``(J_load / N^2 + J_in) / J_r`` with J_load from MuJoCo's mass matrix every 10 ms."""
+    """``(J_load / N^2 + J_in) / J_r`` with J_load, joint k's largest joint-space inertia along
+    the cycle, from MuJoCo's mass matrix every 10 ms (the drive's armature taken out)."""
+    import hashlib
+
     import mujoco
 
-    dof = int(model.jnt_dofadr[model.joint(f"robot/j{k + 1}").id])
-    data = mujoco.MjData(model)
-    full = np.zeros((model.nv, model.nv))
-    step = max(1, int(round(0.01 / float(np.median(np.diff(traj["t"]))))))
-    j_load = 0.0
-    for q in traj["qpos"][::step]:
-        data.qpos[:] = q
-        mujoco.mj_forward(model, data)
-        mujoco.mj_fullM(model, data, full)
-        j_load = max(j_load, full[dof, dof] - float(model.dof_armature[dof]))
-    return (j_load / reducer["ratio"] ** 2 + reducer["input_inertia_kg_m2"]) / \
+    key = (hashlib.sha1(np.ascontiguousarray(traj["qpos"]).tobytes()).hexdigest(), k)
+    if key not in _J_LOAD:
+        dof = int(model.jnt_dofadr[model.joint(f"robot/j{k + 1}").id])
+        data = mujoco.MjData(model)
+        full = np.zeros((model.nv, model.nv))
+        step = max(1, int(round(0.01 / float(np.median(np.diff(traj["t"]))))))
+        j_load = 0.0
+        for q in traj["qpos"][::step]:
+            data.qpos[:] = q
+            mujoco.mj_forward(model, data)
+            mujoco.mj_fullM(model, data, full)
+            j_load = max(j_load, full[dof, dof] - float(model.dof_armature[dof]))
+        _J_LOAD[key] = j_load
+    return (_J_LOAD[key] / reducer["ratio"] ** 2 + reducer["input_inertia_kg_m2"]) / \
         motor["rotor_inertia_kg_m2"]
 
 

@@ -15,6 +15,9 @@ def rot_x(angle: ArrayLike) -> NDArray[np.float64]:
     """Rotation about x by ``angle`` (rad); shape ``angle.shape + (3, 3)``."""
     a = np.asarray(angle, dtype=float)
     c, s = np.cos(a), np.sin(a)
+    if a.ndim == 0:  # one angle (the inverse kinematics' case): no stacking
+        c, s = float(c), float(s)
+        return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
     o, z = np.ones_like(a), np.zeros_like(a)
     return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1),
                      np.stack([z, s, c], -1)], -2)
@@ -24,6 +27,9 @@ def rot_y(angle: ArrayLike) -> NDArray[np.float64]:
     """Rotation about y by ``angle`` (rad); shape ``angle.shape + (3, 3)``."""
     a = np.asarray(angle, dtype=float)
     c, s = np.cos(a), np.sin(a)
+    if a.ndim == 0:  # one angle (the inverse kinematics' case): no stacking
+        c, s = float(c), float(s)
+        return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
     o, z = np.ones_like(a), np.zeros_like(a)
     return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1),
                      np.stack([-s, z, c], -1)], -2)
@@ -33,6 +39,9 @@ def rot_z(angle: ArrayLike) -> NDArray[np.float64]:
     """Rotation about z by ``angle`` (rad); shape ``angle.shape + (3, 3)``."""
     a = np.asarray(angle, dtype=float)
     c, s = np.cos(a), np.sin(a)
+    if a.ndim == 0:  # one angle (the inverse kinematics' case): no stacking
+        c, s = float(c), float(s)
+        return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
     o, z = np.ones_like(a), np.zeros_like(a)
     return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1),
                      np.stack([z, z, o], -1)], -2)
