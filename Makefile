@@ -11,6 +11,8 @@ BIN    := $(VENV)/bin
 SCENARIO ?= bugnar_5r_weld_cycle
 OUT    ?=
 PYTEST_ARGS ?=
+# Test workers: one per core (pytest-xdist); JOBS=0 runs in this process.
+JOBS   ?= auto
 
 # Debian packages that headless rendering needs (EGL on Mesa, or OSMesa).
 SYSTEM_PACKAGES := libegl1 libgl1 libosmesa6 libglu1-mesa
@@ -23,11 +25,11 @@ run: setup
 # The fast share (every test but those marked slow); test-slow runs the slow share (larger
 # generated campaigns, convergence studies), which .ci/run runs after the fast one.
 test: setup
-	@$(BIN)/python -m pytest -m "not slow" $(PYTEST_ARGS); rc=$$?; \
+	@$(BIN)/python -m pytest -m "not slow" -n $(JOBS) $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
 test-slow: setup
-	@$(BIN)/python -m pytest -m slow $(PYTEST_ARGS); rc=$$?; \
+	@$(BIN)/python -m pytest -m slow -n $(JOBS) $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
 bench: setup
