@@ -50,6 +50,8 @@ def derive_accel_limits(spec: RobotSpec, payload_kg: float, samples: int = SAMPL
     Q = np.random.default_rng(seed).uniform(rng[:, 0], rng[:, 1], size=(samples, len(jids)))
     M = np.zeros((model.nv, model.nv))
     worst = np.full(len(jids), np.inf)
+    need = np.zeros(len(jids))  # the largest gravity + friction torque held, N m
+    need_q = np.zeros((len(jids), len(jids)))
     for q in Q:
         data.qpos[:] = model.qpos0
         data.qpos[qadr] = q
@@ -59,8 +61,22 @@ def derive_accel_limits(spec: RobotSpec, payload_kg: float, samples: int = SAMPL
         g = data.qfrc_bias[dadr]
         a = (peak - friction - np.abs(g)) / M[dadr, dadr]
         worst = np.minimum(worst, a)
+        more = friction + np.abs(g) > need
+        need = np.where(more, friction + np.abs(g), need)
+        need_q[more] = q
     if np.any(worst <= 0.0):
-        bad = [j for j, w in zip(spec.joints, worst) if w <= 0.0]
-        raise KinematicsError(f"robot {spec.name!r}: the drives of {', '.join(bad)} cannot hold "
-                              f"the arm with {payload_kg} kg against gravity everywhere in range")
+        parts = []
+        for k, j in enumerate(spec.joints):
+            if worst[k] > 0.0:
+                continue
+            d = spec.drives[k]
+            parts.append(
+                f"{j} needs up to {need[k]:.4g} N m to hold it (gravity and friction, at "
+                f"[{', '.join(f'{v:.0f}' for v in np.degrees(need_q[k]))}] deg) where its drive "
+                f"gives {peak[k]:.4g} N m ({d.peak_torque:g} N m peak x {d.gear_ratio:g} x "
+                f"{d.efficiency:g}): a motor peak of at least "
+                f"{need[k] / (d.gear_ratio * d.efficiency):.4g} N m at this ratio and efficiency")
+        raise KinematicsError(f"robot {spec.name!r} with {payload_kg:g} kg: the drives cannot "
+                              "hold the arm against gravity everywhere in range: "
+                              + "; ".join(parts))
     return worst
