@@ -144,6 +144,8 @@ def vacuum(command: NDArray[np.bool_], dt: float,
 
 #: Steps between updates of the drives' speed-dependent torque limit while it binds, s / h.
 ENVELOPE_STEPS = 10
+#: Times a short chunk is run again when its joint sped past the speed its limit was set for.
+ENVELOPE_RETRIES = 3
 
 
 def _joint_peak(drives: Sequence[Drive], speed: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -160,11 +162,14 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
 
     Args:
         drives: The drive of each joint. When given, each drive's limit follows its peak
-            torque-speed curve (:meth:`sim.robots.registry.Drive.joint_peak_torque_at`, never
-            above the actuator's ``forcerange``): where the curve is below the flat peak for
-            the reference's or the joint's speed, the limit is updated every
-            :data:`ENVELOPE_STEPS` steps to the curve's value at the highest of those speeds
-            over the next steps (conservative). None: the constant ``forcerange``.
+            torque-speed curve at the motor's own speed
+            (:meth:`sim.robots.registry.Drive.joint_peak_torque_at`, never above the
+            actuator's ``forcerange``): where the curve binds, the limit is set every
+            :data:`ENVELOPE_STEPS` steps from the joint's speed at the chunk's start, and a
+            chunk in which the joint sped past that speed runs again at the curve's value at
+            the highest speed it reached (up to :data:`ENVELOPE_RETRIES` times). The
+            reference's speeds only say where the curve may start to bind (where the flat
+            chunks end). None: the constant ``forcerange``.
 
     Raises:
         SimulationError: NaN or a MuJoCo warning; the message names the time and the joint.
@@ -212,6 +217,7 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
     wall = 0.0
     k = 0
     short_until = 0  # steps before which the envelope runs in short chunks (see below)
+    retries, retry_lim = 0, None  # a short chunk run again at a lower limit (see below)
     # the constraint solver's warm start carries over from chunk to chunk (it is not part of
     # the state), so that results do not depend on where the chunks end
     warmstart = data.qacc_warmstart.copy()
@@ -222,6 +228,8 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
             if env_ref is not None:
                 m, lim = _envelope_chunk(drives, env_ref, flat, state, qvel_slice, built, k, m,
                                          short=k < short_until)
+                if retry_lim is not None:  # a retried chunk: the limit the joint's speed set
+                    m, lim = min(m, ENVELOPE_STEPS), np.minimum(lim, retry_lim)
                 flat_chunk = bool(np.all(lim == flat))
                 model.actuator_forcerange[built.robot_act] = np.column_stack([-lim, lim])
                 limit[k:k + m] = lim
@@ -232,13 +240,23 @@ def simulate(built: BuiltCell, motion: Motion, *, feedforward: bool, settle_s: f
                                      control_spec=control_spec, initial_warmstart=warmstart)
             wall += time.perf_counter() - t_start
             st, sd = st[0], sd[0]
-            if env_ref is not None and flat_chunk and m > ENVELOPE_STEPS:
-                # a joint that sags or lags may pass its curve's knee inside a flat chunk
-                # chosen from the speeds at its start: then run that stretch again, short
+            if env_ref is not None:
                 speeds = np.abs(st[:, qvel_slice][:, built.robot_dof]).max(axis=0)
-                if np.any(_joint_peak(drives, speeds) < flat * (1 - 1e-12)):
-                    short_until = k + m
+                own = np.minimum(_joint_peak(drives, speeds), flat)
+                if flat_chunk and m > ENVELOPE_STEPS:
+                    # a joint that sags or lags may pass its curve's knee inside a flat chunk
+                    # chosen from the speeds at its start: then run that stretch again, short
+                    if np.any(own < flat * (1 - 1e-12)):
+                        short_until = k + m
+                        continue
+                elif np.any(own < lim * (1 - 1e-9)) and retries < ENVELOPE_RETRIES:
+                    # the joint sped up past the speed its limit was set for: the same chunk
+                    # again at the curve's value at the speed the joint reached
+                    retries += 1
+                    lim = np.minimum(lim, own)
+                    retry_lim = lim
                     continue
+            retries, retry_lim = 0, None
             warmstart = scratch.qacc_warmstart.copy()
             qpos[k + 1:k + m + 1] = st[:, qpos_slice]
             qvel[k + 1:k + m + 1] = st[:, qvel_slice]
@@ -319,7 +337,8 @@ def _envelope_chunk(drives: Sequence[Drive], env_ref: NDArray[np.float64],
     the falling part of the peak curve, the limit is the flat ``forcerange`` and the chunk runs
     up to the first step where the curve would bind. Otherwise (or when ``short``: a flat chunk
     from here saw a joint pass its curve's knee) a short chunk of :data:`ENVELOPE_STEPS` steps
-    runs at the curve's lowest value over it.
+    runs at the curve's value at the joints' present speeds (the caller runs it again lower
+    when a joint speeds up inside it).
     """
     eps = 1e-12
     qd_now = np.abs(state[qvel_slice][built.robot_dof])
@@ -329,7 +348,7 @@ def _envelope_chunk(drives: Sequence[Drive], env_ref: NDArray[np.float64],
     if not short and not np.any(env_now < flat * (1 - eps)) and (first is None or first > 1):
         return (m if first is None else min(m, first - 1)), flat.copy()
     m = min(ENVELOPE_STEPS, m)
-    return m, np.minimum(env_now, env_ref[k:k + m + 1].min(axis=0))
+    return m, env_now
 
 
 def _instability(model: Any, scratch: Any, st: NDArray[np.float64], t0: float, dt: float,
