@@ -11,8 +11,11 @@ BIN    := $(VENV)/bin
 SCENARIO ?= bugnar_5r_weld_cycle
 OUT    ?=
 PYTEST_ARGS ?=
-# Test workers: one per core (pytest-xdist); JOBS=0 runs in this process.
+# Test workers: one per core (pytest-xdist); JOBS=0 runs in this process. The slow share runs
+# in one process (SLOW_JOBS): on two workers one generated seam of 1000 came out differently
+# once (issue 25's note), not reproduced in one process.
 JOBS   ?= auto
+SLOW_JOBS ?= 0
 
 # Debian packages that headless rendering needs (EGL on Mesa, or OSMesa).
 SYSTEM_PACKAGES := libegl1 libgl1 libosmesa6 libglu1-mesa
@@ -29,7 +32,7 @@ test: setup
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
 test-slow: setup
-	@$(BIN)/python -m pytest -m slow -n $(JOBS) $(PYTEST_ARGS); rc=$$?; \
+	@$(BIN)/python -m pytest -m slow -n $(SLOW_JOBS) $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
 bench: setup
