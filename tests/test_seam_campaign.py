@@ -614,7 +614,9 @@ def check_reference(case: Case, root: Path) -> tuple[Planned, so.Frames] | None:
     TALLY[(case.arm.key, "arm collisions (not judged)")] += bool(arm_hits)
     TALLY[(case.arm.key, f"{case.kind}: failed" if fails else f"{case.kind}: passed")] += 1
     figures = ", ".join(f"{k} {x:.4g}" for k, x in v.figures.items())
-    assert not fails, f"{case.short()}: " + "; ".join(fails) + f" [{figures}]"
+    # the whole case on failure (every number hypothesis drew), to replay it as FIXED is
+    assert not fails, (f"{case.short()}: " + "; ".join(fails) + f" [{figures}]\n"
+                       f"replay: {replace(case, arm=None)!r} on ARMS[{case.arm.key!r}]")
     return pl, fr
 
 
@@ -766,7 +768,8 @@ def check_simulated(case: Case, root: Path) -> Planned | None:
     TALLY[(case.arm.key, "simulated: failed" if v.failures else "simulated: passed")] += 1
     figures = ", ".join(f"{key} {x:.4g}" for key, x in v.figures.items())
     assert v.ok, (f"{case.short()} (simulated; servo bound {dp * 1e3:.4f} mm, {da:.4f} deg): "
-                  + "; ".join(v.failures) + f" [{figures}]")
+                  + "; ".join(v.failures) + f" [{figures}]\n"
+                  f"replay: {replace(case, arm=None)!r} on ARMS[{case.arm.key!r}]")
     return pl
 
 
