@@ -12,8 +12,7 @@ SCENARIO ?= bugnar_5r_weld_cycle
 OUT    ?=
 PYTEST_ARGS ?=
 # Test workers: one per core (pytest-xdist); JOBS=0 runs in this process. The slow share runs
-# in one process (SLOW_JOBS): on two workers one generated seam of 1000 came out differently
-# once (issue 25's note), not reproduced in one process.
+# in one process (SLOW_JOBS=0), as its campaigns were measured.
 JOBS   ?= auto
 SLOW_JOBS ?= 0
 
