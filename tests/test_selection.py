@@ -445,3 +445,66 @@ def test_the_warnings_counted_are_the_warnings_listed_in_every_report(tmp_path, 
     line = f"Run verdict: {verdict}: {len(summary['checks'])} checks"
     assert line in md and line in page
     assert f"{len(warned)} warning(s)" in md and f"{len(warned)} warning(s)" in page
+
+
+def _average_torque(traj, model, k: int, exponent: float) -> tuple[float, float]:
+    """The worse source's speed-weighted mean load torque ``(int |n| |tau_l|^k / int |n|)^(1/k)``
+    on joint k (the reducer makers' procedure; trapezoids written here) and its mean input speed
+    ``int |qd| / T_duty`` (rad/s), both sources."""
+    t = traj["t"]
+    dof = int(model.jnt_dofadr[model.joint(f"robot/j{k + 1}").id])
+    arm = float(model.dof_armature[dof])
+    worst, speed = 0.0, 0.0
+    for tau, qd, qdd in ((traj["tau_id"][:, k], traj["qd_ref"][:, k], traj["qdd_ref"][:, k]),
+                         (traj["tau"][:, k], traj["qd"][:, k], traj["qdd"][:, k])):
+        tau_l = np.abs(tau - arm * qdd)
+        n = np.abs(qd)
+        num = float(np.sum(np.diff(t) * (n[1:] * tau_l[1:] ** exponent
+                                         + n[:-1] * tau_l[:-1] ** exponent) / 2))
+        den = float(np.sum(np.diff(t) * (n[1:] + n[:-1]) / 2))
+        worst = max(worst, (num / den) ** (1 / exponent))
+        speed = max(speed, den / (t[-1] - t[0] + DWELL_S))
+    return worst, speed
+
+
+@pytest.mark.parametrize("side", ["under", "over"])
+def test_a_reducers_average_torque_and_speed_limits_decide_the_pair(pick_selection, tmp_path,
+                                                                    side):
+    """Harmonic Drive's procedure: a reducer whose catalogue row gives a limit for average
+    torque and one for average input speed passes only when the cycle's speed-weighted cubic
+    mean load torque and its mean input speed (recomputed here) are within them; a reducer
+    with an RV maker's life exponent (10/3) gets the life of that formula."""
+    run_dir, model, sel = pick_selection
+    traj = dict(np.load(run_dir / "trajectory.npz"))
+    record = load_run(run_dir)
+    ids, arm = _arm(model, record.joints)
+    doc = tomllib.loads(SMALL)
+    k = 1  # J2: the joint the gravity loads most
+    j = sel.joints[k]
+    motor = next(m for m in doc["motors"] if m["id"] == j.chosen.motor.id)
+    reducer = dict(next(r for r in doc["reducers"] if r["id"] == j.chosen.reducer.id))
+    t_av, w_av = _average_torque(traj, model, k, 3.0)
+    n_av = reducer["ratio"] * w_av * RPM
+    scale = 1.01 if side == "under" else 0.99
+    reducer.update(average_torque_limit_nm=scale * t_av,
+                   max_average_input_speed_rpm=(1.01 if side == "under" else 1e6) * n_av,
+                   life_exponent=10 / 3)
+
+    def toml(entry: dict) -> str:
+        return "\n".join(f"{key} = {json.dumps(v)}" for key, v in entry.items())
+
+    path = tmp_path / "avg.toml"
+    path.write_text(f"[[motors]]\n{toml(motor)}\n\n[[reducers]]\n{toml(reducer)}\n")
+    got = select_actuators(record, ids, arm, SelectionOptions(load_catalog(path),
+                                                              life_h=LIFE_H, dwell_s=DWELL_S))
+    js = got.joints[k]
+    pair = js.chosen if js.chosen is not None else js.closest
+    by = {c.name: c for c in pair.checks}
+    assert by["reducer_average_torque"].value == pytest.approx(t_av, rel=1e-9)
+    assert by["reducer_average_speed"].value == pytest.approx(n_av, rel=1e-9)
+    assert by["reducer_average_torque"].passed is (side == "under")
+    assert (js.chosen is not None) is (side == "under"), [c for c in pair.checks if not c.passed]
+    t_life, _ = _average_torque(traj, model, k, 10 / 3)
+    life = reducer["rated_life_h"] * (reducer["rated_torque_nm"] / t_life) ** (10 / 3) * (
+        reducer["rated_input_speed_rpm"] / n_av)
+    assert by["reducer_life"].value == pytest.approx(life, rel=1e-9)

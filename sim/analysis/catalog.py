@@ -17,7 +17,11 @@ torque-speed curve as ``[[speed_rpm, torque_nm], ...]``, speeds increasing) and
 ``rated_life_h``), ``repeated_peak_torque_nm``, ``momentary_peak_torque_nm``, ``efficiency``,
 ``input_inertia_kg_m2``, ``max_input_speed_rpm``, ``mass_kg`` (optional, as for motors),
 ``source``; optional ``maker``,
-``series``, ``efficiency_note`` and ``illustrative``.
+``series``, ``efficiency_note``, ``illustrative``, ``average_torque_limit_nm`` (the "limit for
+average torque" of strain-wave gear catalogues: the cycle's average load torque must stay under
+it), ``max_average_input_speed_rpm`` (the "limit for average input speed") and
+``life_exponent`` (the torque exponent of the maker's life formula: 3 for strain-wave gears,
+the default; 10/3 for cycloidal and RV reducers).
 
 Mistakes are reported as one line naming the file, the entry (``motors[3]`` and its id) and
 the key, with the valid keys where a key is unknown.
@@ -98,6 +102,9 @@ class ReducerSpec(_Entry):
     input_inertia_kg_m2: float = Field(ge=0)
     max_input_speed_rpm: float = Field(gt=0)
     mass_kg: float | None = Field(None, gt=0)
+    average_torque_limit_nm: float | None = Field(None, gt=0)
+    max_average_input_speed_rpm: float | None = Field(None, gt=0)
+    life_exponent: float = Field(3.0, ge=1, le=10)
     source: str = ""
     illustrative: bool = False
 

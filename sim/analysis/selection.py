@@ -21,9 +21,14 @@ Checks (``error`` severity unless said):
   percent of the curve);
 * ``motor_speed``: ``max n <= min(motor max speed, reducer max input speed)``;
 * ``reducer_peak``: ``max |tau_l| <= repeated peak torque``;
-* ``reducer_life``: ``L10 = rated_life_h (T_rated / T_av)^3 (n_rated / n_av) >= life target``
-  with ``T_av = (sum w |n| |tau_l|^3 / sum w |n|)^(1/3)`` and ``n_av = sum w |n| / T_duty``
-  (the dwell adds time, no revolutions);
+* ``reducer_life``: ``L10 = rated_life_h (T_rated / T_k)^k (n_rated / n_av) >= life target``
+  with ``T_k = (sum w |n| |tau_l|^k / sum w |n|)^(1/k)``, ``k`` the reducer's ``life_exponent``
+  (3 for strain-wave gears, 10/3 for RV reducers), and ``n_av = sum w |n| / T_duty`` (the
+  dwell adds time, no revolutions);
+* ``reducer_average_torque``, where the catalogue gives the reducer's limit for average torque
+  (Harmonic Drive's selection procedure): ``T_av = T_3 <= average_torque_limit_nm``;
+* ``reducer_average_speed``, where it gives the limit for average input speed:
+  ``n_av <= max_average_input_speed_rpm``;
 * ``estop_torque`` (warning): the motor's peak torque braking the load through the reducer,
   ``T_peak N / eta``, against the momentary peak torque (an emergency stop, a collision);
 * ``inertia_ratio`` (error, or a warning where ``[sizing] inertia_ratio = "warning"``):
@@ -262,6 +267,15 @@ class _Source:
     s1: float                     # sum w |qd|
     s3: float                     # sum w |qd| |tau_l|^3
 
+    def average_torque(self, exponent: float) -> float:
+        """The speed-weighted average load torque ``(sum w |qd| |tau_l|^k / sum w |qd|)^(1/k)``
+        of the reducer makers' procedures (``k`` their life exponent), N m; 0 at rest."""
+        if self.s1 <= 0:
+            return 0.0
+        sk = self.s3 if exponent == 3.0 else float(
+            self.w @ (np.abs(self.qd) * np.abs(self.tau_l) ** exponent))
+        return (sk / self.s1) ** (1.0 / exponent) if sk > 0 else 0.0
+
 
 def _weights(t: NDArray[np.float64]) -> NDArray[np.float64]:
     dt = np.diff(t)
@@ -330,13 +344,15 @@ def _pair_values(src: _Source, motor: Motor, reducer: Reducer, opts: SelectionOp
     rms = math.sqrt(max(0.0, (c @ src.moments @ c + opts.dwell_s * tau_dwell**2) / duty))
     peak = float(np.max(np.abs(src.hull @ c)))
     speed = src.qd_max * r.ratio * RPM_PER_RAD_S
-    if src.s1 > 0 and src.s3 > 0:
-        t_av = (src.s3 / src.s1) ** (1.0 / 3.0)
-        n_av = r.ratio * RPM_PER_RAD_S * src.s1 / duty
-        life = r.rated_life_h * (r.rated_torque_nm / t_av) ** 3 * (r.rated_input_speed_rpm / n_av)
+    n_av = r.ratio * RPM_PER_RAD_S * src.s1 / duty
+    t_life = src.average_torque(r.life_exponent)
+    if n_av > 0 and t_life > 0:
+        life = r.rated_life_h * (r.rated_torque_nm / t_life) ** r.life_exponent * (
+            r.rated_input_speed_rpm / n_av)
     else:
         life = math.inf
-    return {"rms": rms, "peak": peak, "speed": speed, "life": life, "tau_l_max": src.tau_l_max}
+    return {"rms": rms, "peak": peak, "speed": speed, "life": life, "tau_l_max": src.tau_l_max,
+            "t_av": src.average_torque(3.0), "n_av": n_av}
 
 
 def _curve_pct(src: _Source, motor: Motor, reducer: Reducer) -> float:
@@ -373,6 +389,14 @@ def check_pair(sources: Sequence[_Source], motor: Motor, reducer: Reducer,
     checks.append(PairCheck("reducer_peak", tl, r.repeated_peak_torque_nm, "N m", s_tl))
     life, s_life = worst("life", low=True)
     checks.append(PairCheck("reducer_life", life, opts.life_h, "h", s_life, at_least=True))
+    if r.average_torque_limit_nm is not None:
+        t_av, s_av = worst("t_av")
+        checks.append(PairCheck("reducer_average_torque", t_av, r.average_torque_limit_nm,
+                                "N m", s_av))
+    if r.max_average_input_speed_rpm is not None:
+        n_av, s_nav = worst("n_av")
+        checks.append(PairCheck("reducer_average_speed", n_av, r.max_average_input_speed_rpm,
+                                "rpm", s_nav))
     # the torque-speed curve (an O(samples) check) decides only between otherwise passing pairs
     if m.torque_speed is not None and all(c.passed for c in checks):
         pct, s_pct = max((_curve_pct(s, motor, reducer), s.name) for s in sources)
@@ -473,7 +497,8 @@ def select_actuators(record: RunRecord, joint_ids: Sequence[int], armature: Sequ
 # --------------------------------------------------------------------------------------------
 
 _CSV_CHECKS = ("motor_rms", "motor_peak", "motor_speed", "reducer_peak", "reducer_life",
-               "estop_torque", "inertia_ratio")
+               "reducer_average_torque", "reducer_average_speed", "estop_torque",
+               "inertia_ratio")
 
 
 def selection_csv(result: SelectionResult) -> str:
@@ -492,8 +517,9 @@ def selection_csv(result: SelectionResult) -> str:
             by = {c.name: c for c in p.checks}
             row = [j.joint, rank, p.motor.id, p.reducer.id, _csvnum(p.mass_kg), p.passed]
             for name in _CSV_CHECKS:
-                c = by[name]
-                row += [_csvnum(c.value), _csvnum(c.limit), _csvnum(c.margin_pct)]
+                c = by.get(name)  # the reducer's average limits only where it gives them
+                row += ["", "", ""] if c is None else [
+                    _csvnum(c.value), _csvnum(c.limit), _csvnum(c.margin_pct)]
             w.writerow(row)
     return buf.getvalue()
 
