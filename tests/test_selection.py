@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import tomllib
 from pathlib import Path
 
@@ -327,10 +328,24 @@ def test_starter_catalogue_cites_sources_and_has_plausible_units():
         assert 0 <= s.input_inertia_kg_m2 <= 1e-1, r.id
         assert 1000 <= s.max_input_speed_rpm <= 10000, r.id
         assert s.mass_kg is None or 0.02 <= s.mass_kg <= 200, r.id
-    # illustrative entries say so in their source text
+    # illustrative entries say so in their source text; the others cite the page they were
+    # checked against (issue 26)
     for e in (*cat.motors, *cat.reducers):
         if e.spec.illustrative:
             assert "memory" in e.spec.source or "not" in e.spec.source.lower(), e.id
+        else:
+            assert "http" in e.spec.source and re.search(r"\b(p\.|page|table)", e.spec.source), e.id
+    # the makers' selection procedures: strain-wave gears with their limits for average torque
+    # (between the rated and the repeated peak torque) and average input speed, life exponent
+    # 3; RV reducers with Nabtesco's 10/3
+    for r in cat.reducers:
+        s = r.spec
+        if r.id.startswith("hd-"):
+            assert s.rated_torque_nm <= s.average_torque_limit_nm <= s.repeated_peak_torque_nm
+            assert 1000 <= s.max_average_input_speed_rpm <= s.max_input_speed_rpm, r.id
+            assert s.life_exponent == 3.0, r.id
+        else:
+            assert s.life_exponent == pytest.approx(10 / 3), r.id
 
 
 @pytest.mark.parametrize("shape", ["full", "never_brakes", "only_torque", "at_rest"])
