@@ -31,6 +31,18 @@ class KinematicsError(CellsimError):
     """Base class of kinematics errors."""
 
 
+class HoldError(KinematicsError):
+    """A robot's drives cannot hold the arm against gravity somewhere in its joint ranges.
+
+    Attributes:
+        needs: The torque each failing joint must hold, N m at the joint, by joint name.
+    """
+
+    def __init__(self, message: str, needs: dict[str, float] | None = None) -> None:
+        super().__init__(message)
+        self.needs = dict(needs or {})
+
+
 class UnreachableError(KinematicsError):
     """A pose outside the workspace; the message says how far outside it is."""
 

@@ -166,3 +166,17 @@ def test_a_drive_that_cannot_hold_the_arm_is_refused_with_its_numbers(tmp_path):
     payload = -(jp.T @ (5.0 * model.opt.gravity))[dof]
     held = abs(data.qfrc_bias[dof] + payload) + model.dof_frictionloss[dof]
     assert need == pytest.approx(held, rel=2e-3), (need, held)
+    # and the lightest pair of the starter catalogue that would pass the check, chosen here
+    # from the catalogue file's own numbers
+    import tomllib
+
+    from sim.analysis.catalog import starter_catalog
+
+    cat = tomllib.loads(starter_catalog().read_text())
+    fits = [(m["mass_kg"] + r["mass_kg"], m["id"], r["id"]) for m in cat["motors"]
+            for r in cat["reducers"]
+            if m["peak_torque_nm"] * r["ratio"] * r["efficiency"] >= need * (1 + 1e-4)
+            and r["repeated_peak_torque_nm"] >= need * (1 + 1e-4)]
+    _, motor_id, reducer_id = min(fits)
+    assert f"the lightest pair of the starter catalogue that would hold it: j2: {motor_id} + " \
+           f"{reducer_id} (" in line, line

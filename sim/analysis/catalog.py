@@ -30,6 +30,7 @@ the key, with the valid keys where a key is unknown.
 from __future__ import annotations
 
 import difflib
+import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -268,3 +269,35 @@ def describe_entry(e: Motor | Reducer) -> str:
     tag = " [illustrative]" if e.illustrative else ""
     return f"{e.id}{f' ({extra})' if extra else ''}{tag}"
 
+
+
+@dataclass(frozen=True)
+class HoldingPair:
+    """The lightest motor and reducer of a catalogue whose peak holds a joint torque."""
+
+    motor: Motor
+    reducer: Reducer
+    joint_peak_nm: float  # motor peak x ratio x efficiency, N m
+
+    @property
+    def mass_kg(self) -> float:
+        return (self.motor.spec.mass_kg or math.inf) + (self.reducer.spec.mass_kg or math.inf)
+
+
+def lightest_holding_pair(catalog: Catalog, torque_nm: float) -> HoldingPair | None:
+    """The lightest pair (motor + reducer mass; entries without a mass last) whose peak at the
+    joint, ``motor peak x ratio x efficiency``, and whose reducer's repeated peak torque both
+    reach ``torque_nm``; None when no pair does."""
+    best: HoldingPair | None = None
+    for r in catalog.reducers:
+        if r.spec.repeated_peak_torque_nm < torque_nm:
+            continue
+        for m in catalog.motors:
+            peak = m.spec.peak_torque_nm * r.spec.ratio * r.spec.efficiency
+            if peak < torque_nm:
+                continue
+            pair = HoldingPair(m, r, peak)
+            if best is None or (pair.mass_kg, peak, m.id, r.id) < (
+                    best.mass_kg, best.joint_peak_nm, best.motor.id, best.reducer.id):
+                best = pair
+    return best

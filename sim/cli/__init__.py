@@ -45,7 +45,7 @@ def main(argv: Sequence[str] | None = None) -> int:
               "report it with the traceback above)", file=sys.stderr)
         return 3
     except CellsimError as exc:
-        print(f"cellsim: error: {exc}", file=sys.stderr)
+        print(f"cellsim: error: {exc}{_holding_hint(exc)}", file=sys.stderr)
         return 2
     except MemoryError:
         print("cellsim: error: out of memory (a size the input asks for is too large)",
@@ -65,6 +65,40 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         print(f"cellsim: error: {message}", file=sys.stderr)
         return 2
+
+
+def _holding_hint(exc: BaseException) -> str:
+    """For drives that cannot hold the arm (a :class:`~sim.errors.HoldError`, also as the
+    context of the error that reports it): the lightest pair of the starter catalogue that
+    would pass that check on each such joint."""
+    from sim.errors import HoldError
+
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and not isinstance(e, HoldError) and id(e) not in seen:
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    if not isinstance(e, HoldError) or not e.needs:
+        return ""
+    from sim.analysis.catalog import (
+        lightest_holding_pair,
+        load_catalog,
+        starter_catalog,
+    )
+
+    try:
+        cat = load_catalog(starter_catalog())
+    except CellsimError:
+        return ""
+    parts = []
+    for joint, need in e.needs.items():
+        pair = lightest_holding_pair(cat, need)
+        parts.append(f"{joint}: none" if pair is None else
+                     f"{joint}: {pair.motor.id} + {pair.reducer.id} ({pair.joint_peak_nm:.4g} N m "
+                     f"at the joint, {pair.motor.spec.peak_torque_nm:g} N m peak x "
+                     f"{pair.reducer.spec.ratio:g} x {pair.reducer.spec.efficiency:g})")
+    return ("; the lightest pair of the starter catalogue that would hold it: "
+            + "; ".join(parts))
 
 
 #: Operating-system errors that are the place's, not cellsim's: reported as one line with the

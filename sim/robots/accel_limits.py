@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.errors import KinematicsError
+from sim.errors import HoldError
 from sim.robots.registry import RobotSpec, joint_ranges
 
 #: Configurations sampled per robot (uniform in the joint ranges, fixed seed).
@@ -28,8 +28,8 @@ def derive_accel_limits(spec: RobotSpec, payload_kg: float, samples: int = SAMPL
     """The acceleration limit of every joint (module docstring), rad/s^2, shape (n,).
 
     Raises:
-        KinematicsError: A joint's drive cannot hold the arm against gravity somewhere in the
-            ranges (no positive limit exists).
+        HoldError: A joint's drive cannot hold the arm against gravity somewhere in the
+            ranges (no positive limit exists); ``needs`` has the torque each such joint holds.
     """
     import mujoco
     from dm_control import mjcf
@@ -76,7 +76,8 @@ def derive_accel_limits(spec: RobotSpec, payload_kg: float, samples: int = SAMPL
                 f"gives {peak[k]:.4g} N m ({d.peak_torque:g} N m peak x {d.gear_ratio:g} x "
                 f"{d.efficiency:g}): a motor peak of at least "
                 f"{need[k] / (d.gear_ratio * d.efficiency):.4g} N m at this ratio and efficiency")
-        raise KinematicsError(f"robot {spec.name!r} with {payload_kg:g} kg: the drives cannot "
-                              "hold the arm against gravity everywhere in range: "
-                              + "; ".join(parts))
+        raise HoldError(f"robot {spec.name!r} with {payload_kg:g} kg: the drives cannot "
+                        "hold the arm against gravity everywhere in range: " + "; ".join(parts),
+                        {j: float(need[k]) for k, j in enumerate(spec.joints)
+                         if worst[k] <= 0.0})
     return worst

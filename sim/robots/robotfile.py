@@ -44,7 +44,7 @@ import numpy as np
 from pydantic import Field
 
 from sim.core.tomlschema import Strict, load_toml
-from sim.errors import KinematicsError
+from sim.errors import HoldError, KinematicsError
 
 
 class FamilyKinematics(Strict):
@@ -256,8 +256,8 @@ def _derived_accel(robot, payload_kg: float, cache: Path | None, where: str) -> 
 
     try:
         accel = np.asarray(derive_accel_limits(robot, payload_kg, samples=500), dtype=float)
-    except KinematicsError as exc:
-        raise KinematicsError(f"{where}: {exc}") from None
+    except HoldError as exc:
+        raise HoldError(f"{where}: {exc}", exc.needs) from None
     if path is not None:
         import os
         import tempfile
