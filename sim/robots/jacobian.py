@@ -110,7 +110,8 @@ def singularity_measures(model: KinematicModel, q: ArrayLike) -> dict[str, NDArr
         * ``sigma_min``: smallest singular value of :func:`task_jacobian` (mixed units; 0 at
           a singularity);
         * ``manipulability``: Yoshikawa's measure of the same Jacobian;
-        * ``det``: its determinant;
+        * ``det``: its determinant (where it is square; else the product of its singular
+          values);
         * ``wrist``/``elbow``/``shoulder``: the explicit factors of ``det`` (module docstring):
           200iC: ``sin theta5``, ``(R4 c3 - d4 s3) / sqrt(R4^2 + d4^2)`` (dimensionless),
           ``rho_w`` (m); 5R: ``wrist`` is absent, ``elbow = cos q3``, ``shoulder = reach`` (m).
@@ -121,7 +122,9 @@ def singularity_measures(model: KinematicModel, q: ArrayLike) -> dict[str, NDArr
     out: dict[str, NDArray[np.float64]] = {
         "sigma_min": sv[..., -1],
         "manipulability": manipulability(J),
-        "det": np.linalg.det(J),
+        # an arm with fewer or more joints than its task's dimensions has no determinant:
+        # the product of the singular values (the same up to sign where J is square)
+        "det": np.linalg.det(J) if J.shape[-1] == J.shape[-2] else np.prod(sv, axis=-1),
     }
     out.update(model.family.singular_factors(Q))
     return out
