@@ -77,16 +77,22 @@ def readme_block(folder: Path) -> str:
               "| " + " | ".join(_g(v * 1e3, 6) for v in p.lengths().values()) + " | "
               + " ".join(_g(math.degrees(v) + 0.0) for v in p.offsets) + " | "
               + " ".join(f"{s:+d}" for s in p.signs) + " |", ""]
+    est = spec.estimated_links or (False,) * n
     L += ["## Mass model (`sim/robots/generate.py`)", "",
-          "| link | mass (kg) | capsule radius (mm) |", "| --- | --- | --- |"]
+          "| link | mass (kg) | centre of mass in its joint frame (mm) | principal moments "
+          "(kg m^2) | inertial | capsule radius (mm) |", "| --- | --- | --- | --- | --- | --- |"]
     for i in range(n):
         b = model.body(f"link{i + 1}")
         geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == b.id
                  and model.geom_group[g] == 3]
         L.append(f"| link{i + 1} | {_g(float(model.body_mass[b.id]))} | "
+                 f"{' '.join(_g(v * 1e3) for v in model.body_ipos[b.id] + 0.0)} | "
+                 f"{' '.join(_g(v) for v in model.body_inertia[b.id])} | "
+                 f"{'estimate' if est[i] else 'source'} | "
                  f"{_g(float(model.geom_size[geoms[0]][0]) * 1e3)} |")
-    L += ["", f"- Total mass: {float(model.body_mass.sum()):.4f} kg (the moving links and the "
-          "base, 1 kg per base geom)", ""]
+    moving = sum(float(model.body_mass[model.body(f"link{i + 1}").id]) for i in range(n))
+    L += ["", f"- Total mass: {float(model.body_mass.sum()):.4f} kg (the moving links, "
+          f"{moving:.4f} kg, and the base, 1 kg per base geom)", ""]
     # largest static gravity torque with the rated payload at the flange
     g = max_gravity_torque(model, n, np.where(np.isfinite(chain.lower), chain.lower, -np.pi),
                            np.where(np.isfinite(chain.upper), chain.upper, np.pi),

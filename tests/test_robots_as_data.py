@@ -477,6 +477,7 @@ def _former_specs():
                           Drive(80, 0.70, 5.0e-6, 0.32, 1.0, 5000),
                           Drive(50, 0.70, 3.0e-6, 0.25, 0.8, 5000)),
                   payload_kg=5.0, max_accel=deg(1800, 4500, 7500, 8700, 200000),
+                  estimated_links=(True,) * 5,
                   maker_joints=("J1", "J2", "J3", "J5", "J6"),
                   maker_matrix=((1, 0, 0, 0, 0), (0, 1, 0, 0, 0), (0, -1, -1, 0, 0),
                                 (0, 0, 0, -1, 0), (0, 0, 0, 0, -1))),
@@ -493,6 +494,7 @@ def _former_specs():
                           Drive(75, 0.70, 5.0e-6, 0.32, 1.0, 6000),
                           Drive(48, 0.70, 3.0e-6, 0.25, 0.8, 6000)),
                   payload_kg=5.0, max_accel=deg(1400, 2300, 5200, 40000, 43000, 210000),
+                  estimated_links=(True,) * 6,
                   maker_joints=("J1", "J2", "J3", "J4", "J5", "J6"),
                   maker_matrix=((1, 0, 0, 0, 0, 0), (0, -1, 0, 0, 0, 0), (0, 1, 1, 0, 0, 0),
                                 (0, 0, 0, -1, 0, 0), (0, 0, 0, 0, 1, 0),
@@ -507,7 +509,8 @@ def _former_specs():
                           Drive(150, 0.80, 5.2e-4, 4.0, 15.0, 5000),
                           Drive(90, 0.75, 2.9e-4, 2.0, 7.8, 5000),
                           Drive(60, 0.75, 1.0e-4, 1.0, 4.0, 5000)),
-                  payload_kg=10.0, max_accel=deg(1200, 1700, 3700, 6900, 28000)),
+                  payload_kg=10.0, max_accel=deg(1200, 1700, 3700, 6900, 28000),
+                  estimated_links=(True,) * 5),
     ]
 
 
@@ -707,6 +710,7 @@ def test_robot_format_reference_documents_every_key():
     from sim.robots.robotfile import (
         DriveBlock,
         FamilyKinematics,
+        LinkBlock,
         MakerBlock,
         RobotFolderSpec,
         RobotJoints,
@@ -717,7 +721,7 @@ def test_robot_format_reference_documents_every_key():
     table_keys = set(re.findall(r"^\| `([a-z][a-z0-9_]*)`", doc, flags=re.M))
     declared = set()
     for model in (RobotFolderSpec, FamilyKinematics, RobotJoints, RobotMass, DriveBlock,
-                  MakerBlock):
+                  MakerBlock, LinkBlock):
         for key in model.model_fields:
             assert key in table_keys, f"{model.__name__}.{key} is not documented"
             declared.add(key)

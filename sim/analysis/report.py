@@ -371,6 +371,8 @@ def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
     parts = [f"# Actuator sizing: {result.scenario or 'run'}", ""]
     parts.append(f"Robot: {result.robot or 'n/a'}; cycle duration {result.duration:.3f} s; checks "
                  f"on basis '{result.basis}'.")
+    if result.estimates_note:
+        parts += ["", result.estimates_note]
     run_line = run_verdict_text(summary or {})
     if run_line is not None:
         checks = (summary or {}).get("checks", [])
@@ -590,6 +592,8 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
     out += _run_verdict_html(summary)
     cls = "verdict" if result.passed else "verdict fail"
     out.append(f'<h2>Sizing verdict</h2><p class="{cls}">{esc(result.verdict)}</p>')
+    if result.estimates_note:
+        out.append(f'<p class="small">{esc(result.estimates_note)}</p>')
     out += _collision_html(summary)
     if selection is not None:
         out += selection_html(selection)

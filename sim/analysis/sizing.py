@@ -333,6 +333,8 @@ class SizingResult:
         phases: Phases as in ``summary.json`` (``name``, ``kind``, ``t0``, ``t1``).
         series: Time series for charts (``t``, ``tau_id``, ``tau``, ``qd_ref``, ``qd``), not
             serialized.
+        estimated_joints: The joints whose torques rest on estimated link inertials
+            (:attr:`sim.robots.registry.RobotSpec.joints_on_estimates`).
     """
 
     joints: tuple[JointSizing, ...]
@@ -342,6 +344,17 @@ class SizingResult:
     scenario: str = ""
     phases: tuple[dict[str, Any], ...] = ()
     series: dict[str, NDArray[np.float64]] = field(default_factory=dict, repr=False, compare=False)
+    estimated_joints: tuple[str, ...] = ()
+
+    @property
+    def estimates_note(self) -> str:
+        """One sentence naming the joints whose torques rest on estimated link inertials ("" when
+        none do)."""
+        if not self.estimated_joints:
+            return ""
+        return (f"The torques of {', '.join(self.estimated_joints)} rest on estimated link "
+                "inertials (the robot's README says which): check them against the maker's "
+                "data before ordering.")
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -423,6 +436,7 @@ class SizingResult:
             "hardest_margin_pct": hardest.margin_pct if hardest else None,
             "hardest_check": hardest.limiting.key if hardest and hardest.limiting else None,
             "verdict": self.verdict,
+            "inertia_estimated_joints": list(self.estimated_joints),
             "conventions": {
                 "rms": "sqrt(1/T int x^2 dt), trapezoidal over the sample times",
                 "mean_abs_power": "1/T int |tau qd| dt",
@@ -909,11 +923,12 @@ def _size(traj: dict[str, NDArray[np.float64]], summary: Mapping[str, Any], wher
     if armature is None:
         armature = ([d.reflected_inertia for d in spec.drives] if spec.drives
                     else np.zeros(len(names)))
-    return size_trajectory(
+    result = size_trajectory(
         traj, names, drives=drives, forcerange=forcerange, speed_limits=spec.max_speed,
         armature=armature, basis=basis, knee_fraction=knee_fraction,
         robot=str(summary.get("robot", spec.name)), scenario=str(summary.get("scenario", "")),
         phases=summary.get("phases", ()))
+    return dataclasses.replace(result, estimated_joints=spec.joints_on_estimates)
 
 
 # --------------------------------------------------------------------------------------------

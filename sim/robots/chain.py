@@ -25,6 +25,18 @@ from numpy.typing import ArrayLike, NDArray
 from sim.errors import KinematicsError
 
 
+def inertia_problem(inertia: NDArray[np.float64]) -> str:
+    """Why an inertia tensor about the centre of mass (3, 3) is not physical ("" when it is):
+    its principal moments must be >= 0 and satisfy the triangle inequality."""
+    ev = np.sort(np.linalg.eigvalsh(inertia))
+    scale = max(float(np.abs(ev).max()), 1e-300)
+    if ev[0] < -1e-9 * scale or ev[0] + ev[1] < ev[2] * (1 - 1e-9):
+        return (f"inertia is not physical (principal moments "
+                f"{', '.join(f'{v:.4g}' for v in ev)} kg m^2: each must be >= 0 and no one "
+                "larger than the sum of the other two)")
+    return ""
+
+
 def rot_axis(axis: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
     """Rotation matrix (3, 3) by ``angle`` (rad) about the unit ``axis`` (Rodrigues)."""
     x, y, z = axis
@@ -263,13 +275,9 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
                 for k in keys]
         ixx, ixy, ixz, iyy, iyz, izz = vals
         Ic = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-        ev = np.sort(np.linalg.eigvalsh(Ic))
-        scale = max(float(np.abs(ev).max()), 1e-300)
-        if ev[0] < -1e-9 * scale or ev[0] + ev[1] < ev[2] * (1 - 1e-9):
-            raise KinematicsError(
-                f"{path}: link {link!r}: inertia is not physical (principal moments "
-                f"{', '.join(f'{v:.4g}' for v in ev)} kg m^2: each must be >= 0 and no one "
-                "larger than the sum of the other two)")
+        problem = inertia_problem(Ic)
+        if problem:
+            raise KinematicsError(f"{path}: link {link!r}: {problem}")
         T = where @ _T(rpy_matrix(*rpy), xyz)
         return mass, T[:3, 3], T[:3, :3] @ Ic @ T[:3, :3].T
 

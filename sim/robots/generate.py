@@ -8,9 +8,11 @@ shipped robots (``models/build_models.py``):
   the range, the armature (each drive's reflected rotor inertia, ``rotor * ratio^2``), and a
   capsule from the joint to the next joint (a sphere where two joints meet): a visual geom
   (group 2) and the same primitive as the collision geom (group 3), as in the shipped models;
-* link masses: a URDF's own ``<inertial>`` elements (the links fixed to a moving link fused
-  into it) when ``[mass] total_kg`` is not given; else ``total_kg`` spread over the moving
-  links in proportion to their segment lengths (a uniform capsule each, MuJoCo's inertia);
+* link masses: ``robot.toml``'s ``[[links]]`` (an explicit inertial per link, or a uniform
+  capsule of the link's mass where it gives no centre of mass and inertia); else a URDF's own
+  ``<inertial>`` elements (the links fixed to a moving link fused into it) when ``[mass]
+  total_kg`` is not given; else ``total_kg`` spread over the moving links in proportion to
+  their segment lengths (a uniform capsule each, MuJoCo's inertia);
   capsule radius tapering from 6 % of the reach at J1 to 40 % of that at the wrist, at least
   20 mm;
 * position actuators ``a1..an`` with ``forcerange`` the drive's peak torque at the joint
@@ -43,7 +45,7 @@ import hashlib
 import os
 import tempfile
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -51,6 +53,14 @@ from sim.robots.chain import Chain
 
 if TYPE_CHECKING:  # imported where used: loading a cached model must not import mujoco
     import mujoco
+
+#: One moving link's inertial: ``(mass kg, centre of mass (3,) m, inertia about it (3, 3)
+#: kg m^2)`` in its joint's frame, or ``(mass kg, None, None)`` for a uniform capsule of that
+#: mass along the link's segment.
+LinkInertial = tuple[float, Any, Any]
+#: What :func:`mjcf_from_chain` takes for the links' masses: a total mass, None (the chain's
+#: own inertials) or one :data:`LinkInertial` per moving link.
+MassModel = float | None | tuple[LinkInertial, ...]
 
 OMEGA_N = 400.0  #: closed-loop natural frequency, rad/s (0.4 / timestep: the stability margin below)
 #: Largest sqrt(max eig(M^-1 Kp)) * timestep over the sample (semi-implicit Euler is stable
@@ -78,13 +88,16 @@ def _quat(R) -> str:
     return _f(q)
 
 
-def mjcf_from_chain(chain: Chain, name: str, drives, total_mass_kg: float | None,
+def mjcf_from_chain(chain: Chain, name: str, drives, total_mass_kg: MassModel,
                     gains: dict[int, tuple[float, float]] | None = None,
                     home=None) -> str:
     """MJCF text of the arm (module docstring). ``gains`` overrides the gains (used to compute
     them on a first model); ``home`` is the ``home`` keyframe's joint values, rad, (n,)
-    (default: all zero, clipped into the ranges). ``total_mass_kg`` None: the chain's own
-    inertials (a URDF's ``<inertial>``), each body's ``<inertial>`` element."""
+    (default: all zero, clipped into the ranges). ``total_mass_kg``: a total mass (spread over
+    capsules by length); None: the chain's own inertials (a URDF's ``<inertial>``), each
+    body's ``<inertial>`` element; or one :data:`LinkInertial` per moving link (``robot.toml``'s
+    ``[[links]]``): an explicit inertial where it gives the centre of mass and inertia, else a
+    uniform capsule of its mass."""
     if total_mass_kg is None and chain.inertials is None:
         raise ValueError("total_mass_kg is needed: the chain has no inertials")
     n = chain.n
@@ -94,7 +107,20 @@ def mjcf_from_chain(chain: Chain, name: str, drives, total_mass_kg: float | None
     r0 = float(np.clip(0.06 * reach, 0.03, 0.12))
     radii = [max(0.02, r0 * (1.0 - 0.6 * i / max(n - 1, 1))) for i in range(n)]
     w = lengths + 1e-3
-    masses = None if total_mass_kg is None else total_mass_kg * w / w.sum()
+    explicit: list = [None] * n  # per link: (mass, com, inertia) of an <inertial> element
+    masses: list = [None] * n    # per link: a capsule's mass
+    if total_mass_kg is None:
+        explicit = list(chain.inertials)
+    elif isinstance(total_mass_kg, (int, float)):
+        masses = list(float(total_mass_kg) * w / w.sum())
+    else:
+        if len(total_mass_kg) != n:
+            raise ValueError(f"{len(total_mass_kg)} link inertials for {n} links")
+        for i, (mass, com, inertia) in enumerate(total_mass_kg):
+            if com is None:
+                masses[i] = float(mass)
+            else:
+                explicit[i] = (float(mass), np.asarray(com, float), np.asarray(inertia, float))
     lo = np.where(np.isfinite(chain.lower), chain.lower, -np.pi)
     hi = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
     zero = np.clip(0.0, lo, hi)
@@ -174,15 +200,15 @@ def mjcf_from_chain(chain: Chain, name: str, drives, total_mass_kg: float | None
             shape = f'type="capsule" fromto="{_f(np.r_[start, e])}" size="{radii[i]:.4g}"'
         else:
             shape = f'type="sphere" size="{radii[i]:.4g}"'
-        if masses is None:  # the source's own inertial, in the joint's frame
-            mass, com, inertia = chain.inertials[i]
+        if explicit[i] is not None:  # the source's own inertial, in the joint's frame
+            mass, com, inertia = explicit[i]
             full = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2],
                     inertia[1, 2]]
             L.append(f'{ind}<inertial pos="{_f(com)}" mass="{mass:.10g}" '
                      f'fullinertia="{_f(full)}"/>')
         L.append(f'{ind}<geom class="visual" {shape}/>')
         L.append(f'{ind}<geom class="collision" {shape}'
-                 + ("/>" if masses is None else f' mass="{masses[i]:.6g}"/>'))
+                 + ("/>" if masses[i] is None else f' mass="{masses[i]:.6g}"/>'))
         indent = ind
     F = chain.flange
     L.append(f'{indent}<site name="wrist" pos="{_f(wrist_point(chain))}"/>')
@@ -357,7 +383,7 @@ def scene_text(name: str) -> str:
             "  </worldbody>\n</mujoco>\n")
 
 
-def model_text(chain: Chain, name: str, drives, total_mass_kg: float | None,
+def model_text(chain: Chain, name: str, drives, total_mass_kg: MassModel,
                payload_kg: float = 0.0, home=None) -> str:
     """The arm's MJCF with its gains (:func:`mjcf_from_chain` twice: the gains need the first
     model's inertia and gravity torques)."""
@@ -373,7 +399,7 @@ def _write(folder: Path, fname: str, text: str) -> None:
     os.replace(tmp, folder / fname)
 
 
-def generated_model_path(chain: Chain, name: str, drives, total_mass_kg: float | None,
+def generated_model_path(chain: Chain, name: str, drives, total_mass_kg: MassModel,
                          key: str, payload_kg: float = 0.0, home=None) -> Path:
     """Write (once) the arm's MJCF and ``scene.xml`` into a cache folder keyed by ``key`` (the
     robot file's content hash) and return the model's path."""

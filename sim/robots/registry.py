@@ -116,6 +116,9 @@ class RobotSpec:
         maker_joints: The maker's joint names (its controller's), when it has a convention.
         maker_matrix: ``M`` with ``maker joint values = M @ seed joint values`` (rows of the
             matrix); empty: the seed's convention is the maker's (:mod:`sim.robots.maker`).
+        estimated_links: Per moving link (J1's first), whether its inertial is an estimate
+            (a capsule of an estimated mass, ``robot.toml``'s ``[mass] estimated``, a
+            ``[[links]]`` entry marked ``estimate``); empty: none is.
     """
 
     name: str
@@ -131,6 +134,14 @@ class RobotSpec:
     max_accel: tuple[float, ...] = ()
     maker_joints: tuple[str, ...] = ()
     maker_matrix: tuple[tuple[float, ...], ...] = ()
+    estimated_links: tuple[bool, ...] = ()
+
+    @property
+    def joints_on_estimates(self) -> tuple[str, ...]:
+        """The joints whose torques rest on an estimated inertial: those with an estimated
+        link at or beyond them (a joint carries every link past it)."""
+        est = self.estimated_links
+        return tuple(j for i, j in enumerate(self.joints) if any(est[i:]))
 
     @property
     def n_joints(self) -> int:

@@ -68,6 +68,18 @@ class RobotJoints(Strict):
 class RobotMass(Strict):
     payload_kg: float = Field(0.0, ge=0)
     total_kg: float | None = Field(None, gt=0)
+    estimated: bool | None = None
+
+
+class LinkBlock(Strict):
+    """One moving link's inertial (``[[links]]``, J1's link first), in its joint's frame at
+    q = 0 (a URDF's child link frame of the joint; a DH arm's frame at the joint)."""
+
+    mass_kg: float = Field(gt=0)
+    com_mm: list[float] | None = Field(None, min_length=3, max_length=3)
+    inertia_kg_m2: list[float] | None = Field(None, min_length=6, max_length=6)
+    estimate: bool = False
+    source: str = ""
 
 
 class DriveBlock(Strict):
@@ -92,6 +104,7 @@ class RobotFolderSpec(Strict):
     kinematics: FamilyKinematics
     joints: RobotJoints = RobotJoints()
     mass: RobotMass = RobotMass()
+    links: list[LinkBlock] = []
     drives: list[DriveBlock] = []
     maker: MakerBlock | None = None
 
@@ -136,6 +149,11 @@ def load_robot_folder(folder: str | Path):  # -> RobotSpec (imported lazily: no 
             raise KinematicsError(f"{where}: {key}: {len(values)} values for {n} joints")
     if spec.drives and len(spec.drives) != n:
         raise KinematicsError(f"{where}: drives: {len(spec.drives)} drives for {n} joints")
+    if spec.links or spec.mass.total_kg is not None:
+        key = "links" if spec.links else "mass.total_kg"
+        raise KinematicsError(f"{where}: {key}: a robot with its own MJCF carries its link "
+                              "inertials there (give [mass] estimated = true where they are "
+                              "estimates)")
     maker_joints, maker_matrix = _maker(spec, n, where)
     from sim.core.resources import models_dir
 
@@ -153,7 +171,55 @@ def load_robot_folder(folder: str | Path):  # -> RobotSpec (imported lazily: no 
         payload_kg=spec.mass.payload_kg,
         max_accel=() if spec.joints.max_accel_deg_s2 is None else tuple(
             float(v) for v in np.deg2rad(spec.joints.max_accel_deg_s2)),
-        maker_joints=maker_joints, maker_matrix=maker_matrix)
+        maker_joints=maker_joints, maker_matrix=maker_matrix,
+        estimated_links=(True,) * n if spec.mass.estimated else ())
+
+
+def _mass_model(spec: RobotFolderSpec, chain, where: str) -> tuple[object, tuple[bool, ...]]:
+    """The links' mass model for :mod:`sim.robots.generate` (``[[links]]``, a URDF's inertials
+    or ``[mass] total_kg``) and which links' inertials are estimates: every capsule of a total
+    mass; a ``[[links]]`` entry marked ``estimate`` or without its centre of mass and inertia
+    (a capsule of its mass); every link where ``[mass] estimated = true``."""
+    from sim.robots.chain import inertia_problem
+
+    n = chain.n
+    if spec.links:
+        if len(spec.links) != n:
+            raise KinematicsError(f"{where}: links: {len(spec.links)} [[links]] for {n} moving "
+                                  "links (one per joint, J1's link first)")
+        if spec.mass.total_kg is not None:
+            raise KinematicsError(f"{where}: mass.total_kg: give [[links]] or mass.total_kg, "
+                                  "not both")
+        out = []
+        for i, lk in enumerate(spec.links):
+            if (lk.com_mm is None) != (lk.inertia_kg_m2 is None):
+                raise KinematicsError(f"{where}: links[{i}]: give com_mm and inertia_kg_m2 "
+                                      "together (or neither: a uniform capsule of mass_kg)")
+            if lk.com_mm is None:
+                out.append((lk.mass_kg, None, None))
+                continue
+            if not np.all(np.isfinite(lk.com_mm + lk.inertia_kg_m2)):
+                raise KinematicsError(f"{where}: links[{i}]: com_mm and inertia_kg_m2 must be "
+                                      "finite numbers")
+            ixx, iyy, izz, ixy, ixz, iyz = lk.inertia_kg_m2
+            inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+            problem = inertia_problem(inertia)
+            if problem:
+                raise KinematicsError(f"{where}: links[{i}].inertia_kg_m2: {problem}")
+            out.append((lk.mass_kg, np.asarray(lk.com_mm, float) / 1000.0, inertia))
+        estimated = tuple(lk.estimate or lk.com_mm is None for lk in spec.links)
+        mass: object = tuple(out)
+    elif spec.mass.total_kg is not None:
+        mass, estimated = spec.mass.total_kg, (True,) * n
+    elif chain.inertials is not None:
+        mass, estimated = None, (False,) * n
+    else:
+        raise KinematicsError(f"{where}: mass.total_kg: required for a robot given by a DH table "
+                              "or a URDF without <inertial> on every moving link and without "
+                              "[[links]] (the link inertias are estimated from it)")
+    if spec.mass.estimated:
+        estimated = (True,) * n
+    return mass, estimated
 
 
 def _maker(spec: RobotFolderSpec, n: int, where: str):
@@ -182,10 +248,7 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     if len(spec.drives) != n:
         raise KinematicsError(f"{where}: drives: {len(spec.drives)} drives for {n} joints (a "
                               "robot given by a DH table or a URDF needs one [[drives]] per joint)")
-    if spec.mass.total_kg is None and chain.inertials is None:
-        raise KinematicsError(f"{where}: mass.total_kg: required for a robot given by a DH table "
-                              "or a URDF without <inertial> on every moving link (the link "
-                              "inertias are estimated from it)")
+    mass, estimated = _mass_model(spec, chain, where)
     if spec.joints.max_speed_deg_s is not None:
         if len(spec.joints.max_speed_deg_s) != n:
             raise KinematicsError(f"{where}: joints.max_speed_deg_s: "
@@ -215,7 +278,7 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
         if spec.kinematics.urdf is not None:
             key += (path.parent / spec.kinematics.urdf).read_text(encoding="utf-8",
                                                                    errors="replace")
-        model = generated_model_path(chain, spec.name, drives, spec.mass.total_kg,
+        model = generated_model_path(chain, spec.name, drives, mass,
                                      key + f"|payload {spec.mass.payload_kg!r}",
                                      payload_kg=spec.mass.payload_kg, home=home)
     maker_joints, maker_matrix = _maker(spec, n, where)
@@ -228,7 +291,8 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
         robot_file=model.name, family=ChainFamily(arm_from_chain(chain, path)),
         max_speed=tuple(float(v) for v in speed),
         description=spec.description or f"robot from {path}", drives=drives,
-        payload_kg=spec.mass.payload_kg, maker_joints=maker_joints, maker_matrix=maker_matrix)
+        payload_kg=spec.mass.payload_kg, maker_joints=maker_joints, maker_matrix=maker_matrix,
+        estimated_links=estimated)
     if spec.joints.max_accel_deg_s2 is not None:
         accel = np.deg2rad(spec.joints.max_accel_deg_s2)
     else:
@@ -389,13 +453,12 @@ def generated_files(folder: str | Path) -> dict[Path, str]:
     chain = chain_from_robot_file(spec, path)
     if len(spec.drives) != chain.n:
         raise KinematicsError(f"{path}: drives: {len(spec.drives)} drives for {chain.n} joints")
-    if spec.mass.total_kg is None and chain.inertials is None:
-        raise KinematicsError(f"{path}: mass.total_kg: required (no URDF inertials)")
+    mass, _ = _mass_model(spec, chain, str(path))
     # the registry's Drive fields (not imported: the registry loads this very folder)
     drives = tuple(SimpleNamespace(gear_ratio=d.gear_ratio, efficiency=d.efficiency,
                                    rotor_inertia=d.rotor_inertia_kg_m2,
                                    peak_torque=d.peak_torque_nm) for d in spec.drives)
-    xml = model_text(chain, spec.name, drives, spec.mass.total_kg, spec.mass.payload_kg,
+    xml = model_text(chain, spec.name, drives, mass, spec.mass.payload_kg,
                      home=_home(spec, chain, str(path)))
     return {path.parent / spec.mjcf: xml, path.parent / "scene.xml": scene_text(spec.name)}
 
