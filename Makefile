@@ -11,10 +11,9 @@ BIN    := $(VENV)/bin
 SCENARIO ?= bugnar_5r_weld_cycle
 OUT    ?=
 PYTEST_ARGS ?=
-# Test workers: one per core (pytest-xdist); JOBS=0 runs in this process. The slow share runs
-# in one process (SLOW_JOBS=0), as its campaigns were measured.
+# Test workers: one per core (pytest-xdist); JOBS=0 (SLOW_JOBS=0) runs in this process.
 JOBS   ?= auto
-SLOW_JOBS ?= 0
+SLOW_JOBS ?= auto
 
 # Debian packages that headless rendering needs (EGL on Mesa, or OSMesa).
 SYSTEM_PACKAGES := libegl1 libgl1 libosmesa6 libglu1-mesa
