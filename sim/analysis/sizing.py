@@ -530,14 +530,7 @@ def motor_torque(tau_joint: ArrayLike, qd: ArrayLike, qdd: ArrayLike, drive: Dri
     Returns:
         Motor torque, N m, shape (N,).
     """
-    tau_joint = np.asarray(tau_joint, dtype=float)
-    qd = np.asarray(qd, dtype=float)
-    qdd = np.asarray(qdd, dtype=float)
-    n, eta = drive.gear_ratio, drive.efficiency
-    load = tau_joint - armature * qdd
-    motoring = load * qd >= 0.0
-    through_gear = np.where(motoring, load / (n * eta), load * eta / n)
-    return through_gear + drive.rotor_inertia * n * qdd
+    return drive.motor_torque(tau_joint, qd, qdd, armature)
 
 
 def motor_speed_rpm(qd: ArrayLike, drive: Drive) -> NDArray[np.float64]:

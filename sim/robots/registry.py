@@ -86,6 +86,39 @@ class Drive:
         rpm = np.asarray(joint_speed, dtype=float) * self.gear_ratio * RPM_PER_RAD_S
         return self.peak_torque_at(rpm) * self.gear_ratio * self.efficiency
 
+    def motor_torque(self, tau_joint: ArrayLike, qd: ArrayLike, qdd: ArrayLike,
+                     armature: float | ArrayLike = 0.0) -> NDArray[np.float64]:
+        """The motor torque that gives joint torque ``tau_joint`` (N m, with the joint-side
+        inertia ``armature * qdd`` in it) at joint speed ``qd`` and acceleration ``qdd``, N m,
+        motor side: the gear's efficiency on the load torque only, in the direction power
+        flows, and the rotor's inertia on the motor side::
+
+            tau_load = tau_joint - armature qdd
+            tau_m    = tau_load / (N eta) + J_r N qdd   where tau_load qd >= 0 (the motor drives)
+            tau_m    = tau_load eta / N   + J_r N qdd   where the load drives back
+
+        The one formula of cellsim: the simulation's drive limit and sizing both use it."""
+        tau_joint = np.asarray(tau_joint, dtype=float)
+        qd = np.asarray(qd, dtype=float)
+        qdd = np.asarray(qdd, dtype=float)
+        n, eta = self.gear_ratio, self.efficiency
+        load = tau_joint - np.asarray(armature, dtype=float) * qdd
+        through_gear = np.where(load * qd >= 0.0, load / (n * eta), load * eta / n)
+        return through_gear + self.rotor_inertia * n * qdd
+
+    def joint_torque_for(self, tau_motor: ArrayLike, qd: ArrayLike, qdd: ArrayLike,
+                         armature: float | ArrayLike = 0.0) -> NDArray[np.float64]:
+        """The joint torque at which :meth:`motor_torque` is ``tau_motor`` (its inverse at
+        given ``qd`` and ``qdd``), N m."""
+        tau_motor = np.asarray(tau_motor, dtype=float)
+        qd = np.asarray(qd, dtype=float)
+        qdd = np.asarray(qdd, dtype=float)
+        n, eta = self.gear_ratio, self.efficiency
+        through_gear = tau_motor - self.rotor_inertia * n * qdd
+        drives = through_gear * qd >= 0.0  # tau_load has the sign of through_gear
+        load = np.where(drives, through_gear * n * eta, through_gear * n / eta)
+        return load + np.asarray(armature, dtype=float) * qdd
+
     @property
     def reflected_inertia(self) -> float:
         """Rotor inertia seen at the joint, ``rotor_inertia * gear_ratio**2``, kg m^2."""
