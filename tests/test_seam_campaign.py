@@ -37,6 +37,7 @@ drawn. Any other refusal or exception fails the case.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 from collections import Counter
@@ -658,10 +659,31 @@ SIM_SHARE = [("lrmate200ic5l", "line"), ("lrmate200ic5l", "polyline"),
              ("lrmate100ib", "line")]
 
 
+@contextlib.contextmanager
+def _without_local_constants():
+    """hypothesis mixes into its draws constants it reads from every local module loaded so far
+    (``hypothesis.internal.conjecture.providers``: the pool grows as tests import cellsim's
+    modules lazily), so the seams drawn for a seed depended on which tests had run before in
+    the process: a campaign run alone, after others or on another pytest-xdist worker drew
+    other seams (issue 25's note). The campaign draws without that pool, from its seed alone."""
+    from hypothesis.internal.conjecture import providers
+    from hypothesis.internal.constants_ast import Constants
+
+    saved = providers._get_local_constants
+    providers.CONSTANTS_CACHE.cache.clear()
+    providers._get_local_constants = Constants
+    try:
+        yield
+    finally:
+        providers._get_local_constants = saved
+        providers.CONSTANTS_CACHE.cache.clear()
+
+
 def campaign(arm: Arm, kind: str, n: int, seed: int, body: Any) -> None:
     """Run ``body(case, root)`` on ``n`` cases hypothesis draws for ``arm`` and ``kind``
-    (reproducible: a fixed seed, no example database); a case refused as out of reach does
-    not count (``body`` returns None) and another is drawn."""
+    (reproducible: a fixed seed, no example database, no constants from the modules loaded:
+    the same seams in any process); a case refused as out of reach does not count (``body``
+    returns None) and another is drawn."""
     import tempfile
 
     @settings(max_examples=n, database=None, deadline=None,
@@ -675,7 +697,8 @@ def campaign(arm: Arm, kind: str, n: int, seed: int, body: Any) -> None:
 
     from hypothesis import seed as hseed
 
-    hseed(seed)(run)()
+    with _without_local_constants():
+        hseed(seed)(run)()
 
 
 #: The slow share's size: this many times :data:`MIX` on the reference, and this many simulated
