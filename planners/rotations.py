@@ -110,8 +110,13 @@ def axis_angle_matrix(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
         Rotation matrices, shape (..., 3, 3).
     """
     k = np.asarray(axis, dtype=float)
-    k = k / np.linalg.norm(k)
+    norm = float(np.linalg.norm(k))
     th = np.asarray(angle, dtype=float)[..., None, None]
+    if not norm > 0.0:  # no axis (a zero or underflowing vector): only a zero turn is defined
+        if np.any(th != 0.0):
+            raise ValueError("axis_angle_matrix: a turn about a zero axis")
+        return np.broadcast_to(np.eye(3), th.shape[:-2] + (3, 3)).copy()
+    k = k / norm
     K = skew(k)
     return np.eye(3) + np.sin(th) * K + (1.0 - np.cos(th)) * (K @ K)
 

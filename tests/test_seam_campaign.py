@@ -443,6 +443,9 @@ class Planned:
     scenario: Any
     built: Any
     motion: Any
+    #: The arm's own collisions ``cellsim check`` reports on the reference (self-collisions,
+    #: links in the part): not judged on the reference, a reason not to simulate the case.
+    arm_hits: tuple[dict, ...] = ()
 
     @property
     def weld(self) -> Any:
@@ -613,6 +616,7 @@ def check_reference(case: Case, root: Path) -> tuple[Planned, so.Frames] | None:
     collisions = reported_collisions(pl)
     fails = v.failures + collision_failures(case, fr, collisions, pl.weld.t0, pl.weld.t1)
     arm_hits = [c for c in collisions if not _tool_parts(c)]
+    pl.arm_hits = tuple(arm_hits)
     TALLY[(case.arm.key, "arm collisions (not judged)")] += bool(arm_hits)
     TALLY[(case.arm.key, f"{case.kind}: failed" if fails else f"{case.kind}: passed")] += 1
     figures = ", ".join(f"{k} {x:.4g}" for k, x in v.figures.items())
@@ -761,13 +765,21 @@ def check_simulated(case: Case, root: Path) -> Planned | None:
     plots) and checked by the same oracle on the recorded ``tcp_pos`` / ``tcp_quat``, with the
     acceptance limits widened by the servo's tracking error (:func:`servo_bounds`: the
     simulated tool point may be off the reference by that much, to first order; feed-forward
-    keeps it to micrometres), the progress speed by twice that over the speed window."""
+    keeps it to micrometres), the progress speed by twice that over the speed window. A case
+    whose reference drives the arm into itself or the part is not simulated (another is
+    drawn)."""
     from sim.pipeline.run import RunOptions, evaluate_scenario
 
     got = check_reference(case, root)
     if got is None:
         return None
     pl, _ = got
+    if pl.arm_hits:
+        # the reference drives the arm into itself or the part: the simulation's contacts
+        # push it off the path (cellsim reports the collision and fails the verdict), which
+        # is no measure of the weld path
+        TALLY[(case.arm.key, "not simulated: the arm collides on the reference")] += 1
+        return None
     try:
         ev = evaluate_scenario(pl.scenario, RunOptions(video=False, plots=False))
     except CellsimError as exc:  # a limit of the scenario's own moves, not of the weld

@@ -101,8 +101,8 @@ class SeamOrientation:
 
     def _rotation(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
         R = self._frame(u)
-        if not np.any(self._delta):
-            return R
+        if not np.linalg.norm(self._delta) > 1e-15:  # no start offset to fade (a denormal
+            return R                                 # one has no direction to turn about)
         fade = 1.0 - _smooth(np.clip(u / self.settle, 0.0, 1.0))
         return R @ axis_angle_matrix(self._delta, fade * np.linalg.norm(self._delta))
 
