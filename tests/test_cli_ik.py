@@ -47,8 +47,16 @@ def test_ik_json_round_trip(capsys, name):
         assert set(s) == {"joints_deg", "within_limits"}
         assert isinstance(s["within_limits"], bool) and len(s["joints_deg"]) == m.n_joints
         np.testing.assert_allclose(m.fk(np.deg2rad(s["joints_deg"])), m.fk(q), atol=1e-9)
-    # the source configuration (home is close to it, it is inside the ranges) ranks first
-    np.testing.assert_allclose(doc["solutions"][0]["joints_deg"], np.rad2deg(q), atol=1e-6)
+    # the source configuration is among them, and they are ranked as --help says: inside the
+    # ranges first, then closest to home (q = 0; joint distance weighted by 1/max speed, as
+    # sqrt(sum(((q - home) / v_max)^2)))
+    sols = np.array([s["joints_deg"] for s in doc["solutions"]])
+    assert np.abs(sols - np.rad2deg(q)).max(axis=1).min() < 1e-6
+    inside = [s["within_limits"] for s in doc["solutions"]]
+    assert inside == sorted(inside, reverse=True)
+    dist = np.linalg.norm(np.deg2rad(sols) / np.asarray(ROBOTS[name].max_speed), axis=1)
+    n_in = sum(inside)
+    assert np.all(np.diff(dist[:n_in]) >= -1e-9), dist
     # without --all only the best one
     code, out, _ = _run(capsys, "ik", name, *_pose_args(name, q), "--json")
     assert code == 0 and len(json.loads(out)["solutions"]) == 1
@@ -94,7 +102,7 @@ def test_ik_default_orientation_is_home(capsys):
 
 
 @pytest.mark.parametrize("argv, needle", [
-    (["ik", "lrmate300", "1", "2", "3"], "lrmate100ib, lrmate200ic5l, robot_5r"),
+    (["ik", "lrmate300", "1", "2", "3"], "lrmate100ib, lrmate200ic5l, m10ia, m20ia, robot_5r"),
     (["ik", "robot_5r", "1", "2", "nan"], "Z must be a finite number"),
     (["ik", "robot_5r", "1", "2", "3", "--euler-zyx-deg", "0", "inf", "0"], "B must be a finite"),
     (["ik", "lrmate200ic5l", "2000", "0", "300"], "mm outside"),

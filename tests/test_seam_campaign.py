@@ -25,7 +25,8 @@ are in :func:`seam_oracle.judge_weld`; collisions must be reported exactly where
 a torch part (nozzle, contact tip, body) into a solid, never where it keeps them clear, and the
 wire only beyond its allowed depth (:func:`collision_failures`).
 
-Arms: the three shipped 6-axis arms; the 5-axis LR Mate 100iB on lines radial to J1 (work
+Arms: the shipped 6-axis arms (the welding-robot library's five among them); the 5-axis
+LR Mate 100iB on lines radial to J1 (work
 angle 90 and the surface pitched in the vertical plane through J1: its torch stays in that
 plane, the only postures it has); a UR5 DH table in a robot folder (numeric IK: its seams are
 short, fast and without a weave, each of its path's poses costing about 0.2 s to solve). A case
@@ -113,6 +114,12 @@ ARMS = {a.key: a for a in (
     Arm("kr6r900_2", "kr6r900_2", (0, -90, 90, 0, 90, 0), (380, 600), (100, 400)),
     Arm("irb2400", "irb2400", (0, 0, 0, 0, 90, 0), (750, 1100), (300, 800)),
     Arm("lrmate100ib", "lrmate100ib", (0, 0, 0, 90, 0), (330, 470), (100, 300), torch_column=0),
+    # the welding-robot library (models/README.md): seams inside about 0.45-0.75 of the reach
+    Arm("m10ia", "m10ia", (0, 0, 0, 0, -90, 0), (650, 1000), (200, 700)),
+    Arm("m20ia", "m20ia", (0, 0, 0, 0, -90, 0), (800, 1300), (300, 900)),
+    Arm("ar2010", "ar2010", (0, 0, 0, 0, -90, 0), (900, 1450), (300, 1000)),
+    Arm("irb1600", "irb1600", (0, 0, 0, 0, 90, 0), (550, 900), (200, 600)),
+    Arm("kr10r1420", "kr10r1420", (0, -90, 90, 0, 90, 0), (650, 1000), (200, 700)),
     Arm("ur5_dh", "robots/ur5_dh", (0, -90, 90, -90, -90, 0), (330, 550), (50, 250), 180.0,
         dh=UR5_DH),
 )}
@@ -446,6 +453,8 @@ class Planned:
     #: The arm's own collisions ``cellsim check`` reports on the reference (self-collisions,
     #: links in the part): not judged on the reference, a reason not to simulate the case.
     arm_hits: tuple[dict, ...] = ()
+    #: The simulated run (:func:`check_simulated`), when it was simulated.
+    evaluation: Any = None
 
     @property
     def weld(self) -> Any:
@@ -627,7 +636,9 @@ def check_reference(case: Case, root: Path) -> tuple[Planned, so.Frames] | None:
 
 
 # ---------------------------------------------------------------------------- the campaign
-#: The mix of generated seams by arm and kind (arm, kind, cases), 100 in all: the slow share
+#: The welding-robot library's arms (models/README.md).
+LIBRARY = ("m10ia", "m20ia", "ar2010", "irb1600", "kr10r1420")
+#: The mix of generated seams by arm and kind (arm, kind, cases), 115 in all: the slow share
 #: checks :data:`SLOW_FACTOR` times it on the reference motion. Few full circles: most drawn
 #: circles are refused as out of reach (the wrist would wind past its range), and each refusal
 #: costs a plan.
@@ -640,11 +651,12 @@ MIX = [
     ("irb2400", "circle", 2),
     ("ur5_dh", "line", 1), ("ur5_dh", "polyline", 1), ("ur5_dh", "arc", 1), ("ur5_dh", "circle", 1),
     ("lrmate100ib", "line", 26),
+    *((arm, kind, 1) for arm in LIBRARY for kind in ("line", "polyline", "arc")),
 ]
-assert sum(n for *_, n in MIX) == 100
-#: The fast share (``make test``): 100 cases on the reference motion, the mix with one full
-#: circle per shipped 6-axis arm (the costliest draws: about 20 refused per circle) and the
-#: saved draws given to lines.
+assert sum(n for *_, n in MIX) == 115
+#: The fast share (``make test``): 105 cases on the reference motion, the mix with one full
+#: circle per seed 6-axis arm (the costliest draws: about 20 refused per circle), the saved
+#: draws given to lines, and a line per arm of the welding-robot library.
 FAST_SHARE = [
     ("lrmate200ic5l", "line", 9), ("lrmate200ic5l", "polyline", 10),
     ("lrmate200ic5l", "arc", 6), ("lrmate200ic5l", "circle", 1),
@@ -654,8 +666,9 @@ FAST_SHARE = [
     ("irb2400", "circle", 1),
     ("ur5_dh", "line", 1), ("ur5_dh", "polyline", 1), ("ur5_dh", "arc", 1), ("ur5_dh", "circle", 1),
     ("lrmate100ib", "line", 26),
+    *((arm, "line", 1) for arm in LIBRARY),
 ]
-assert sum(n for *_, n in FAST_SHARE) == 100
+assert sum(n for *_, n in FAST_SHARE) == 105
 #: The simulated share: (arm, kind), one case each; 10 in all.
 SIM_SHARE = [("lrmate200ic5l", "line"), ("lrmate200ic5l", "polyline"),
              ("lrmate200ic5l", "circle"), ("kr6r900_2", "arc"), ("kr6r900_2", "polyline"),
@@ -800,6 +813,7 @@ def check_simulated(case: Case, root: Path) -> Planned | None:
                       pos_tol=so.POS_TOL_M + dp, end_tol=so.END_TOL_M + dp,
                       angle_tol=so.ANGLE_TOL_DEG + da,
                       speed_tol=so.SPEED_TOL + dp / (so.SPEED_HALF_WINDOW_S * case.speed * 1e-3))
+    pl.evaluation = ev
     TALLY[(case.arm.key, "simulated: failed" if v.failures else "simulated: passed")] += 1
     figures = ", ".join(f"{key} {x:.4g}" for key, x in v.figures.items())
     assert v.ok, (f"{case.short()} (simulated; servo bound {dp * 1e3:.4f} mm, {da:.4f} deg): "
@@ -835,6 +849,38 @@ def test_many_generated_seams_simulated(arm, kind):
     :data:`SIM_SHARE`."""
     campaign(ARMS[arm], kind, SLOW_SIMULATED + 1, _seed("sim-slow", arm, kind),
              after_the_first(check_simulated))
+
+
+# ------------------------------------------------------- every URDF arm through a weld
+#: The shipped arms given by a URDF (tests/test_robots_as_data.py checks their models against
+#: MuJoCo's own compile of the URDF and their closed form against the published OPW sets).
+URDF_ARMS = ("kr6r900_2", "irb2400", *LIBRARY)
+
+
+def check_simulated_torques(case: Case, root: Path) -> Planned | None:
+    """:func:`check_simulated`, then the run's recorded joint torques against pinocchio's RNEA
+    on the run's own model (:mod:`rnea_oracle`): within 1e-5 of each joint's peak (the model
+    goes to pinocchio as MJCF text, its numbers at the text's precision; a 1 % error in one
+    joint's torque is caught: tests/test_torques.py)."""
+    from rnea_oracle import tau_id_error
+
+    pl = check_simulated(case, root)
+    if pl is None:
+        return None
+    ev = pl.evaluation
+    (root / "model.xml").write_text(ev.built.xml)
+    err = tau_id_error(root / "model.xml", ev.summary["joints"], ev.record.arrays, root)
+    assert err <= 1e-5, f"{case.short()}: tau_id off pinocchio's RNEA by {err:.3g} of the peak"
+    TALLY[(case.arm.key, "torques checked against pinocchio")] += 1
+    return pl
+
+
+@pytest.mark.parametrize("arm", URDF_ARMS)
+def test_every_urdf_arm_welds_a_generated_seam_with_torques_pinocchio_agrees(arm):
+    """Each shipped URDF arm (the welding-robot library among them) simulated through a
+    generated line weld: the tool path judged on its recorded tool frames (inverse kinematics,
+    speed, angles: :func:`check_simulated`) and its joint torques against pinocchio."""
+    campaign(ARMS[arm], "line", 2, _seed("library", arm), after_the_first(check_simulated_torques))
 
 
 # ---------------------------------------------------------------------------- planted faults

@@ -27,8 +27,8 @@ shipped robots (``models/build_models.py``):
 * sites ``frame0`` (the chain's base frame), ``wrist`` (:func:`wrist_point`), ``flange`` and
   ``tcp`` (the chain's end frame, z out of the flange); keyframes ``home`` (``[joints] home_deg`` of robot.toml, else all
   joints at 0) and ``zero`` (all joints at 0; each the nearest value in range);
-* ``<exclude>`` of each link with the link two further on when the link between is shorter
-  than their two radii (the spherical wrist's J5 body, an elbow offset: the two capsules meet
+* ``<exclude>`` of each link with a link two or more further on when the links between are
+  together shorter than their two radii (the spherical wrist's J5 body, an elbow offset: the two capsules meet
   at a compact joint by construction), each with a comment saying so; the base is a disc on
   the floor (at most 40 mm high, a tenth of J2's height), J1's capsule starts 10 mm clear of it
   (thinner where J2 sits too low for the full radius), and a column carries J1's link where
@@ -193,7 +193,7 @@ def mjcf_from_chain(chain: Chain, name: str, drives, total_mass_kg: MassModel,
         L.append(f'{indent}<body name="link{i + 1}" pos="{_f(T[:3, 3])}" quat="{_quat(T[:3, :3])}">')
         ind = indent + "  "
         L.append(f'{ind}<joint name="j{i + 1}" axis="{_f(chain.axes[i])}" '
-                 f'range="{_f([lo[i], hi[i]])}" armature="{armature:.6g}"/>')
+                 f'range="{_f([lo[i], hi[i]])}" armature="{armature:.10g}"/>')
         e = ends[i]
         start = j1_start if i == 0 else np.zeros(3)
         if lengths[i] > 1e-6:
@@ -218,13 +218,17 @@ def mjcf_from_chain(chain: Chain, name: str, drives, total_mass_kg: MassModel,
         L.append("  " * (i + 3) + "</body>")
     L.append("    </body>")
     L.append("  </worldbody>")
-    # links two apart meet at a compact joint when the link between is shorter than their radii
-    excl = [(i, i + 2) for i in range(n - 2) if lengths[i + 1] < radii[i] + radii[i + 2]]
+    # links two or more apart meet at compact joints when the links between are together
+    # shorter than their radii (a wrist whose J4 sits at the wrist centre: the forearm's capsule
+    # reaches the wrist, J4's link has no length and J5's is short)
+    excl = [(i, j) for i in range(n - 2) for j in range(i + 2, n)
+            if sum(lengths[i + 1:j]) < radii[i] + radii[j]]
     if excl:
         L.append("  <contact>")
         for a, b in excl:
-            L.append(f"    <!-- link{a + 1} and link{b + 1} meet at the compact joint of link{a + 2} "
-                     f"({lengths[a + 1] * 1e3:.0f} mm long, shorter than their radii "
+            between = ", ".join(f"link{k + 1}" for k in range(a + 1, b))
+            L.append(f"    <!-- link{a + 1} and link{b + 1} meet at the compact joint of {between} "
+                     f"({sum(lengths[a + 1:b]) * 1e3:.0f} mm long, shorter than their radii "
                      f"{(radii[a] + radii[b]) * 1e3:.0f} mm) -->")
             L.append(f'    <exclude body1="link{a + 1}" body2="link{b + 1}"/>')
         L.append("  </contact>")
