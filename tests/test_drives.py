@@ -118,7 +118,8 @@ def test_the_drive_a_joint_has_sets_the_model_the_clamp_and_sizing(tmp_path, sou
     # to the rated torque at the top speed, 0 beyond)
     tau, qd, qdd = (a[k][:, joint] for k in ("tau", "qd", "qdd"))
     load = tau - rotor * ratio**2 * qdd
-    motor = np.where(load * qd >= 0, load / (ratio * eta), load * eta / ratio) + \
+    motor = np.where((load * qd >= 0) | (np.abs(qd) < 1e-3), load / (ratio * eta),
+                     load * eta / ratio) + \
         rotor * ratio * qdd
     rpm = np.abs(qd) * ratio * 60 / (2 * np.pi)
     if source == "scenario override":  # the 5R's J2: a 4000 rpm motor, rated = peak / 2

@@ -52,6 +52,66 @@ def test_sizing_torques_converge_as_the_timestep_shrinks(name):
                                    err_msg=f"{name} {key} (peak, RMS) per joint")
 
 
+def _reported_peaks(scenario, timestep: float) -> dict[str, np.ndarray]:
+    """The sizing's peaks at ``timestep``, per joint: ``used``: the values its peak checks use
+    (joint torque, motor peak torque; basis worst: the worse source), ``id`` and ``sim``: each
+    source's peak joint and motor torque; shape (n, 2) each."""
+    from sim.pipeline.run import evaluate_scenario
+
+    sc = dataclasses.replace(scenario, simulation=scenario.simulation.model_copy(
+        update={"timestep_s": timestep}))
+    res = evaluate_scenario(sc, RunOptions(video=False, plots=False, progress=False)).sizing
+    out = {s: np.array([[j.stats[s].peak_torque, j.motor[s].peak_torque] for j in res.joints])
+           for s in ("id", "sim")}
+    out["used"] = np.array([[j.check("joint_torque").used, j.check("motor_peak_torque").used]
+                            for j in res.joints])
+    return out
+
+
+def _peaks_agree(name: str, sim_rtol: float) -> None:
+    """Peaks at 2 and 1 ms against 0.5 ms, every joint loaded over 2 % of the largest: the
+    values the checks use and the reference's within 0.2 %, the simulated ones within
+    ``sim_rtol``."""
+    scenario = load_scenario(name)
+    fine = _reported_peaks(scenario, 0.0005)
+    for h in (0.002, 0.001):
+        got = _reported_peaks(scenario, h)
+        for key, rtol in (("used", 0.002), ("id", 0.002), ("sim", sim_rtol)):
+            loaded = fine[key] > 0.02 * fine[key].max(axis=0)
+            np.testing.assert_allclose(got[key][loaded], fine[key][loaded], rtol=rtol,
+                                       err_msg=f"{name} at {h * 1e3:g} ms: {key} (joint, motor) "
+                                       "peak per joint")
+
+
+def test_reported_peaks_agree_at_2_1_and_half_ms_through_contacts():
+    """Issue 26's acceptance on the pick-and-place cycle, whose part contacts move the joints
+    in a step or two (its simulated J3 torque at one step: 15.99 N m at 2 ms, 12.85 at 1 ms,
+    12.83 at 0.5 ms): every peak sizing reports, of both sources, joint and motor side, at
+    2, 1 and 0.5 ms steps within 0.2 % (the simulated peaks are sustained over 5 ms)."""
+    _peaks_agree("lrmate200ic_pick_place", sim_rtol=0.002)
+
+
+@pytest.mark.slow
+def test_peaks_of_the_samples_would_not_agree(monkeypatch):
+    """The check above is not blind: with the peaks taken of the samples (no window), the
+    pick-and-place's J3 peak that its check uses at 2 ms is 25 % over the one at 0.5 ms."""
+    import sim.analysis.sizing as sizing
+
+    monkeypatch.setattr(sizing, "PEAK_WINDOW_S", 0.0)
+    with pytest.raises(AssertionError, match="at 2 ms: used"):
+        _peaks_agree("lrmate200ic_pick_place", sim_rtol=0.002)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [s for s in SCENARIOS if s != "lrmate200ic_pick_place"])
+def test_reported_peaks_agree_at_2_1_and_half_ms(name):
+    """Every other shipped scenario: the peaks the checks use and the reference's within
+    0.2 % at 2, 1 and 0.5 ms. The simulated source converges at first order in the step
+    (MuJoCo's implicit Euler): seed 000's fast J2 motor peak is 1.013, 1.021 and 1.024 N m at
+    2, 1 and 0.5 ms, so it is held to 1.5 % here; its checks use the reference's 1.029."""
+    _peaks_agree(name, sim_rtol=0.015)
+
+
 @pytest.mark.parametrize("name", ["kacso_lrmate100ib_sequence1", "lrmate200ic_weld_plate",
                                   "bugnar_5r_phase1", "bugnar_5r_weld_cycle",
                                   "bugnar_5r_weld_cycle_ceiling", "lrmate200ic_pick_place"])

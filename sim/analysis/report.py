@@ -28,6 +28,7 @@ import numpy as np
 from sim.analysis.sizing import (
     CHECK_TITLES,
     PEAK_KNEE_FRACTION,
+    PEAK_WINDOW_S,
     SOURCE_TITLES,
     JointSizing,
     SizingResult,
@@ -121,6 +122,7 @@ def sizing_rows(result: SizingResult) -> tuple[list[str], list[dict[str, Any]]]:
             r[f"{name}_sim_{unit}"] = b
         r["peak_torque_time_id_s"] = sid.peak_torque_time
         r["peak_torque_time_sim_s"] = ssim.peak_torque_time
+        r["momentary_torque_sim_nm"] = ssim.momentary_torque
         for name, attr, unit in (("mean_abs_power", "mean_abs_power", "w"),
                                  ("mean_power", "mean_power", "w"),
                                  ("net_energy", "net_energy", "j")):
@@ -340,7 +342,12 @@ _CONVENTIONS = (
     "(tau - armature qdd) eta/N + J_r N qdd when power flows back. Margin = (limit - used)/limit "
     "x 100; a check passes at margin >= 0. The peak envelope holds the peak torque up to "
     f"{PEAK_KNEE_FRACTION:g} x max speed, then falls linearly to the rated torque at max speed "
-    "(generic shape, not catalogue data); the continuous envelope is the rated torque."
+    "(generic shape, not catalogue data); the continuous envelope is the rated torque. "
+    f"Simulated peaks (torque, acceleration, power, motor torque, envelope) are of the signal "
+    f"sustained over {PEAK_WINDOW_S * 1e3:g} ms (its centred sliding mean): a contact's onset "
+    "moves a joint within a step or two, an impulse whose one-step torque depends on the "
+    "timestep; the largest instantaneous torque is the momentary torque (sizing.csv, "
+    "sizing.json), for a reducer's momentary rating."
 )
 
 

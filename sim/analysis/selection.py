@@ -9,6 +9,7 @@ the last sample's torque. With ``N`` the ratio, ``eta`` the efficiency, ``J_r`` 
 
     tau_l = tau - armature qdd                     # the model's own drive inertia removed
     tau_m = tau_l / (N eta) + (J_r + J_in) N qdd   when tau_l qd >= 0 (the motor drives)
+                                                   or |qd| < 1e-3 rad/s (standstill)
     tau_m = tau_l eta / N   + (J_r + J_in) N qdd   otherwise (the load drives back)
     n     = N |qd| 60 / (2 pi)                     # motor (reducer input) speed, rpm
 
@@ -21,6 +22,9 @@ Checks (``error`` severity unless said):
   percent of the curve);
 * ``motor_speed``: ``max n <= min(motor max speed, reducer max input speed)``;
 * ``reducer_peak``: ``max |tau_l| <= repeated peak torque``;
+* the peaks (``motor_peak``, the curve, ``reducer_peak``) of the simulated torque are of the
+  torque sustained over 5 ms, as sizing takes them (:data:`sim.analysis.sizing.PEAK_WINDOW_S`:
+  a contact's one-step impulse is not a peak the drive must hold);
 * ``reducer_life``: ``L10 = rated_life_h (T_rated / T_k)^k (n_rated / n_av) >= life target``
   with ``T_k = (sum w |n| |tau_l|^k / sum w |n|)^(1/k)``, ``k`` the reducer's ``life_exponent``
   (3 for strain-wave gears, 10/3 for RV reducers), and ``n_av = sum w |n| / T_duty`` (the
@@ -65,7 +69,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.analysis.catalog import Catalog, Motor, Reducer, describe_entry
-from sim.robots.registry import RPM_PER_RAD_S
+from sim.analysis.sizing import PEAK_WINDOW_S, sustained
+from sim.robots.registry import COULOMB_SPEED, RPM_PER_RAD_S
 from sim.simulation.runfolder import SELECTION_CSV, SELECTION_JSON, RunRecord
 
 #: Ways to rank the passing pairs (``--rank``).
@@ -257,6 +262,7 @@ class _Source:
     name: str
     w: NDArray[np.float64]        # trapezoid weights, s
     p: NDArray[np.float64]        # (N, 3): u, v, qdd
+    p_peak: NDArray[np.float64]   # p sustained over the source's peak window (sizing's)
     qd: NDArray[np.float64]       # joint speed, rad/s
     tau_l: NDArray[np.float64]    # load torque, N m
     moments: NDArray[np.float64]  # sum w p p^T, (3, 3)
@@ -306,16 +312,21 @@ def _hull_points(p: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _source(name: str, t: NDArray[np.float64], tau: NDArray[np.float64],
-            qd: NDArray[np.float64], qdd: NDArray[np.float64], armature: float) -> _Source:
+            qd: NDArray[np.float64], qdd: NDArray[np.float64], armature: float,
+            window: float = 0.0) -> _Source:
+    """A source; its peaks (motor and reducer peak torque, the torque-speed curve) of the
+    signals sustained over ``window`` s, as sizing takes them (the simulated source's:
+    :data:`sim.analysis.sizing.PEAK_WINDOW_S`)."""
     w = _weights(t)
     tau_l = tau - armature * qdd
-    drives = tau_l * qd >= 0.0
+    drives = (tau_l * qd >= 0.0) | (np.abs(qd) < COULOMB_SPEED)
     p = np.column_stack([np.where(drives, tau_l, 0.0), np.where(drives, 0.0, tau_l), qdd])
     moments = (p * w[:, None]).T @ p
-    hull = _hull_points(np.vstack([p, [[tau_l[-1], 0.0, 0.0]]]))
+    p_peak = sustained(t, p, window)  # linear in p: the sustained motor torque is p_peak @ c
+    hull = _hull_points(np.vstack([p_peak, [[tau_l[-1], 0.0, 0.0]]]))
     aqd = np.abs(qd)
-    return _Source(name, w, p, qd, tau_l, moments, hull, float(tau_l[-1]),
-                   float(np.max(aqd)), float(np.max(np.abs(tau_l))),
+    return _Source(name, w, p, p_peak, qd, tau_l, moments, hull, float(tau_l[-1]),
+                   float(np.max(aqd)), float(np.max(np.abs(p_peak[:, 0] + p_peak[:, 1]))),
                    float(w @ aqd), float(w @ (aqd * np.abs(tau_l) ** 3)))
 
 
@@ -358,7 +369,7 @@ def _pair_values(src: _Source, motor: Motor, reducer: Reducer, opts: SelectionOp
 def _curve_pct(src: _Source, motor: Motor, reducer: Reducer) -> float:
     """The worst ``|tau_m| / curve(n)`` over the cycle, percent (the dwell at speed 0 too)."""
     r = reducer.spec
-    tau_m = np.abs(np.append(motor_torque(src, motor, reducer),
+    tau_m = np.abs(np.append(src.p_peak @ _coeffs(motor, reducer),
                              src.tau_l_last / (r.ratio * r.efficiency)))
     avail = motor.peak_torque_at(np.append(np.abs(src.qd) * r.ratio * RPM_PER_RAD_S, 0.0))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -474,7 +485,7 @@ def select_actuators(record: RunRecord, joint_ids: Sequence[int], armature: Sequ
             _source("id", t, record.get("tau_id")[:, k], record.get("qd_ref")[:, k],
                     record.get("qdd_ref")[:, k], float(armature[k])),
             _source("sim", t, record.get("tau")[:, k], record.get("qd")[:, k],
-                    qdd_sim[:, k], float(armature[k])),
+                    qdd_sim[:, k], float(armature[k]), PEAK_WINDOW_S),
         ]
         pairs = [check_pair(sources, m, r, options, cycle, float(j_load[k]))
                  for m in options.catalog.motors for r in options.catalog.reducers]

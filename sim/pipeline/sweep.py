@@ -41,7 +41,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sim.analysis.report import csv_text, figure_png, write_atomic
-from sim.analysis.sizing import load_summary, load_trajectory, peak_abs, rms
+from sim.analysis.sizing import (
+    PEAK_WINDOW_S,
+    load_summary,
+    load_trajectory,
+    peak_abs,
+    rms,
+    sustained,
+)
 from sim.errors import CellsimError, SweepError
 from sim.simulation.runfolder import SIZING_JSON
 
@@ -251,18 +258,21 @@ def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequ
         run_dir: The variant's run folder ("" when none was kept).
 
     Peak and RMS torques are computed from both sources; the unsuffixed value is the larger.
+    The simulated peaks are of the torque sustained over
+    :data:`~sim.analysis.sizing.PEAK_WINDOW_S`, as sizing takes them.
     """
     t = np.asarray(arrays["t"], dtype=float)
     rows = []
     for k, name in enumerate(joints):
         tau_id, tau = arrays["tau_id"][:, k], arrays["tau"][:, k]
         pk_id, _ = peak_abs(t, tau_id)
-        pk_sim, _ = peak_abs(t, tau)
+        # the simulated source's peaks as sizing takes them: sustained over PEAK_WINDOW_S
+        pk_sim, _ = peak_abs(t, sustained(t, tau, PEAK_WINDOW_S))
         rms_id = float(rms(t, tau_id))
         rms_sim = float(rms(t, tau))
         speed = max(peak_abs(t, arrays["qd_ref"][:, k])[0], peak_abs(t, arrays["qd"][:, k])[0])
         power = max(peak_abs(t, tau_id * arrays["qd_ref"][:, k])[0],
-                    peak_abs(t, tau * arrays["qd"][:, k])[0])
+                    peak_abs(t, sustained(t, tau * arrays["qd"][:, k], PEAK_WINDOW_S))[0])
         s = sized.get(name, {})
         margin = s.get("margin_pct")
         rows.append({

@@ -97,13 +97,19 @@ class Drive:
             tau_m    = tau_load / (N eta) + J_r N qdd   where tau_load qd >= 0 (the motor drives)
             tau_m    = tau_load eta / N   + J_r N qdd   where the load drives back
 
+        At standstill, ``|qd| <`` :data:`COULOMB_SPEED` (where the friction law ramps through
+        zero), the motor drives (the larger torque): a servo holding a joint still sees a
+        speed that only wobbles about zero, and the gear's direction of power flow must not
+        flip with it from one sample to the next.
+
         The one formula of cellsim: the simulation's drive limit and sizing both use it."""
         tau_joint = np.asarray(tau_joint, dtype=float)
         qd = np.asarray(qd, dtype=float)
         qdd = np.asarray(qdd, dtype=float)
         n, eta = self.gear_ratio, self.efficiency
         load = tau_joint - np.asarray(armature, dtype=float) * qdd
-        through_gear = np.where(load * qd >= 0.0, load / (n * eta), load * eta / n)
+        drives = (load * qd >= 0.0) | (np.abs(qd) < COULOMB_SPEED)
+        through_gear = np.where(drives, load / (n * eta), load * eta / n)
         return through_gear + self.rotor_inertia * n * qdd
 
     def joint_torque_for(self, tau_motor: ArrayLike, qd: ArrayLike, qdd: ArrayLike,
@@ -115,7 +121,8 @@ class Drive:
         qdd = np.asarray(qdd, dtype=float)
         n, eta = self.gear_ratio, self.efficiency
         through_gear = tau_motor - self.rotor_inertia * n * qdd
-        drives = through_gear * qd >= 0.0  # tau_load has the sign of through_gear
+        # tau_load has the sign of through_gear; standstill as in motor_torque
+        drives = (through_gear * qd >= 0.0) | (np.abs(qd) < COULOMB_SPEED)
         load = np.where(drives, through_gear * n * eta, through_gear * n / eta)
         return load + np.asarray(armature, dtype=float) * qdd
 
