@@ -193,3 +193,29 @@ def test_cli_exit_codes_separate_user_mistakes_from_internal_faults(monkeypatch,
     assert main(["list"]) == 3
     err = capsys.readouterr().err
     assert "Traceback" in err and "internal error" in err and "report" in err
+
+
+@pytest.mark.parametrize("exc", [ValueError("could not convert string to float: 'x'"),
+                                 ZeroDivisionError("float division by zero"),
+                                 OverflowError("cannot convert float infinity to integer"),
+                                 KeyError("phases"), FileNotFoundError(2, "gone"),
+                                 OSError(5, "Input/output error")])
+def test_any_exception_that_is_not_cellsims_is_an_internal_fault_never_exit_1(
+        exc, monkeypatch, capsys):
+    """Issue 31: an exception escaping cellsim's readers (a fault planted in a command) is
+    exit 3 with its traceback and one line naming it, never exit 1, which a --strict run
+    returns for a failed verdict; a disk error the OS reports for a path stays exit 2."""
+    import sim.cli.list as list_command
+    from sim.cli import main
+
+    def planted(args):
+        raise exc
+
+    monkeypatch.setattr(list_command, "run", planted)
+    code = main(["list"])
+    err = capsys.readouterr().err
+    if type(exc) is OSError:  # EIO: the place's error, one line with the path
+        assert code == 2 and "Traceback" not in err
+        return
+    assert code == 3, err
+    assert "Traceback" in err and f"internal error: {type(exc).__name__}" in err

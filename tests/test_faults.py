@@ -508,3 +508,71 @@ def test_a_real_full_disk_and_a_read_only_parent(tmp_path):
     assert rc == 2 and err.count("\n") == 1 and "Read-only file system" in err, err
     assert str(tmp_path / "ro") in err
     assert seen["ro_left"] == []
+
+
+# ---------------------------------------------------------------------------- every reader
+def _readers():
+    """Every reader of a file a user names: (what, function taking the path)."""
+    from sim.analysis.catalog import load_catalog
+    from sim.cells import load_cell
+    from sim.cells.meshes import read_mesh
+    from sim.cells.toolfile import load_tool_file
+    from sim.robots.chain import chain_from_urdf
+    from sim.robots.robotfile import load_robot_folder
+    from sim.scenario import load_scenario
+    from sim.scenario.fanuc_ls import read_ls
+
+    def robot_folder(path: Path):  # path: the folder's robot.toml
+        return load_robot_folder(path.parent)
+
+    return {"scenario": load_scenario, "cell": load_cell, "tool": load_tool_file,
+            "robot.toml": robot_folder, "URDF": chain_from_urdf, "TP program": read_ls,
+            "catalogue": load_catalog, "mesh": read_mesh}
+
+
+@pytest.mark.parametrize("kind", ["fifo", "dev_zero", "folder"])
+@pytest.mark.parametrize("reader", ["catalogue", "cell", "mesh", "robot.toml", "scenario",
+                                    "TP program", "tool", "URDF"])
+def test_every_reader_refuses_a_fifo_a_device_and_a_folder_in_one_line(reader, kind, tmp_path):
+    """Issue 31: a FIFO with no writer (which blocked forever), /dev/zero (which read until
+    memory ran out) or a folder given as any input file is refused before a byte is read:
+    cellsim's own error, one line naming the path. The call returning at all is the check
+    that nothing blocks (a FIFO with no writer blocks a plain open)."""
+    import os
+
+    from sim.errors import CellsimError
+
+    suffix = {"mesh": ".stl", "TP program": ".ls", "URDF": ".urdf"}.get(reader, ".toml")
+    path = tmp_path / f"input{suffix}"
+    if reader == "robot.toml":
+        path = tmp_path / "input" / "robot.toml"
+        path.parent.mkdir()
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "dev_zero":
+        path.symlink_to("/dev/zero")
+    else:
+        path.mkdir()
+    with pytest.raises(CellsimError) as err:
+        _readers()[reader](path)
+    msg = str(err.value)
+    assert "\n" not in msg and "input" in msg, msg
+
+
+def test_a_binary_stl_is_bounded_by_its_header_before_it_is_loaded(tmp_path):
+    """A binary STL whose header promises more triangles than the limit is refused from its
+    84 bytes (it was loaded whole first: 48 s and 2.9 GB for 250 MB); one whose file is
+    shorter than its header says is refused as truncated."""
+    from sim.cells.meshes import MAX_FACES, read_mesh
+    from sim.errors import CellError
+
+    big = tmp_path / "big.stl"
+    with open(big, "wb") as fh:
+        fh.write(b"\0" * 80 + (MAX_FACES + 1).to_bytes(4, "little"))
+        fh.truncate(84 + 50 * (MAX_FACES + 1))  # sparse: no disk used
+    with pytest.raises(CellError, match="triangles .its header., more than"):
+        read_mesh(big)
+    short = tmp_path / "short.stl"
+    short.write_bytes(b"\0" * 80 + (12).to_bytes(4, "little") + b"\0" * 50 * 11)
+    with pytest.raises(CellError, match="truncated"):
+        read_mesh(short)

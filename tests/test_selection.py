@@ -287,7 +287,7 @@ def test_cli_bad_catalogue_exits_2_before_any_run(tmp_path, capsys):
                str(tmp_path / "missing.toml"), "--out", str(out), "--quiet"])
     assert rc == 2
     err = capsys.readouterr().err
-    assert "missing.toml: catalogue file not found" in err and err.count("\n") == 1
+    assert "missing.toml: no such catalogue file" in err and err.count("\n") == 1
     assert not out.exists()
 
 

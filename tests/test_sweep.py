@@ -219,3 +219,82 @@ def test_parse_float_list_errors(text: str, fragment: str) -> None:
     with pytest.raises(SweepError) as err:
         parse_float_list(text, field="--payload")
     assert str(err.value).startswith("--payload:") and fragment in str(err.value)
+
+
+# ---------------------------------------------------------------- nothing lost (issue 31)
+def all_failing_runner(variant: Variant) -> Path:
+    raise UnknownNameError("tool", "torch9", ["mig_torch"])
+
+
+def interrupted_runner(variant: Variant) -> Path:
+    if variant.index == 1:
+        raise KeyboardInterrupt
+    return fake_runner(variant)
+
+
+def test_variants_whose_values_print_alike_get_their_own_run_folders(tmp_path) -> None:
+    """1.0000001 and 1.0000002 kg both print as 1: each variant keeps its own run folder
+    (the second silently replaced the first), named with its exact digits."""
+    res = run_sweep("weld_demo", [1.0000001, 1.0000002], [1.0], fake_runner, workers=1,
+                    out_dir=tmp_path / "sw", progress=False)
+    dirs = [Path(o.run_dir) for o in res.outcomes]
+    assert len(set(dirs)) == 2 and all(d.is_dir() and d.parent == tmp_path / "sw" for d in dirs)
+    assert {d.name for d in dirs} == {"payload_1.0000001kg_speed_1.0x",
+                                      "payload_1.0000002kg_speed_1.0x"}
+    rows = read_csv(tmp_path / "sw" / "sweep.csv")
+    assert {r["run_dir"] for r in rows} == {str(d) for d in dirs}
+
+
+def test_a_second_sweep_into_a_busy_folder_refuses(tmp_path) -> None:
+    """While a sweep (or run) holds the folder, another sweep into it refuses in one line
+    instead of both succeeding with one table lost."""
+    from sim.errors import RunFolderError
+    from sim.simulation.runfolder import RunLock
+
+    out = tmp_path / "sw"
+    with RunLock(out), pytest.raises(RunFolderError, match="being written by another"):
+        run_sweep("weld_demo", [0.0], [1.0], fake_runner, workers=1, out_dir=out,
+                  progress=False)
+    assert not out.exists()
+
+
+def test_a_sweep_whose_every_variant_failed_leaves_the_previous_table(tmp_path) -> None:
+    """A good sweep, then one whose every variant fails into the same folder: the good table
+    and run folders are as they were, the failed sweep's report is in <out>.failed."""
+    out = tmp_path / "sw"
+    run_sweep("weld_demo", PAYLOADS, SCALES, fake_runner, workers=1, out_dir=out,
+              progress=False)
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    with pytest.raises(SweepError, match="every variant failed: the previous .* is as it was"):
+        run_sweep("weld_demo", PAYLOADS, SCALES, all_failing_runner, workers=1, out_dir=out,
+                  progress=False)
+    after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    assert after == before
+    failed = tmp_path / "sw.failed"
+    assert "torch9" in (failed / "sweep.md").read_text()
+
+
+def test_an_interrupted_sweep_leaves_the_previous_folder_and_nothing_marked_complete(
+        tmp_path) -> None:
+    """A sweep stopped mid-way (here by an interrupt in its second variant) leaves the
+    previous folder as it was and no hidden folder behind; one killed outright leaves its
+    hidden folder marked "writing" (never read as a result), which the next sweep removes."""
+    import shutil
+
+    from sim.simulation.runfolder import marker_state, write_marker
+
+    out = tmp_path / "sw"
+    run_sweep("weld_demo", [0.0], [1.0], fake_runner, workers=1, out_dir=out, progress=False)
+    table = (out / "sweep.csv").read_bytes()
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep("weld_demo", PAYLOADS, SCALES, interrupted_runner, workers=1, out_dir=out,
+                  progress=False)
+    assert (out / "sweep.csv").read_bytes() == table and marker_state(out) == "complete"
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".sw.") and p.is_dir()]
+    # what SIGKILL leaves: a hidden sibling marked "writing"
+    killed = tmp_path / ".sw.abcd1234"
+    killed.mkdir()
+    write_marker(killed, state="writing")
+    shutil.copytree(out / "payload_0kg_speed_1x", killed / "payload_0kg_speed_1x")
+    run_sweep("weld_demo", [0.0], [1.0], fake_runner, workers=1, out_dir=out, progress=False)
+    assert not killed.exists() and marker_state(out) == "complete"

@@ -189,12 +189,11 @@ def load_catalog(path: str | Path) -> Catalog:
     """
     path = Path(path)
     where = str(path)
+    from sim.core.files import read_input_text
+
+    text = read_input_text(path, CatalogError, "catalogue file")
     try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise CatalogError(f"{where}: catalogue file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CatalogError(f"{where}: cannot read the catalogue ({exc})") from None
+        raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise CatalogError(f"{where}: not valid TOML: {exc}") from None
     unknown = sorted(set(raw) - set(_TOP_KEYS))

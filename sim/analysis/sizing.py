@@ -31,10 +31,10 @@ losses help and the motor only sees ``eta`` times the load torque (the ``1/eta``
 motoring formula inverted). At standstill (``|qd| < 1e-3 rad/s``, the friction law's zone
 through zero: :meth:`sim.robots.registry.Drive.motor_torque`) the motoring formula is used
 (the larger torque, conservative; a held joint's speed wobbles about zero and must not flip
-the gear's direction from sample to sample). ``armature`` is the joint-side inertia the simulated model
-already adds to its torques (MJCF ``armature``, by the registry's convention the reflected
-rotor inertia ``J_r N^2`` of the *default* drives); it is taken out first so that the rotor
-inertia of the drive being checked is counted once.
+the gear's direction from sample to sample). ``armature`` is the joint-side inertia the
+simulated model already adds to its torques (MJCF ``armature``, by the registry's convention
+the reflected rotor inertia ``J_r N^2`` of the *default* drives); it is taken out first so that
+the rotor inertia of the drive being checked is counted once.
 
 Limits (:class:`Check`): the joint torque against the MJCF actuator force range (sign by sign
 when asymmetric; the gear of the actuator is applied), the joint speed against

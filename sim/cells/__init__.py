@@ -328,7 +328,7 @@ def resolve_cell(ref: str, base: Path | None = None) -> CellSpec:
     """
     if is_file_ref(ref):
         path = Path(ref) if base is None else base / ref
-        if not path.is_file():
+        if not path.exists() or path.is_dir():
             raise CellError(f"{path}: no such cell file (a path is relative to the scenario "
                             f"file; shipped cells: {', '.join(CELLS)})")
         return load_cell(path)

@@ -34,6 +34,8 @@ MAX_PIECES = 64
 UNITS = {"mm": 1e-3, "m": 1.0}
 #: A mesh larger than this is refused (it would make every model.xml huge).
 MAX_FACES = 500_000
+#: The largest mesh file read, bytes: an ASCII STL of MAX_FACES triangles takes about 130 MB.
+MAX_MESH_BYTES = 160 * 1024 * 1024
 
 
 def read_mesh(path: Path, unit: str = "mm", where: str = "") -> tuple[NDArray[np.float64],
@@ -49,8 +51,10 @@ def read_mesh(path: Path, unit: str = "mm", where: str = "") -> tuple[NDArray[np
     path = Path(path)
     if path.suffix.lower() not in (".stl", ".obj"):
         raise CellError(f"{prefix}{path.name}: mesh files must be .stl or .obj")
-    if not path.is_file():
-        raise CellError(f"{prefix}no such file {path}")
+    from sim.core.files import check_input
+
+    size = check_input(path, lambda m: CellError(prefix + m), "mesh file", MAX_MESH_BYTES)
+    _check_stl_count(path, size, prefix)
     try:
         mesh = trimesh.load(str(path), force="mesh", process=True)
     except Exception as exc:  # trimesh raises many kinds for a damaged file
@@ -63,6 +67,25 @@ def read_mesh(path: Path, unit: str = "mm", where: str = "") -> tuple[NDArray[np
         raise CellError(f"{prefix}{path.name}: {len(faces)} triangles, more than {MAX_FACES}; "
                         "simplify the mesh")
     return verts * UNITS[unit], faces
+
+
+def _check_stl_count(path: Path, size: int, prefix: str) -> None:
+    """A binary STL's triangle count from its header, against :data:`MAX_FACES`, before the
+    file is loaded (a binary STL is 84 + 50 n bytes; an ASCII one starts with ``solid`` and is
+    bounded by its size)."""
+    if path.suffix.lower() != ".stl" or size < 84:
+        return
+    with open(path, "rb") as fh:
+        head = fh.read(84)
+    n = int.from_bytes(head[80:84], "little")
+    if head[:5].lower() == b"solid" and size != 84 + 50 * n:
+        return  # ASCII
+    if n > MAX_FACES:
+        raise CellError(f"{prefix}{path.name}: {n} triangles (its header), more than "
+                        f"{MAX_FACES}; simplify the mesh")
+    if size < 84 + 50 * n:
+        raise CellError(f"{prefix}{path.name}: a binary STL of {n} triangles (its header) "
+                        f"needs {84 + 50 * n:,} bytes, it has {size:,}: a truncated file")
 
 
 def _cache_path(path: Path, unit: str) -> Path:

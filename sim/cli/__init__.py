@@ -3,7 +3,9 @@
 Each sub-command lives in its own module of this package with ``register(sub)`` (adds its
 parser) and sets ``func(args) -> int``. User mistakes (every :class:`CellsimError` but
 :class:`InternalError`, planners' errors included) are printed as one line and exit with code
-2; an :class:`InternalError` (a fault inside cellsim) prints its traceback and exits with 3.
+2; an :class:`InternalError`, or any other exception (a fault inside cellsim: its readers
+turn every input mistake into a :class:`CellsimError`), prints its traceback and exits with 3,
+never 1 (the code of a ``--strict`` run whose verdict fails).
 May import every layer below.
 """
 
@@ -40,10 +42,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except InternalError as exc:
-        traceback.print_exc()
-        print(f"cellsim: internal error: {exc} (a fault in cellsim, not in your input: please "
-              "report it with the traceback above)", file=sys.stderr)
-        return 3
+        return _internal_fault(exc)
     except CellsimError as exc:
         print(f"cellsim: error: {exc}{_holding_hint(exc)}", file=sys.stderr)
         return 2
@@ -62,9 +61,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:
         message = io_error(exc)
         if message is None:
-            raise
+            return _internal_fault(exc)
         print(f"cellsim: error: {message}", file=sys.stderr)
         return 2
+    except Exception as exc:  # noqa: BLE001  (the last line of defence: never exit 1)
+        return _internal_fault(exc)
+
+
+def _internal_fault(exc: BaseException) -> int:
+    """A fault inside cellsim (an :class:`InternalError`, or any exception that is not a
+    :class:`CellsimError`: cellsim's readers turn every input mistake into one of those):
+    its traceback, one line saying so, exit 3."""
+    traceback.print_exc()
+    print(f"cellsim: internal error: {type(exc).__name__}: {exc} (a fault in cellsim, not in "
+          "your input: please report it with the traceback above)", file=sys.stderr)
+    return 3
 
 
 def _holding_hint(exc: BaseException) -> str:

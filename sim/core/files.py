@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -59,3 +59,91 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
             pass
         raise
     return path
+
+
+#: The largest text input cellsim reads (a scenario, cell, tool, robot.toml, URDF, TP program
+#: or catalogue), bytes: a thousand times the largest shipped one, checked before reading.
+MAX_TEXT_BYTES = 16 * 1024 * 1024
+
+
+def read_input(path: str | Path, error: Callable[[str], BaseException],
+               what: str = "file",
+               max_bytes: int = MAX_TEXT_BYTES) -> bytes:
+    """The bytes of an input file: a regular file (a FIFO, a device such as ``/dev/zero`` or a
+    folder is refused before a byte is read: opened without blocking, checked with ``fstat``),
+    at most ``max_bytes`` (its size checked before reading, and the read bounded too).
+
+    Raises:
+        error: One line naming the file: missing, not a regular file, too large, unreadable.
+    """
+    import stat
+
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except FileNotFoundError:
+        raise error(f"{path}: no such {what}") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO"
+                    if stat.S_ISFIFO(st.st_mode) else "a device" if stat.S_ISCHR(st.st_mode)
+                    or stat.S_ISBLK(st.st_mode) else "not a regular file")
+            raise error(f"{path}: {kind}, not a {what} (cellsim reads regular files only)")
+        if st.st_size > max_bytes:
+            raise error(f"{path}: {st.st_size:,} bytes, more than the {max_bytes:,} a {what} "
+                        "may have")
+        chunks, left = [], max_bytes + 1
+        while left > 0:
+            chunk = os.read(fd, min(left, 1 << 20))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            left -= len(chunk)
+        data = b"".join(chunks)
+        if len(data) > max_bytes:  # it grew while read
+            raise error(f"{path}: more than the {max_bytes:,} bytes a {what} may have")
+        return data
+    except OSError as exc:
+        raise error(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
+    finally:
+        os.close(fd)
+
+
+def check_input(path: str | Path, error: Callable[[str], BaseException],
+                what: str = "file",
+                max_bytes: int = MAX_TEXT_BYTES) -> int:
+    """Refuse what :func:`read_input` refuses (missing, not a regular file, larger than
+    ``max_bytes``) without opening the file (``stat`` does not block on a FIFO), for files a
+    library reads itself; returns the size in bytes."""
+    import stat
+
+    path = Path(path)
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise error(f"{path}: no such {what}") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO"
+                if stat.S_ISFIFO(st.st_mode) else "a device" if stat.S_ISCHR(st.st_mode)
+                or stat.S_ISBLK(st.st_mode) else "not a regular file")
+        raise error(f"{path}: {kind}, not a {what} (cellsim reads regular files only)")
+    if st.st_size > max_bytes:
+        raise error(f"{path}: {st.st_size:,} bytes, more than the {max_bytes:,} a {what} may "
+                    "have")
+    return int(st.st_size)
+
+
+def read_input_text(path: str | Path, error: Callable[[str], BaseException],
+                    what: str = "file",
+                    max_bytes: int = MAX_TEXT_BYTES, errors: str = "strict") -> str:
+    """:func:`read_input` decoded as UTF-8 (one line naming the file when it is not UTF-8)."""
+    data = read_input(path, error, what, max_bytes)
+    try:
+        return data.decode("utf-8", errors=errors)
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None

@@ -129,12 +129,9 @@ def load_toml(path: Path, root: type[M], error: type[Exception]) -> tuple[M, dic
     Returns:
         The validated model and the raw table.
     """
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise error(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise error(f"{path}: cannot read ({exc})") from None
+    from sim.core.files import read_input_text
+
+    text = read_input_text(path, error, "file")
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

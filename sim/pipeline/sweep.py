@@ -29,6 +29,8 @@ import math
 import multiprocessing
 import os
 import re
+import shutil
+import tempfile
 import time
 import traceback
 from collections.abc import Callable, Mapping, Sequence
@@ -210,8 +212,14 @@ def make_variants(base_scenario: Any, payloads: Sequence[float], speed_scales: S
                          f"{len(ps) * len(ss)} variants (at most {MAX_SWEEP_VARIANTS})")
     out = Path(out_dir)
     combos = [(p, s) for p in ps for s in ss]
-    return [Variant(p, s, base_scenario, out / Variant(p, s).slug, i)
-            for i, (p, s) in enumerate(combos)]
+    names = [Variant(p, s).slug for p, s in combos]
+    clash = {n for n in names if names.count(n) > 1}
+    # values that print alike (1.0000001 and 1.0000002 kg: both "1") get their exact digits,
+    # so that no two variants share a run folder
+    names = [re.sub(r"[^A-Za-z0-9_.-]", "_", f"payload_{p!r}kg_speed_{s!r}x") if n in clash
+             else n for n, (p, s) in zip(names, combos, strict=True)]
+    return [Variant(p, s, base_scenario, out / name, i)
+            for i, ((p, s), name) in enumerate(zip(combos, names, strict=True))]
 
 
 @dataclass(frozen=True)
@@ -374,7 +382,11 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
         runner: Module-level function ``runner(variant) -> run_dir``.
         workers: Worker processes (default ``os.cpu_count()``, capped at the number of
             variants); 1 runs serially in this process.
-        out_dir: Folder for the sweep outputs (and the suggested variant run folders).
+        out_dir: Folder for the sweep outputs (and the variant run folders). cellsim's own,
+            as a run folder is: locked while the sweep runs (a second sweep into it refuses),
+            written in a hidden sibling and moved into place only when the sweep's table is
+            written; when every variant failed, the previous folder stays as it was and the
+            failed sweep's report goes to ``<out_dir>.failed``.
         mp_context: Start method of the worker processes (``"spawn"``, ``"forkserver"``,
             ``"fork"``).
         progress: Show a progress bar (tqdm; silent when not a terminal).
@@ -393,6 +405,7 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
 
     Raises:
         SweepError: Bad payloads, speed scales or workers; failed variants (after writing).
+        RunFolderError: Another sweep or run is writing ``out_dir``.
     """
     if not callable(runner):
         raise SweepError(f"runner: {runner!r} is not callable")
@@ -410,22 +423,76 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
     # the sweep folder is cellsim's, like a run folder: never the working directory, a file,
     # a symbolic link or a user's folder (its marker lets a later sweep reuse it)
     out_dir = runfolder.check_out_dir(out_dir)
-    variants = make_variants(base_scenario, payloads, speed_scales, out_dir)
-    if workers is None:
-        workers = os.cpu_count() or 1
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+    make_variants(base_scenario, payloads, speed_scales, out_dir)  # validated before any folder
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
         raise SweepError(f"workers: must be a whole number >= 1, got {workers!r}")
-    workers = min(workers, len(variants))
     if mp_context not in multiprocessing.get_all_start_methods():
         raise SweepError(f"mp_context: unknown start method {mp_context!r}; known: "
                          f"{', '.join(multiprocessing.get_all_start_methods())}")
     try:
-        Path(out_dir).mkdir(parents=True, exist_ok=True)
+        out_dir.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise SweepError(f"{out_dir}: cannot create the sweep folder: {exc.strerror or exc}"
                          ) from None
-    runfolder.write_marker(out_dir)
+    # a sweep has a run's guarantees: one writer per place (a second sweep into it refuses),
+    # everything written into a hidden sibling marked "writing" and moved into place only
+    # when its table is written (a killed sweep leaves the previous folder as it was, and what
+    # it left goes at the next sweep); a sweep whose every variant failed leaves the previous
+    # table too, its own report in the failed folder next to it
+    with runfolder.RunLock(out_dir):
+        runfolder.remove_stale(out_dir)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+        try:
+            runfolder.write_marker(tmp, state="writing")
+            variants = make_variants(base_scenario, payloads, speed_scales, tmp)
+            n_workers = min(workers or os.cpu_count() or 1, len(variants))
+            result = _run_variants(runner, variants, n_workers, mp_context, engine, address,
+                                   batch, progress)
+            result = _moved(result, tmp, out_dir)
+            failures = result.failures
+            every_failed = bool(failures) and len(failures) == len(result.outcomes)
+            if write:
+                result.files = {k: out_dir / v.name
+                                for k, v in write_sweep(tmp, result).items()}
+            if every_failed:
+                runfolder.write_marker(tmp, state="failed")
+                failed = runfolder.failed_folder(out_dir)
+                if runfolder.is_run_folder(failed):
+                    shutil.rmtree(failed)
+                elif failed.exists() or failed.is_symlink():  # not ours: never replaced
+                    failed = Path(tempfile.mkdtemp(prefix=failed.name + "-",
+                                                   dir=out_dir.parent))
+                    failed.rmdir()
+                os.replace(tmp, failed)
+                result = _moved(result, out_dir, failed)
+                result.files = {k: failed / v.name for k, v in result.files.items()}
+            else:
+                runfolder.write_marker(tmp, state="complete")
+                runfolder.check_out_dir(out_dir)  # again: the place may have changed meanwhile
+                if out_dir.exists():
+                    trash = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old.",
+                                                  dir=out_dir.parent))
+                    os.replace(out_dir, trash / "old")
+                    shutil.rmtree(trash, ignore_errors=True)
+                os.replace(tmp, out_dir)
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+    if failures and raise_on_failure:
+        first = failures[0]
+        where = f"; see {result.files['md']}" if "md" in result.files else ""
+        kept = (f" (every variant failed: the previous {out_dir} is as it was)"
+                if every_failed else "")
+        raise SweepError(f"{len(failures)} of {len(result.outcomes)} sweep variants failed; first: "
+                         f"{first.variant.label}: {first.error}{where}{kept}")
+    return result
 
+
+def _run_variants(runner: Callable[[Variant], Any], variants: list[Variant], workers: int,
+                  mp_context: str, engine: str, address: str | None, batch: Any,
+                  progress: bool) -> SweepResult:
+    """Run every variant (a batch, Ray, this process or a process pool)."""
     from tqdm import tqdm
 
     bar = tqdm(total=len(variants), desc="sweep", unit="run", disable=None if progress else True)
@@ -458,17 +525,26 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
                     bar.update(len(group))
     finally:
         bar.close()
-    result = SweepResult(outcomes=[r for r in results if r is not None], workers=workers,
-                         wall_s=time.perf_counter() - t0)
-    if write:
-        result.files = write_sweep(out_dir, result)
-    failures = result.failures
-    if failures and raise_on_failure:
-        first = failures[0]
-        where = f"; see {result.files['md']}" if "md" in result.files else ""
-        raise SweepError(f"{len(failures)} of {len(result.outcomes)} sweep variants failed; first: "
-                         f"{first.variant.label}: {first.error}{where}")
-    return result
+    return SweepResult(outcomes=[r for r in results if r is not None], workers=workers,
+                       wall_s=time.perf_counter() - t0)
+
+
+def _moved(result: SweepResult, old: Path, new: Path) -> SweepResult:
+    """``result`` with every path under ``old`` (run folders, in outcomes and rows) under
+    ``new``: the sweep is written in a hidden sibling and then moved into place."""
+    import dataclasses
+
+    a, b = str(old), str(new)
+
+    def path(p: Any) -> Any:
+        return b + p[len(a):] if isinstance(p, str) and (p == a or p.startswith(a + os.sep)) \
+            else p
+
+    outcomes = [dataclasses.replace(
+        o, run_dir=path(o.run_dir),
+        variant=dataclasses.replace(o.variant, run_dir=Path(path(str(o.variant.run_dir)))),
+        rows=tuple({k: path(v) for k, v in r.items()} for r in o.rows)) for o in result.outcomes]
+    return dataclasses.replace(result, outcomes=outcomes)
 
 
 #: Where variants run: a process pool on this machine, or Ray (a local instance or a cluster).

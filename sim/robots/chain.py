@@ -202,12 +202,13 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
             planar or floating joint on the chain, limits with lower > upper (one line naming the
             file and the joint).
     """
+    from sim.core.files import read_input
+
     path = Path(path)
-    if not path.is_file():
-        raise KinematicsError(f"{path}: no such URDF file")
+    data = read_input(path, KinematicsError, "URDF file")
     try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as exc:
+        root = ET.fromstring(data)
+    except ET.ParseError as exc:
         raise KinematicsError(f"{path}: not a readable URDF ({exc})") from None
     if root.tag != "robot":
         raise KinematicsError(f"{path}: not a URDF (the root element is <{root.tag}>, not <robot>)")

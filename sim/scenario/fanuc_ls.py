@@ -416,11 +416,10 @@ def _position(index: int, block: str, path, ln: int) -> LSPosition:
 def read_ls(path: str | Path) -> LSProgram:
     """:func:`parse_ls` of a file (one-line error for a missing or unreadable file), with the
     weave schedules of its sidecar table when there is one (:func:`weave_table_path`)."""
+    from sim.core.files import read_input_text
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise ScenarioError(f"{path}: cannot read the TP program ({exc.strerror})") from None
+    text = read_input_text(path, ScenarioError, "TP program", errors="replace")
     prog = parse_ls(text, path)
     table = weave_table_path(path)
     if table.is_file():

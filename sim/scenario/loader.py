@@ -63,8 +63,8 @@ def resolve_scenario(ref: str | Path) -> Path:
         UnknownNameError: Neither an existing file nor a shipped scenario; lists the shipped ones.
     """
     path = Path(ref)
-    if path.is_file():
-        return path
+    if path.is_file() or (path.exists() and not path.is_dir()):
+        return path  # a FIFO or device too: read_input refuses it in one line
     shipped = shipped_scenarios()
     if str(ref) not in shipped and (path.suffix == ".toml" or path.parent != Path(".")):
         raise ScenarioError(f"{ref}: no such scenario file")
@@ -79,12 +79,10 @@ def load_scenario(ref: str | Path) -> Scenario:
             the file and the key.
         UnknownNameError: Unknown scenario name or robot.
     """
+    from sim.core.files import read_input_text
+
     path = resolve_scenario(ref)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError(f"{path}: cannot read scenario file ({exc})") from None
-    return parse_scenario(text, source=path)
+    return parse_scenario(read_input_text(path, ScenarioError, "scenario file"), source=path)
 
 
 def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
