@@ -576,3 +576,29 @@ def test_a_binary_stl_is_bounded_by_its_header_before_it_is_loaded(tmp_path):
     short.write_bytes(b"\0" * 80 + (12).to_bytes(4, "little") + b"\0" * 50 * 11)
     with pytest.raises(CellError, match="truncated"):
         read_mesh(short)
+
+
+@pytest.mark.parametrize("payload, passes", [(3.0, True), (15.0, False)])
+def test_a_payload_over_the_robots_rating_fails_the_verdict(payload, passes, tmp_path):
+    """Issue 31: three times the LR Mate 200iC/5L's 5 kg passed; the tool's mass and the
+    payload are checked against the rating (check ``payload``): over it, the verdict fails."""
+    from sim.cells.tools import TOOLS
+    from sim.pipeline.run import RunOptions, evaluate_scenario
+    from sim.robots.registry import ROBOTS
+    from sim.scenario import parse_scenario
+
+    text = ('name = "heavy"\ndescription = "a joint move with a payload"\n'
+            'robot = "lrmate200ic5l"\ncell = "weld_table"\ntool = "mig_torch"\n'
+            f"payload_kg = {payload}\n[[phases]]\nname = \"move\"\nplanner = \"434\"\n"
+            "time_s = [0.0, 0.5, 1.0, 1.5, 2.0]\njoints_deg = [\n"
+            "  [0, 0, 0, 0, -90, 0], [2, 2, -2, 0, -88, 0], [4, 4, -4, 0, -86, 0],\n"
+            "  [6, 6, -6, 0, -84, 0], [8, 8, -8, 0, -82, 0]]\n")
+    ev = evaluate_scenario(parse_scenario(text), RunOptions(video=False, plots=False,
+                                                            progress=False))
+    check = next(c for c in ev.summary["checks"] if c["name"] == "payload")
+    load = TOOLS.get("mig_torch").mass_kg + payload
+    assert check["value"] == pytest.approx(load) and check["limit"] == ROBOTS[
+        "lrmate200ic5l"].payload_kg
+    assert check["pass"] is passes
+    if not passes:
+        assert ev.summary["verdict"] == "fail"

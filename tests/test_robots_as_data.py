@@ -1085,3 +1085,18 @@ def test_a_numeric_arms_path_ik_continues_its_branch_as_the_global_search_would(
             np.testing.assert_allclose(np.angle(np.exp(1j * (got[k] - want))), 0.0, atol=1e-6,
                                        err_msg=f"point {k}")
             prev = got[k]
+
+
+@pytest.mark.parametrize("kind", ["joint", "link"])
+def test_a_urdf_with_two_joints_or_links_of_one_name_is_refused(kind, tmp_path):
+    """Issue 31: a second joint (or link) of one name silently replaced the first; now one
+    line naming the file and the name."""
+    text = SHIPPED_DATA["irb2400"].read_text()
+    if kind == "joint":
+        text = text.replace('<joint name="joint_2"', '<joint name="joint_1"')
+    else:
+        text = text.replace('<link name="link_2"/>', '<link name="link_1"/>')
+    path = tmp_path / "twice.urdf"
+    path.write_text(text)
+    with pytest.raises(KinematicsError, match=rf"two {kind}s named '(joint|link)_1'"):
+        chain_from_urdf(path)

@@ -26,7 +26,10 @@ is per joint:
   corner zones left out: :func:`sim.simulation.metrics.measure_seam`), deg, against the
   scenario's ``simulation.torch_angle_tolerance_deg``;
 * ``selection`` (when actuators were chosen from a catalogue, :mod:`sim.analysis.selection`):
-  per joint, the chosen pair's smallest margin, %; fails when no pair serves the joint.
+  per joint, the chosen pair's smallest margin, %; fails when no pair serves the joint;
+* ``payload``: the mass at the flange, the tool's and the scenario's payload, kg, against the
+  robot's rated payload (``[mass] payload_kg``; not checked for a robot that gives none): a
+  robot carrying three times its rating is no result to size from.
 
 ``summary.json`` holds ``"checks"`` (each ``name``, ``joint`` ("" when the check is not a
 joint's), ``subject``, ``value``, ``limit``, ``unit``, ``pass``, ``severity``) and
@@ -73,11 +76,20 @@ class RunCheck:
 def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], spec: RobotSpec,
                tracking_tolerance_deg: float, sizing: SizingResult | None = None,
                clearance_mm: float = 5.0, selection: Any = None, *,
-               torch_angle_tolerance_deg: float) -> list[RunCheck]:
+               torch_angle_tolerance_deg: float,
+               flange_load_kg: tuple[float, float] | None = None) -> list[RunCheck]:
     """Every check of a run (module docstring): joint by joint, then collisions, clearance,
-    the Cartesian phases' speeds, the weld phases' torch angles, the weaves and the actuator
-    selection when one was made."""
+    the Cartesian phases' speeds, the weld phases' torch angles, the weaves, the actuator
+    selection when one was made, and the payload (``flange_load_kg``: the tool's mass and the
+    scenario's payload, kg) against the robot's rating."""
     checks: list[RunCheck] = []
+    if flange_load_kg is not None and spec.payload_kg > 0:
+        tool, payload = flange_load_kg
+        load = float(tool) + float(payload)
+        checks.append(RunCheck("payload", "", load, float(spec.payload_kg), "kg",
+                               load <= spec.payload_kg * (1 + 1e-9),
+                               subject=f"tool {tool:g} kg + payload {payload:g} kg on the "
+                               f"{spec.name}, rated {spec.payload_kg:g} kg"))
     track = np.degrees(np.max(np.abs(np.asarray(arrays["q"]) - arrays["q_ref"]), axis=0))
     speed = np.degrees(np.max(np.abs(np.asarray(arrays["qd"])), axis=0))
     accel = np.degrees(np.max(np.abs(np.asarray(arrays["qdd_ref"])), axis=0))

@@ -269,7 +269,9 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
                             clearance_mm=scenario.simulation.clearance_mm,
                             selection=selected,
                             torch_angle_tolerance_deg=(
-                                scenario.simulation.torch_angle_tolerance_deg))
+                                scenario.simulation.torch_angle_tolerance_deg),
+                            flange_load_kg=(built.cell.tool.mass_kg if built.cell.tool else 0.0,
+                                            scenario.payload_kg))
         summary["checks"] = [c.to_dict() for c in checks]
         summary["verdict"] = verdict(checks)
         summary["warnings"] = warnings_count(checks)

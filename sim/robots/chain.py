@@ -213,6 +213,13 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
     if root.tag != "robot":
         raise KinematicsError(f"{path}: not a URDF (the root element is <{root.tag}>, not <robot>)")
     links = [ln.get("name") for ln in root.findall("link")]
+    for kind, names in (("link", links), ("joint", [j.get("name") for j in root.findall("joint")])):
+        seen: set[str | None] = set()
+        for name in names:
+            if name in seen:  # a second one would silently replace the first
+                raise KinematicsError(f"{path}: two {kind}s named {name!r} (names must be "
+                                      "unique)")
+            seen.add(name)
     joints = {}
     child_of = {}
     for j in root.findall("joint"):
