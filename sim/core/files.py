@@ -76,7 +76,6 @@ def read_input(path: str | Path, error: Callable[[str], BaseException],
     Raises:
         error: One line naming the file: missing, not a regular file, too large, unreadable.
     """
-    import stat
 
     path = Path(path)
     try:
@@ -86,15 +85,7 @@ def read_input(path: str | Path, error: Callable[[str], BaseException],
     except OSError as exc:
         raise error(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
     try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO"
-                    if stat.S_ISFIFO(st.st_mode) else "a device" if stat.S_ISCHR(st.st_mode)
-                    or stat.S_ISBLK(st.st_mode) else "not a regular file")
-            raise error(f"{path}: {kind}, not a {what} (cellsim reads regular files only)")
-        if st.st_size > max_bytes:
-            raise error(f"{path}: {st.st_size:,} bytes, more than the {max_bytes:,} a {what} "
-                        "may have")
+        _refuse(os.fstat(fd), path, error, what, max_bytes)
         chunks, left = [], max_bytes + 1
         while left > 0:
             chunk = os.read(fd, min(left, 1 << 20))
@@ -118,7 +109,6 @@ def check_input(path: str | Path, error: Callable[[str], BaseException],
     """Refuse what :func:`read_input` refuses (missing, not a regular file, larger than
     ``max_bytes``) without opening the file (``stat`` does not block on a FIFO), for files a
     library reads itself; returns the size in bytes."""
-    import stat
 
     path = Path(path)
     try:
@@ -127,6 +117,15 @@ def check_input(path: str | Path, error: Callable[[str], BaseException],
         raise error(f"{path}: no such {what}") from None
     except OSError as exc:
         raise error(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
+    _refuse(st, path, error, what, max_bytes)
+    return int(st.st_size)
+
+
+def _refuse(st: os.stat_result, path: Path, error: Callable[[str], BaseException], what: str,
+            max_bytes: int) -> None:
+    """Raise ``error`` for what is not a regular file of at most ``max_bytes``."""
+    import stat
+
     if not stat.S_ISREG(st.st_mode):
         kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO"
                 if stat.S_ISFIFO(st.st_mode) else "a device" if stat.S_ISCHR(st.st_mode)
@@ -135,7 +134,6 @@ def check_input(path: str | Path, error: Callable[[str], BaseException],
     if st.st_size > max_bytes:
         raise error(f"{path}: {st.st_size:,} bytes, more than the {max_bytes:,} a {what} may "
                     "have")
-    return int(st.st_size)
 
 
 def read_input_text(path: str | Path, error: Callable[[str], BaseException],
