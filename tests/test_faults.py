@@ -602,3 +602,17 @@ def test_a_payload_over_the_robots_rating_fails_the_verdict(payload, passes, tmp
     assert check["pass"] is passes
     if not passes:
         assert ev.summary["verdict"] == "fail"
+
+
+def test_check_is_bounded_like_run(tmp_path, capsys):
+    """Issue 31: `cellsim check` sampled any duration (a joint move of 2.5e6 s: 2.5e9 samples)
+    where `cellsim run` refuses it; now the same one line and exit 2 as run."""
+    from sim.core.resources import shipped_scenarios
+
+    text = Path(shipped_scenarios()["lrmate200ic_weld_plate"]).read_text()
+    assert text.count("durations_s = [2.5]") == 1
+    path = tmp_path / "s.toml"
+    path.write_text(text.replace("durations_s = [2.5]", "durations_s = [2.5e6]"))
+    rc = main(["check", str(path)])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and "2,000,000" in err, err

@@ -33,7 +33,7 @@ from sim.simulation.collisions import (
     samples_from_motion,
 )
 from sim.simulation.compile import build
-from sim.simulation.motion import Motion, build_motion, limit_violations
+from sim.simulation.motion import Motion, build_motion, check_size, limit_violations
 
 #: Sampling period of the reference motion, s (``cellsim run`` checks every recorded sample).
 CHECK_DT_S = 0.001
@@ -77,6 +77,8 @@ def check_scenario(scenario: Scenario, *, dt: float = CHECK_DT_S) -> CheckResult
         res.findings.append(Finding("reach", str(exc)))
         return res
     res.timings["plan_s"] = time.perf_counter() - t0
+    # bounded as `cellsim run` is (its step count and shortest phase), before sampling it
+    check_size(scenario, motion, float(built.model.opt.timestep))
     res.findings += [Finding("limit", line) for line in limit_violations(scenario, motion)]
     t0 = time.perf_counter()
     res.findings += _singular_passes(built, motion, dt=0.01)
