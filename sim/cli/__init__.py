@@ -15,10 +15,12 @@ import argparse
 import importlib
 import sys
 import traceback
+import warnings
 from collections.abc import Sequence
+from typing import Any
 
 from sim import __version__
-from sim.errors import CellsimError, InternalError
+from sim.errors import CellsimError, CellsimWarning, InternalError
 
 #: Sub-command modules, in the order ``--help`` lists them.
 COMMANDS = ("list", "plan", "ik", "workspace", "check", "run", "size", "render", "export")
@@ -39,6 +41,25 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_warning
+        return _dispatch(args)
+
+
+def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                  file: Any = None, line: str | None = None) -> None:
+    """cellsim's own warnings as one line, ``cellsim: warning: ...``; others as Python
+    prints them."""
+    if issubclass(category, CellsimWarning):
+        print(f"cellsim: warning: {message}", file=sys.stderr if file is None else file)
+    else:
+        _python_showwarning(message, category, filename, lineno, file, line)
+
+
+_python_showwarning = warnings.showwarning
+
+
+def _dispatch(args: argparse.Namespace) -> int:
     try:
         return int(args.func(args) or 0)
     except InternalError as exc:
