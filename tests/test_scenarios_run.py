@@ -87,6 +87,57 @@ def test_pick_place_parts_in_slots(scenario_run):
         assert np.all(off < 0.005), f"part {i} slid {off.max() * 1e3:.2f} mm in the cup"
 
 
+def _slots_from_cell_file() -> np.ndarray:
+    """The pick cell's slots, m, read here from the cell file's own numbers (world frame)."""
+    import tomllib
+
+    from sim.core.resources import models_dir
+
+    doc = tomllib.loads((models_dir() / "cells" / "pick.toml").read_text())
+    assert all("object" not in s for s in doc["slots"])  # world coordinates
+    return np.array([s["pos_mm"] for s in doc["slots"]]) * 1e-3
+
+
+def _placement_checks(summary: dict) -> list[dict]:
+    return [c for c in summary["checks"] if c["name"] == "part_placed"]
+
+
+def test_the_verdict_checks_every_part_in_its_slot(scenario_run):
+    """The shipped cycle: one passed ``part_placed`` check per slot, its distance the one
+    between the recorded final part centre and the cell file's slot."""
+    out, summary = scenario_run("lrmate200ic_pick_place")
+    final = np.load(out / "trajectory.npz")["part_pos"][-1]
+    want = np.linalg.norm(final - _slots_from_cell_file(), axis=1) * 1e3
+    checks = _placement_checks(summary)
+    assert [c["subject"] for c in checks] == [f"part {k} in slot {k}" for k in range(1, 5)]
+    np.testing.assert_allclose([c["value"] for c in checks], want, rtol=1e-9)
+    assert all(c["pass"] and c["severity"] == "error" and c["limit"] == 5.0 for c in checks)
+
+
+def test_a_cycle_that_never_grips_fails_its_verdict(tmp_path, capsys):
+    """Issue 31: the same cycle with every ``suction_on`` removed moved the arm but placed 0/4
+    parts and passed ``--strict``; now each part left on the infeed fails ``part_placed``."""
+    import re
+
+    from sim.cli import main
+    from sim.core.resources import scenarios_dir
+
+    src = (scenarios_dir() / "lrmate200ic_pick_place.toml").read_text()
+    text = re.sub(r'\[\[actions\]\]\naction = "suction_on"\nphase = "grip\d"\n', "", src)
+    assert "suction_on" not in text and text.count("suction_off") == 4
+    (tmp_path / "s.toml").write_text(text)
+    rc = main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "r"), "--no-video",
+               "--no-plots", "--quiet", "--strict"])
+    capsys.readouterr()
+    summary = json.loads((tmp_path / "r" / "summary.json").read_text())
+    final = np.load(tmp_path / "r" / "trajectory.npz")["part_pos"][-1]
+    want = np.linalg.norm(final - _slots_from_cell_file(), axis=1) * 1e3
+    checks = _placement_checks(summary)
+    assert rc == 1 and summary["verdict"] == "fail"
+    assert [c["pass"] for c in checks] == [False] * 4 and min(want) > 100.0
+    np.testing.assert_allclose([c["value"] for c in checks], want, rtol=1e-9)
+
+
 def test_weld_cycle_phase1_ends_at_seam_start(scenario_run):
     """The end of seed 001's phase I puts the torch on the seam start (the cell is built so)."""
     out, summary = scenario_run("bugnar_5r_weld_cycle")

@@ -30,6 +30,9 @@ is per joint:
 * ``payload``: the mass at the flange, the tool's and the scenario's payload, kg, against the
   robot's rated payload (``[mass] payload_kg``; not checked for a robot that gives none): a
   robot carrying three times its rating is no result to size from.
+* ``part_placed``: in a cell with slots, per slot, how far the centre of its part (part k goes
+  to slot k) ends from it, mm, against 5 mm (``summary["place_tolerance_mm"]``): a pick cycle
+  that drops a part or never lifts it fails.
 
 ``summary.json`` holds ``"checks"`` (each ``name``, ``joint`` ("" when the check is not a
 joint's), ``subject``, ``value``, ``limit``, ``unit``, ``pass``, ``severity``) and
@@ -122,6 +125,7 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                                dev <= 1.0, subject=f"{c['phase']}: {c['cruise_mm_s']:.4g} mm/s "
                                f"for {c['set_mm_s']:.4g} mm/s"))
     checks += torch_angle_checks(summary, torch_angle_tolerance_deg)
+    checks += placement_checks(summary)
     for w in summary.get("weave", ()):
         # a weave the arm does not reproduce (too fast for the joints' polynomial or the
         # servos): warnings, the weld still ran
@@ -168,6 +172,17 @@ def motion_checks(summary: Mapping[str, Any], clearance_mm: float) -> list[RunCh
         checks.append(RunCheck("clearance", "", float(value), float(clearance_mm), "mm",
                                bool(value >= clearance_mm), severity="warning",
                                subject=str(c["phase"])))
+    return checks
+
+
+def placement_checks(summary: Mapping[str, Any]) -> list[RunCheck]:
+    """The ``part_placed`` checks (errors): one per slot of the summary's ``"place_error_mm"``
+    (none for a cell without slots)."""
+    tol = float(summary.get("place_tolerance_mm", 5.0))
+    checks = []
+    for k, err in enumerate(summary.get("place_error_mm", ())):
+        checks.append(RunCheck("part_placed", "", float(err), tol, "mm", float(err) <= tol,
+                               subject=f"part {k + 1} in slot {k + 1}"))
     return checks
 
 

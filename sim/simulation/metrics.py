@@ -513,15 +513,23 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
     return out
 
 
-def pick_metrics(arrays: dict[str, NDArray[Any]], built: BuiltCell, tol_mm: float = 5.0
-                 ) -> dict[str, Any] | None:
-    """For pick cells: final part positions against their slots."""
-    slots = np.asarray(built.cell.slots, dtype=float)
+#: A part is placed when its centre ends within this distance of its slot, mm.
+PLACE_TOLERANCE_MM = 5.0
+
+
+def pick_metrics(arrays: dict[str, NDArray[Any]], built: BuiltCell,
+                 tol_mm: float = PLACE_TOLERANCE_MM) -> dict[str, Any] | None:
+    """For cells with parts and slots: where each part ends, from the recorded part positions,
+    against its slot (part k goes to slot k; slots beyond the parts, or parts beyond the
+    slots, are not counted)."""
+    slots = np.asarray(built.cell.slots, dtype=float).reshape(-1, 3)
     if "part_pos" not in arrays or slots.size == 0:
         return None
-    final = arrays["part_pos"][-1]
-    err = np.linalg.norm(final[: slots.shape[0]] - slots, axis=1) * 1e3
-    return {"placed": [bool(e <= tol_mm) for e in err], "place_error_mm": [float(e) for e in err]}
+    final = np.asarray(arrays["part_pos"], dtype=float)[-1].reshape(-1, 3)
+    n = min(len(final), len(slots))
+    err = [float(e) for e in np.linalg.norm(final[:n] - slots[:n], axis=1) * 1e3]
+    return {"placed": [e <= tol_mm for e in err], "place_error_mm": err,
+            "place_tolerance_mm": float(tol_mm)}
 
 
 def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: SimulationRecord,
