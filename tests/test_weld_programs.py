@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from sim.pipeline.run import evaluate_scenario
 from sim.scenario import load_scenario
@@ -451,13 +453,14 @@ def test_a_tp_program_runs_its_moves_speeds_blends_and_arc(tp_run):
 
 def test_a_cartesian_tp_position_takes_the_branch_its_config_names(tmp_path):
     """P[1] with CONFIG 'N U T' ends with FANUC J5 >= 0 (no flip); the same point with 'F U T'
-    ends flipped (J5 < 0), same tcp pose."""
+    ends flipped (J5 < 0), same tcp pose (the program's other positions flipped alike)."""
     from sim.robots.maker import to_maker
 
     ends = {}
     for flip in ("N", "F"):
-        text = (DATA / "weld1.ls").read_text().replace("CONFIG : 'N U T, 0, 0, 0',\n\tX =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000",
-                                                     f"CONFIG : '{flip} U T, 0, 0, 0',\n\tX =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000")
+        # every Cartesian position flipped alike: an L move keeps the J move's flip
+        text = (DATA / "weld1.ls").read_text().replace("CONFIG : 'N U T,",
+                                                     f"CONFIG : '{flip} U T,")
         (tmp_path / f"{flip}.ls").write_text(text)
         (tmp_path / f"{flip}.toml").write_text(TP_SCENARIO.replace("weld1.ls", f"{flip}.ls"))
         sc = load_scenario(tmp_path / f"{flip}.toml")
@@ -818,3 +821,61 @@ def test_a_5r_cycle_exports_and_runs_back(tmp_path):
             x = T[:3, :3] @ (np.array(pos.xyzwpr[:3]) * 1e-3) + T[:3, 3]
             assert np.linalg.norm(p - x, axis=1).min() < 0.1e-3
     assert ev.summary["verdict"] == "pass"
+
+
+def _plan_program(tmp_path: Path, text: str):
+    """The reference motion of ``text`` run as TP_SCENARIO's program (planning only)."""
+    from sim.simulation.compile import build
+    from sim.simulation.motion import build_motion
+
+    (tmp_path / "weld1.ls").write_text(text)
+    (tmp_path / "s.toml").write_text(TP_SCENARIO)
+    sc = load_scenario(tmp_path / "s.toml")
+    built = build(sc)
+    return sc, build_motion(sc, built.context)
+
+
+def _with_config(text: str, index: int, config: str) -> str:
+    head = f"P[{index}]{{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : '"
+    start = text.index(head) + len(head)
+    return text[:start] + config + text[text.index("'", start):]
+
+
+def test_the_program_s_cartesian_moves_end_in_the_configs_they_name(tmp_path):
+    """The oracle of the next test: weld1.ls as written plans, and each L/C move ends with the
+    controller's J5 > 0 (no flip), the maker's joint values computed here from the planned
+    joint values."""
+    from sim.robots.maker import to_maker
+
+    sc, motion = _plan_program(tmp_path, (DATA / "weld1.ls").read_text())
+    ends = {pm.phase.name: np.rad2deg(to_maker(sc.robot, motion.at(pm.t1).q[0]))
+            for pm in motion.phases if pm.phase.name in ("line010_L", "line012_L", "line013_C")}
+    assert len(ends) == 3
+    for maker in ends.values():
+        assert maker[4] > 1.0
+
+
+@settings(max_examples=6, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(which=st.sampled_from([(2, 10, "L"), (3, 12, "L"), (5, 13, "C")]),
+       config=st.tuples(st.sampled_from("NF"), st.sampled_from("UD"), st.sampled_from("TB"),
+                        st.integers(-1, 1), st.integers(-1, 1), st.integers(-1, 1))
+       .filter(lambda c: c[:3] != ("N", "U", "T")))
+def test_a_linear_or_circular_move_honours_its_config(tmp_path, which, config):
+    """Issue 31: an L move's CONFIG was ignored. A position of an L or C move whose flip,
+    elbow or front/back is not the one the path reaches it in (the previous test's oracle)
+    is refused, naming the move's line and both configurations; its turn numbers, where the
+    path's wrist rotation leads, are not binding (weld1.ls's P[3] says turn 0 where J6 has
+    passed -180 deg, and plans)."""
+    from sim.errors import ReachError
+
+    index, line, kind = which
+    text = _with_config((DATA / "weld1.ls").read_text(), index,
+                        f"{config[0]} {config[1]} {config[2]}, {config[3]}, {config[4]}, "
+                        f"{config[5]}")
+    move = "linear" if kind == "L" else "circular"
+    turns = f"{config[3]}, {config[4]}, {config[5]}"
+    with pytest.raises(ReachError, match=rf"line0?{line}_{kind}\): the {move} move ends in "
+                       rf"CONFIG 'N U T, {turns}' but its position says "
+                       rf"'{config[0]} {config[1]} {config[2]}, {turns}'"):
+        _plan_program(tmp_path, text)

@@ -150,6 +150,9 @@ class CartesianPhase:
             turn a flange via point into the tcp's), rad.
         target: A linear move's end given by a seam (``to_seam``, with ``approach_mm`` or
             ``retract_mm``): a :class:`PoseTarget` with ``seam``; ``to`` is then None.
+        config: A TP program's move: the FANUC configuration its position names (flip,
+            up, front, turn numbers; :func:`sim.scenario.program.config_of`), which the move's
+            end must have: a linear or circular move cannot change it.
         standoff: The pass's own stand-off along ``seam``, m (its ``ctwd_mm`` less the torch's
             nominal stick-out, :mod:`sim.cells.seam`); None: the seam's
             (:meth:`seam_as_welded`).
@@ -179,6 +182,7 @@ class CartesianPhase:
     via_euler_zyx: NDArray[np.float64] | None = None
     target: "PoseTarget | None" = None
     standoff: float | None = None
+    config: tuple | None = None
 
     def seam_as_welded(self, seam: Seam) -> Seam:
         """The seam this phase welds: ``seam`` (the cell's seam named ``self.seam``) with the

@@ -286,7 +286,7 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                           planner="434", speed=speed, sample_period=0.1, ramp=None,
                           orientation="euler", to=p, frame=frame_name(mo.line),
                           euler_zyx=_zyx(R), blend_fraction=fraction, move_time=move_time,
-                          flange=ut == 0, weave=weave)
+                          flange=ut == 0, weave=weave, config=target.config)
             if mo.kind == "C":
                 via = position(mo.via, mo.line)
                 pv, Rv = cart(via, mo.line)

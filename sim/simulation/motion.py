@@ -312,9 +312,11 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
                 raise ScenarioError(f"{label}.blend_mm: the next phase is not a linear or "
                                     "circular move to blend into (leave blend_mm out)")
             labels = [f"{where}: phases[{ph.index}] ({ph.name})" for ph in group]
-            for pm in _plan_blended(group, t, q, context, labels):
+            for pm, lb in zip(_plan_blended(group, t, q, context, labels), labels,
+                              strict=True):
                 if phases:
                     _check_phase_continuity(phases[-1], pm, label, scenario.robot.joints)
+                _check_end_config(pm, context, lb)
                 phases.append(pm)
             t = phases[-1].t1
             q = phases[-1].trajectory.at(phases[-1].t1).q
@@ -355,6 +357,7 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
             if context is None:
                 raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
             pm = _plan_cartesian(phase, t, q, context, label)
+            _check_end_config(pm, context, label)
         else:  # pragma: no cover - the loader only makes the kinds above
             raise ScenarioError(f"{label}: unknown phase kind {phase.kind!r}")
         if phases:
@@ -612,6 +615,53 @@ def _seam_pose(tgt: Any, ctx: CartesianContext, label: str) -> NDArray[np.float6
     T[:3, 3] = ctx.to_frame0(seam.tcp_point(s) - tgt.offset * seam.torch_axis(s))
     T[:3, :3] = ctx.rot_to_frame0(seam.torch_rotation(s))
     return T
+
+
+#: A joint this close to a boundary of the FANUC configuration (J5 at 0 deg for the flip) matches
+#: the labels of both sides, deg.
+CONFIG_TOLERANCE_DEG = 0.5
+
+
+def _check_end_config(pm: PhaseMotion, ctx: CartesianContext, label: str) -> None:
+    """A TP program's linear or circular move keeps the arm's configuration along its path
+    (branch-continuous IK), so the configuration it ends in is where its start leads, not a
+    choice: where its flip, elbow (up/down) or front/back is not the one its position names,
+    the program says one thing and the arm would do another, and the move is refused, naming
+    both (never the CONFIG ignored). Its turn numbers are where the path's wrist rotation
+    leads, as a controller's linear move takes the wrist the short way (J6 passing 180 deg
+    along a seam ends at turn -1 or 1): they bind joint moves only.
+
+    Raises:
+        ReachError: The configurations differ.
+    """
+    phase = pm.phase
+    if not isinstance(phase, CartesianPhase) or phase.config is None:
+        return
+    from sim.robots.ik import solve_ik
+    from sim.scenario.program import config_of
+
+    q_end = np.asarray(pm.trajectory.at(pm.t1).q, dtype=float)
+    sols = solve_ik(ctx.kinematics, np.asarray(ctx.kinematics.fk(q_end), dtype=float),
+                    current=q_end)
+    same = [s for s in sols if np.max(np.abs(np.asarray(s.q) - q_end)) < 1e-4]
+    if not same:  # the solver did not list this posture: its branch is unknown
+        return
+    have = config_of(ctx.robot, q_end, same[0].branch)
+    # J5 on the flip's boundary (0 deg) has either label: the flips a nudge of
+    # CONFIG_TOLERANCE_DEG gives are all accepted
+    nudge = np.radians(CONFIG_TOLERANCE_DEG)
+    near = {config_of(ctx.robot, q_end + d, same[0].branch)[:3]
+            for d in np.vstack([np.zeros(len(q_end)), np.diag(np.full(len(q_end), nudge)),
+                                np.diag(np.full(len(q_end), -nudge))])}
+    want = tuple(phase.config)
+    if want[:3] not in near:
+        move = "linear" if phase.kind == "linear" else "circular"
+        shown = have[:3] + want[3:]  # the turn numbers are not compared
+        raise ReachError(
+            f"{label}: the {move} move ends in CONFIG '{_config_text(shown)}' but its position "
+            f"says '{_config_text(want)}': a {move} move keeps the arm's configuration "
+            "along its path; teach the position in the configuration the path reaches it in, "
+            "or reach it with a J move")
 
 
 def _config_text(c: tuple) -> str:
