@@ -386,3 +386,30 @@ to_mm = [600.0, 0.0, 0.0]
     bad = text.replace("joints_deg = [[1,1,1,1,1]]", "joints_deg = [[1,1,1,1,1],[2,2,2,2,2]]")
     msg = _err(bad)
     assert "phases[1].joints_deg" in msg and "pose target" in msg
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(times=st.lists(st.one_of(st.floats(-1e308, 1e308), st.sampled_from([1e300, -1e300,
+                                                                            1e6, 1e-300])),
+                      min_size=3, max_size=3).map(sorted))
+def test_knot_times_at_any_scale_plan_or_are_one_line_without_numpy_warnings(times):
+    """Issue 31: a knot time of 1e300 s printed numpy's overflow warnings before its error.
+    Whatever the times, the scenario plans or is refused in one line naming the key (the
+    bounds, checked here on the file's numbers: segments of MIN_SEGMENT_S to MAX_TIME_S,
+    knot times within MAX_TIME_S of 0), and numpy warns of nothing (warnings are errors)."""
+    import warnings
+
+    from sim.scenario.loader import MAX_TIME_S, MIN_SEGMENT_S
+    from sim.simulation.motion import build_motion
+
+    text = GOOD.replace("time_s = [0.0, 1.0, 2.0]", f"time_s = {times!r}")
+    steps = np.diff(times)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        if np.any(steps <= 0):
+            assert "must increase" in _err(text)
+        elif not (np.all(steps >= MIN_SEGMENT_S) and np.all(steps <= MAX_TIME_S)
+                  and np.all(np.abs(times) <= MAX_TIME_S)):
+            assert "phases[0].time_s[" in _err(text)
+        else:
+            build_motion(parse_scenario(text, source="x.toml"), None)

@@ -124,7 +124,8 @@ def parse_float_list(text: str, field: str = "value") -> list[float]:
 
 
 def validate_payloads(payloads: Sequence[float], field: str = "payload") -> list[float]:
-    """Payloads in kg: finite, >= 0, at least one; duplicates dropped.
+    """Payloads in kg: 0 to :data:`~sim.scenario.schema.MAX_PAYLOAD_KG`, at least one;
+    duplicates dropped.
 
     Raises:
         SweepError: One line naming ``field`` and the bad value.
@@ -132,9 +133,12 @@ def validate_payloads(payloads: Sequence[float], field: str = "payload") -> list
     values = [float(p) for p in payloads]
     if not values:
         raise SweepError(f"{field}: no payload given (expected kg values like 0,2.5,5)")
+    from sim.scenario.schema import MAX_PAYLOAD_KG
+
     for p in values:
-        if not math.isfinite(p) or p < 0:
-            raise SweepError(f"{field}: payload must be a finite mass >= 0 kg, got {p:g}")
+        if not math.isfinite(p) or p < 0 or p > MAX_PAYLOAD_KG:
+            raise SweepError(f"{field}: payload must be a mass of 0 to {MAX_PAYLOAD_KG:g} kg, "
+                             f"got {p:g}")
     return list(dict.fromkeys(values))
 
 

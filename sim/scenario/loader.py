@@ -233,6 +233,27 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
     )
 
 
+#: Knot times and segment durations a joint phase may have, s: a segment from a microsecond
+#: to 10^6 s (11.6 days; a run is bounded far below by its step count), knot times within
+#: 10^6 s of 0. Outside them the knot system's powers of the durations overflow or vanish.
+MIN_SEGMENT_S, MAX_TIME_S = 1e-6, 1e6
+
+
+def _check_times(times: np.ndarray, durations: np.ndarray, key: str) -> None:
+    """Refuses knot times or segment durations outside :data:`MIN_SEGMENT_S` ..
+    :data:`MAX_TIME_S`, naming the key and the index."""
+    for values, what, low in ((np.abs(times), "knot time", -np.inf),
+                              (durations, "segment", MIN_SEGMENT_S)):
+        bad = np.flatnonzero((values > MAX_TIME_S) | (values < low))
+        if bad.size:
+            k = int(bad[0])
+            raise ScenarioError(
+                f"{key}[{k + (1 if what == 'segment' and key.endswith('time_s') else 0)}]: "
+                f"{what} of {values[k]:g} s; cellsim takes {what}s "
+                + (f"of {MIN_SEGMENT_S:g} to {MAX_TIME_S:g} s" if what == "segment"
+                   else f"within {MAX_TIME_S:g} s of 0"))
+
+
 def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where: str) -> JointPhase:
     if (spec.time_s is None) == (spec.durations_s is None):
         raise ScenarioError(f"{where}: give exactly one of time_s or durations_s")
@@ -250,6 +271,7 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
                 f"{times[k - 1]:g} s)")
         durations = steps
         n_rows = times.size
+        _check_times(times, durations, f"{where}.time_s")
     else:
         durations = np.asarray(spec.durations_s, dtype=float)
         times = None
@@ -260,6 +282,7 @@ def _build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where
             raise ScenarioError(f"{where}.durations_s[{k}]: segment durations must be positive, "
                                 f"got {durations[k]:g} s")
         n_rows = durations.size  # the start knot is the previous phase's end
+        _check_times(np.zeros(1), durations, f"{where}.durations_s")
 
     target = _pose_target(spec, where)
     if target is not None:

@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 
 from sim.errors import ScenarioError, UsageError
 from sim.robots.registry import Drive, RobotSpec
-from sim.scenario.schema import SimulationSpec, SizingSpec, VideoSpec
+from sim.scenario.schema import MAX_PAYLOAD_KG, SimulationSpec, SizingSpec, VideoSpec
 
 if TYPE_CHECKING:
     from sim.cells import CellSpec
@@ -286,14 +286,17 @@ class Scenario:
         damping, joint torques then scale exactly as ``speed_scale**2``.
 
         Raises:
-            ScenarioError: ``speed_scale`` not positive, or negative ``payload_kg``.
+            ScenarioError: ``speed_scale`` not positive, or ``payload_kg`` outside 0 ..
+                :data:`~sim.scenario.schema.MAX_PAYLOAD_KG`.
         """
         import dataclasses
 
         if not (np.isfinite(speed_scale) and speed_scale > 0):
             raise ScenarioError(f"speed scale must be a positive number, got {speed_scale!r}")
-        if payload_kg is not None and not (np.isfinite(payload_kg) and payload_kg >= 0):
-            raise ScenarioError(f"payload_kg must be >= 0, got {payload_kg!r}")
+        if payload_kg is not None and not (np.isfinite(payload_kg)
+                                           and 0 <= payload_kg <= MAX_PAYLOAD_KG):
+            raise ScenarioError(f"payload_kg must be 0 to {MAX_PAYLOAD_KG:g} kg, got "
+                                f"{payload_kg!r}")
         s = float(speed_scale)
         order = {"v": 1, "a": 2, "j": 3}
         phases: list[Phase] = []

@@ -30,6 +30,11 @@ for _end, _kw in (("start", "0"), ("end", "f")):
         _BOUNDARY_KEYS[f"{_end}_{_qty}_rad{_unit}"] = (f"{_sym}{_kw}", 1.0)
 
 
+#: The largest payload a scenario or sweep takes, kg (the heaviest industrial robots carry
+#: 2.3 t; 10^308 kg made the simulation blow up at its first step).
+MAX_PAYLOAD_KG = 10_000.0
+
+
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
 
@@ -236,7 +241,9 @@ class ScenarioSpec(_Strict):
     cell: str | None = None
     tool: str | None = None
     mount: Literal["floor", "ceiling"] = "floor"
-    payload_kg: float = Field(0.0, ge=0)
+    payload_kg: float = Field(0.0, ge=0, le=MAX_PAYLOAD_KG, description="mass at the tool point, "
+                              "kg (at most MAX_PAYLOAD_KG: the heaviest industrial robots "
+                              "carry 2.3 t)")
     simulation: SimulationSpec = SimulationSpec()
     video: VideoSpec = VideoSpec()
     drives: dict[str, DriveOverrideSpec] = {}

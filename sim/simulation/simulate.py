@@ -317,6 +317,8 @@ def qvel_slice_of(model: Any) -> slice:
 MOTOR_TOL = 1e-9
 #: Iterations of the per-step solve for the held joint torques (each one a step).
 MOTOR_ITERATIONS = 12
+#: Largest motor torque error left after them that is accepted, in peak torques.
+MOTOR_SETTLE_TOL = 1e-4
 
 
 class _MotorLimit:
@@ -441,11 +443,17 @@ class _MotorLimit:
                     rng[self.act[j]] = (f, f)
                 fixed |= new
             else:
-                raise SimulationError(
-                    f"the drives' motor torque limit did not settle in {MOTOR_ITERATIONS} "
-                    f"passes at t = {s[0]:.4f} s (joints "
-                    f"{', '.join(str(j + 1) for j in np.nonzero(new | off)[0])}); try a "
-                    "smaller simulation.timestep_s")
+                # a motor past its top speed (an arm falling under a load its drives cannot
+                # hold) has 0 N m to give: the secant approaches it slowly; a residual within
+                # MOTOR_SETTLE_TOL is far inside what sizing resolves, and the step is kept
+                left = np.abs(tm - target) / peak
+                if new.any() or np.any(left[off] > MOTOR_SETTLE_TOL):
+                    raise SimulationError(
+                        f"the drives' motor torque limit did not settle in {MOTOR_ITERATIONS} "
+                        f"passes at t = {s[0]:.4f} s (joints "
+                        f"{', '.join(str(j + 1) for j in np.nonzero(new | off)[0])}, "
+                        f"{np.max(left[new | off]):.2g} of the peak torque off); try a "
+                        "smaller simulation.timestep_s")
             held[i, fixed] = np.abs(force[fixed])
             st_out[i], sd_out[i] = st[-1], sd[-1]
             s, ws = st[-1], scratch.qacc_warmstart.copy()
