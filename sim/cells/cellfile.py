@@ -59,6 +59,7 @@ from sim.cells.tools import (
     ToolSpec,
 )
 from sim.core.rotations import euler_zyx_to_matrix
+from sim.core.text import PlainText
 from sim.core.tomlschema import Strict, load_toml
 from sim.errors import CellError, CellsimError
 
@@ -141,7 +142,7 @@ class SeamBlock(Strict):
     stickout_mm: float | None = Field(None, gt=0, le=100)
     ctwd_mm: float | None = Field(None, gt=0, le=100)
     joins: list[str] = []
-    description: str = ""
+    description: PlainText = ""
 
 
 class SlotBlock(Strict):
@@ -166,7 +167,7 @@ class CellFileSpec(Strict):
     """Top level of a cell file."""
 
     name: str = Field(pattern=_NAME)
-    description: str = ""
+    description: PlainText = ""
     tool: str | None = None
     tools: list[str] | None = None
     robot: RobotBlock = RobotBlock()

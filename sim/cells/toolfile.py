@@ -39,6 +39,7 @@ from pydantic import Field
 
 from sim.cells.tools import TIP_SITE, ToolSpec
 from sim.core.rotations import euler_zyx_to_matrix
+from sim.core.text import PlainText
 from sim.core.tomlschema import Strict, load_toml
 from sim.errors import CellError
 
@@ -65,7 +66,7 @@ class ToolFileSpec(Strict):
     """Top level of a tool file."""
 
     name: str = Field(pattern=_NAME)
-    description: str = ""
+    description: PlainText = ""
     kind: Literal["torch", "gripper"] = "torch"
     mass_kg: float = Field(gt=0, le=100)
     com_mm: list[Mm] | None = Field(None, min_length=3, max_length=3)

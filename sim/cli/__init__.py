@@ -20,6 +20,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from sim import __version__
+from sim.core.text import printable
 from sim.errors import CellsimError, CellsimWarning, InternalError
 
 #: Sub-command modules, in the order ``--help`` lists them.
@@ -51,7 +52,7 @@ def _show_warning(message: Warning | str, category: type[Warning], filename: str
     """cellsim's own warnings as one line, ``cellsim: warning: ...``; others as Python
     prints them."""
     if issubclass(category, CellsimWarning):
-        print(f"cellsim: warning: {message}", file=sys.stderr if file is None else file)
+        print(printable(f"cellsim: warning: {message}"), file=sys.stderr if file is None else file)
     else:
         _python_showwarning(message, category, filename, lineno, file, line)
 
@@ -65,7 +66,7 @@ def _dispatch(args: argparse.Namespace) -> int:
     except InternalError as exc:
         return _internal_fault(exc)
     except CellsimError as exc:
-        print(f"cellsim: error: {exc}{_holding_hint(exc)}", file=sys.stderr)
+        print(printable(f"cellsim: error: {exc}{_holding_hint(exc)}"), file=sys.stderr)
         return 2
     except MemoryError:
         print("cellsim: error: out of memory (a size the input asks for is too large)",
@@ -83,7 +84,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         message = io_error(exc)
         if message is None:
             return _internal_fault(exc)
-        print(f"cellsim: error: {message}", file=sys.stderr)
+        print(printable(f"cellsim: error: {message}"), file=sys.stderr)
         return 2
     except Exception as exc:  # noqa: BLE001  (the last line of defence: never exit 1)
         return _internal_fault(exc)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 
 from sim.core.resources import shipped_scenarios
+from sim.core.text import printable
 from sim.errors import CellsimError
 from sim.robots.registry import ROBOTS
 
@@ -65,30 +66,36 @@ def _cell_lines(spec, strict: bool = False) -> list[str]:
     return lines
 
 
+def _print(line: str) -> None:
+    """A line of the listing, control characters shown as escapes (a path or a name from a
+    user's folder is printed as it is, never as a terminal command)."""
+    print(printable(line))
+
+
 def run(args: argparse.Namespace) -> int:
     if getattr(args, "cell", None) is not None:
         from sim.cells import load_cell
 
         spec = load_cell(args.cell)  # a bad file: one line, exit 2
-        print(f"{spec.name}: {spec.description} ({spec.source})")
+        _print(f"{spec.name}: {spec.description} ({spec.source})")
         for line in _cell_lines(spec, strict=True):
-            print(f"    {line}")
+            _print(f"    {line}")
         return 0
-    print("robots:")
+    _print("robots:")
     for spec in ROBOTS.values():
-        print(f"  {spec.name:32s} {spec.n_joints} axes  {spec.description}")
+        _print(f"  {spec.name:32s} {spec.n_joints} axes  {spec.description}")
     from sim.cells import CELLS
     from sim.cells.tools import TOOLS
 
-    print("cells:")
+    _print("cells:")
     for name, item in sorted(CELLS.items()):
-        print(f"  {name:32s} {item.description}")
+        _print(f"  {name:32s} {item.description}")
         for line in _cell_lines(item):
-            print(f"      {line}")
-    print("tools:")
+            _print(f"      {line}")
+    _print("tools:")
     for name, item in sorted(TOOLS.items()):
-        print(f"  {name:32s} {item.description}")
-    print("scenarios:")
+        _print(f"  {name:32s} {item.description}")
+    _print("scenarios:")
     for name, path in shipped_scenarios().items():
-        print(_scenario_line(name, path))
+        _print(_scenario_line(name, path))
     return 0

@@ -120,7 +120,7 @@ def describe(exc: ValidationError, root: type[BaseModel], *,
     msg = str(err["msg"]).replace("Input should be", "must be").replace(
         "List should have", "must have").replace("String should match pattern",
                                                  "must match the pattern")
-    return f"{path}: {msg}"
+    return f"{path}: {msg.removeprefix('Value error, ')}"
 
 
 def load_toml(path: Path, root: type[M], error: type[Exception]) -> tuple[M, dict[str, Any]]:

@@ -15,6 +15,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag
 
 from planners.registry import PLANNERS
+from sim.core.text import PlainText
 
 #: Names (scenario, phases) are plain folder names: letters, digits, ``_ . -``, not starting
 #: with a dot (``.`` and ``..`` would make the default run folder the working directory or
@@ -85,7 +86,8 @@ class JointPhaseSpec(_Strict):
                        '"world" or a cell object')
     blend_deg: float | None = Field(None, ge=0, description="pass the last knot without "
                                     "stopping into the next joint phase, deg")
-    note: str | None = Field(None, description="free text (e.g. which seed value was chosen)")
+    note: PlainText | None = Field(None, description="free text (e.g. which seed value was "
+                                   "chosen)")
 
 
 class WeaveSpec(_Strict):
@@ -115,7 +117,7 @@ class _CartesianSpec(_Strict):
     ctwd_mm: float | None = Field(None, gt=0, le=100, description="with seam: the "
                                   "contact-tip-to-work distance of this pass, mm (default: "
                                   "the seam's)")
-    note: str | None = None
+    note: PlainText | None = None
 
 
 class LinearPhaseSpec(_CartesianSpec):
@@ -146,7 +148,7 @@ class HoldPhaseSpec(_Strict):
     name: str = Field(pattern=_NAME_PATTERN)
     kind: Literal["hold"]
     duration_s: float = Field(gt=0)
-    note: str | None = None
+    note: PlainText | None = None
 
 
 def _phase_kind(value: Any) -> str | None:
@@ -235,9 +237,9 @@ class ScenarioSpec(_Strict):
     """Top level of a scenario file."""
 
     name: str = Field(pattern=_NAME_PATTERN, description="scenario name")
-    description: str = Field(description="one paragraph shown by `cellsim list`")
+    description: PlainText = Field(description="one paragraph shown by `cellsim list`")
     robot: str = Field(description="robot name (`cellsim list` shows them)")
-    note: str | None = Field(None, description="free text: sources, choices made")
+    note: PlainText | None = Field(None, description="free text: sources, choices made")
     cell: str | None = None
     tool: str | None = None
     mount: Literal["floor", "ceiling"] = "floor"
