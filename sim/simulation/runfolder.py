@@ -24,15 +24,17 @@ A run that fails mid-simulation keeps what it recorded in ``DIR.failed/`` with `
 from __future__ import annotations
 
 import json
+import math
+import os
 import zipfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from sim.core.files import naming
+from sim.core.files import check_input, naming, read_input
 from sim.errors import RunFolderError
 
 # ------------------------------------------------------------------------------------ schema
@@ -120,6 +122,21 @@ REQUIRED_FOR_PLOTS: tuple[str, ...] = (
 JOINT_ARRAYS: tuple[str, ...] = (
     "q_ref", "qd_ref", "qdd_ref", "qddd_ref", "q", "qd", "tau", "tau_id",
 )  # fmt: skip
+
+# ------------------------------------------------------------------------- reading bounds
+#: Largest ``model.xml`` read from a run folder, bytes (a compiled cell carries its meshes
+#: inline: the shipped cells' are well under a megabyte).
+MAX_MODEL_BYTES = 256 * 1024 * 1024
+#: Largest ``summary.json`` read from a run folder, bytes.
+MAX_SUMMARY_BYTES = 64 * 1024 * 1024
+#: Most bytes ``trajectory.npz`` may take, on disk and unpacked (all arrays together): twice
+#: what the longest run records (``MAX_STEPS`` of :mod:`sim.simulation.motion`, about 1 KB a
+#: step). Every array's size is checked against it before a byte of it is unpacked.
+MAX_TRAJECTORY_BYTES = 4 * 1024**3
+#: Most arrays ``trajectory.npz`` may hold.
+MAX_TRAJECTORY_ARRAYS = 256
+#: Largest file a run folder's ``model.xml`` may name (a mesh, texture, height field, skin).
+MAX_ASSET_BYTES = 1024**3
 
 
 @dataclass
@@ -234,8 +251,7 @@ class RunRecord:
                 return mujoco.MjModel.from_xml_string(self.model_xml)
             if self.model_path is None:
                 raise RunFolderError(f"{self.where}: no model (model.xml) to render")
-            confine_model_files(self.model_path, self.where)
-            return mujoco.MjModel.from_xml_path(str(self.model_path))
+            return mujoco.MjModel.from_xml_path(confine_model_files(self.model_path, self.where))
         except ValueError as exc:
             first = str(exc).strip().splitlines()[0] if str(exc).strip() else repr(exc)
             raise RunFolderError(f"{self.where}: model.xml does not load: {first}") from exc
@@ -270,7 +286,7 @@ class RunRecord:
         record = cls(
             arrays={k: np.asarray(v) for k, v in arrays.items()},
             joints=list(joints),
-            phases=[_phase(p, "phases") for p in (phases or [])],
+            phases=[_phase(p, f"phases[{i}]") for i, p in enumerate(phases or [])],
             model_path=Path(model_path) if model_path is not None else None,
             model_xml=model_xml,
             summary=dict(summary or {}),
@@ -279,25 +295,31 @@ class RunRecord:
         return record
 
     def validate(self) -> None:
-        """Checks shapes and times.
+        """Checks dtypes, shapes and times.
 
         Raises:
-            RunFolderError: ``t`` missing, not 1-D, not strictly increasing or not finite, or
-                an array whose first dimension or joint column count does not match.
+            RunFolderError: ``t`` missing, not 1-D numbers, not strictly increasing or not
+                finite; an array that is not numbers (or holds NaN or inf), whose first
+                dimension does not match ``t``, or whose shape is not the one :data:`ARRAYS`
+                gives it (joint columns: one per name of ``joints``).
         """
         self.require(("t",))
+        for name, value in self.arrays.items():
+            if not isinstance(value, np.ndarray) or value.dtype.kind not in "fiub":
+                kind = value.dtype if isinstance(value, np.ndarray) else type(value).__name__
+                raise RunFolderError(f"{self.where}: trajectory.npz {name!r} has dtype "
+                                     f"{kind}, expected numbers")
         t = self.arrays["t"]
-        if t.ndim != 1 or t.size < 2:
-            raise RunFolderError(f"{self.where}: trajectory.npz 't' must be 1-D with >= 2 samples")
-        if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0.0):
+        if t.ndim != 1 or t.size < 2 or t.dtype.kind not in "fiu":
+            raise RunFolderError(f"{self.where}: trajectory.npz 't' must be 1-D numbers with "
+                                 f">= 2 samples (it has shape {t.shape}, dtype {t.dtype})")
+        tf = t.astype(np.float64)  # no wrap-around of integer differences
+        if not np.all(np.isfinite(tf)) or np.any(np.diff(tf) <= 0.0):
             raise RunFolderError(
                 f"{self.where}: trajectory.npz 't' must be finite and strictly increasing"
             )
         n = t.size
         for name, value in self.arrays.items():
-            if value.dtype.kind not in "fiub":
-                raise RunFolderError(f"{self.where}: trajectory.npz {name!r} has dtype "
-                                     f"{value.dtype}, expected numbers")
             if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
                 raise RunFolderError(f"{self.where}: trajectory.npz {name!r} holds NaN or inf")
             if name in ("knot_t",):
@@ -321,63 +343,493 @@ class RunRecord:
                     f"{self.where}: trajectory.npz {name!r} has shape {self.arrays[name].shape}, "
                     "expected (N, 3)"
                 )
+        for name, value in self.arrays.items():
+            spec = ARRAYS.get(name)
+            if spec is None:
+                continue
+            dims = [d.strip() for d in spec.shape.strip("()").split(",") if d.strip()]
+            want = {"N": n, "n": len(self.joints)}
+            if value.ndim != len(dims) or any(
+                    (d.isdigit() and size != int(d)) or (d in want and size != want[d])
+                    for d, size in zip(dims, value.shape)):
+                raise RunFolderError(
+                    f"{self.where}: trajectory.npz {name!r} has shape {value.shape}, expected "
+                    f"{spec.shape} (N = {n} samples, n = {len(self.joints)} joints)"
+                )
 
 
-def confine_model_files(model_path: Path, where: str) -> None:
-    """Refuse a ``model.xml`` that would read files outside its folder: ``<include>``, an
-    absolute or ``..`` file name (meshes, textures, height fields, skins), or an asset
-    directory pointing elsewhere.
+# --------------------------------------------------------------------- model.xml's files
+#: MJCF elements whose file attributes MuJoCo resolves against ``<compiler meshdir>`` (height
+#: fields, skins and flexcomp meshes too, not only meshes) or ``texturedir``, and the
+#: attributes it reads files from.
+_MESHDIR_FILES: dict[str, tuple[str, ...]] = {
+    "mesh": ("file",), "hfield": ("file",), "skin": ("file",), "flexcomp": ("file",),
+}
+_TEXTUREDIR_FILES: dict[str, tuple[str, ...]] = {
+    "texture": ("file", "fileright", "fileleft", "fileup", "filedown", "filefront",
+                "fileback"),
+}
+#: Elements that read other files cellsim does not follow: refused in a run folder's model.
+_REFUSED_ELEMENTS: dict[str, str] = {
+    "include": "includes another file",
+    "model": "attaches another model file (<model file=...>)",
+    "plugin": "uses a MuJoCo plugin, which may read files cellsim cannot check",
+    "extension": "uses a MuJoCo plugin (<extension>), which may read files cellsim cannot check",
+}
+#: Most elements of a run folder's ``model.xml`` (the shipped cells have a few thousand).
+MAX_MODEL_ELEMENTS = 1_000_000
+
+
+def _mj_abs_prefix(path: str) -> str:
+    """The part of ``path`` MuJoCo takes for an absolute prefix (its ``FilePath::AbsPrefix``):
+    a leading ``/`` or ``\\``, or everything up to a ``:/`` or ``:\\`` ("" when relative)."""
+    if not path:
+        return ""
+    if path[0] in "/\\":
+        return path[0]
+    for mark in (":/", ":\\"):
+        i = path.find(mark)
+        if i >= 0:
+            return path[:i + 2]
+    return ""
+
+
+def _mj_reduce(path: str) -> str:
+    """``path`` as MuJoCo reduces it (``FilePath::PathReduce``): ``\\`` and ``/`` both separate,
+    ``.`` and empty parts go, ``..`` removes the part before it (lexically, not as the file
+    system would through a symbolic link), parts are joined with ``/``."""
+    prefix = _mj_abs_prefix(path)
+    parts: list[str] = []
+    start = len(prefix)
+    for i in range(start, len(path)):
+        if path[i] in "/\\":
+            part, start = path[start:i], i + 1
+            if part == ".." and parts and parts[-1] != "..":
+                parts.pop()
+            elif part not in (".", ""):
+                parts.append(part)
+    parts.append(path[start:])
+    return prefix + "/".join(parts)
+
+
+def _mj_join(base: str, name: str) -> str:
+    """``base`` and ``name`` joined and reduced as MuJoCo does (``name`` when it is absolute)."""
+    if not _mj_abs_prefix(name) and base:
+        name = base + name if base[-1] in "/\\" else f"{base}/{name}"
+    return _mj_reduce(name)
+
+
+def _mj_strip(name: str) -> str:
+    """``name`` without its folders, as ``<compiler strippath="true">`` reads it."""
+    return name[max(name.rfind("/"), name.rfind("\\")) + 1:]
+
+
+def _show(value: Any, limit: int = 80) -> str:
+    """``repr`` of a value for a one-line message, shortened to ``limit`` characters."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _model_elements(data: bytes, where: str) -> list[tuple[str, dict[str, str], int]]:
+    """The elements of ``model.xml`` that bear on the files MuJoCo reads: ``(tag, attributes,
+    depth)`` of the root, the ``<compiler>`` sections and every element with a ``file*``
+    attribute or a tag of :data:`_REFUSED_ELEMENTS`, in document order.
+
+    Parsed with expat without namespace processing (tags and attribute names as MuJoCo's
+    tinyxml2 reads them), as UTF-8 whatever the XML declaration says (tinyxml2 reads UTF-8 only);
+    a DOCTYPE (entities: tinyxml2 does not read them as expat does) is refused.
+    """
+    from xml.parsers import expat
+
+    class _Refused(Exception):
+        pass
+
+    kept: list[tuple[str, dict[str, str], int]] = []
+    depth = 0
+    count = 0
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        nonlocal depth, count
+        count += 1
+        if count > MAX_MODEL_ELEMENTS:
+            raise _Refused(f"more than {MAX_MODEL_ELEMENTS:,} elements")
+        if (depth == 0 or tag == "compiler" or tag in _REFUSED_ELEMENTS
+                or any(k.startswith("file") for k in attrs)):
+            kept.append((tag, attrs, depth))
+        depth += 1
+
+    def end(tag: str) -> None:
+        nonlocal depth
+        depth -= 1
+
+    def doctype(*args: Any) -> None:
+        raise _Refused("a DOCTYPE (entity declarations), which a run folder's model has none of")
+
+    parser = expat.ParserCreate(encoding="UTF-8")
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.StartDoctypeDeclHandler = doctype
+    try:
+        parser.Parse(data, True)
+    except expat.ExpatError as exc:
+        raise RunFolderError(f"{where}: model.xml is not valid XML "
+                             f"({expat.errors.messages.get(exc.code, exc)}, line {exc.lineno})"
+                             ) from None
+    except _Refused as exc:
+        raise RunFolderError(f"{where}: model.xml has {exc}") from None
+    return kept
+
+
+def model_file_names(data: bytes, where: str) -> list[tuple[str, str, str, bool]]:
+    """The files and asset folders an MJCF model makes MuJoCo read, named as MuJoCo names them.
+
+    Args:
+        data: The model's XML (UTF-8).
+        where: How messages name the run.
+
+    Returns:
+        ``(what, value, name, is_dir)`` for the effective ``meshdir`` and ``texturedir`` (when
+        set) and for every file attribute: ``what`` as messages say it (``"<hfield file>"``),
+        the attribute's ``value``, and ``name``, the path MuJoCo opens relative to the model
+        file's folder (absolute when MuJoCo takes it for absolute): ``value`` with
+        ``strippath`` applied, joined to its dir, reduced as :func:`_mj_reduce` does.
 
     Raises:
-        RunFolderError: The first such reference, named.
+        RunFolderError: Not XML (:func:`_model_elements`), a root other than ``<mujoco>``, an
+            element of :data:`_REFUSED_ELEMENTS`, a file attribute of an element cellsim does
+            not know, a name with white space or control characters, or a drive or resource
+            name (``c:...``, ``scheme:...``).
     """
-    import xml.etree.ElementTree as ET
+    elements = _model_elements(data, where)
+    if not elements or elements[0][0] != "mujoco":
+        root = elements[0][0] if elements else "?"
+        raise RunFolderError(f"{where}: model.xml's root element is <{_show(root)[1:-1]}>, not "
+                             "<mujoco> (a run folder holds a compiled MJCF model)")
+    dirs = {"meshdir": "", "texturedir": ""}
+    strip = False
+    for tag, attrs, depth in elements:
+        if tag != "compiler" or depth != 1:  # MuJoCo reads the root's <compiler> sections only
+            continue
+        if "assetdir" in attrs:  # first: meshdir and texturedir of the same section override it
+            dirs["meshdir"] = dirs["texturedir"] = attrs["assetdir"]
+        for key in ("meshdir", "texturedir"):
+            if key in attrs:
+                dirs[key] = attrs[key]
+        if "strippath" in attrs:
+            strip = attrs["strippath"] == "true"
 
-    folder = model_path.resolve().parent
-    try:
-        root = ET.parse(model_path).getroot()
-    except (ET.ParseError, OSError) as exc:
-        raise RunFolderError(f"{where}: model.xml is not valid XML ({exc})") from None
-    dirs = {"": folder}
-    for comp in root.iter("compiler"):
-        for key in ("assetdir", "meshdir", "texturedir"):
-            if key in comp.attrib:
-                dirs[key] = (folder / comp.attrib[key]).resolve()
-    for el in root.iter():
-        if el.tag == "include":
-            raise RunFolderError(f"{where}: model.xml includes {el.attrib.get('file', '?')!r}; "
+    def check_name(what: str, value: str) -> None:
+        if any(c.isspace() or not c.isprintable() for c in value):
+            raise RunFolderError(f"{where}: model.xml's {what} {_show(value)} holds white space "
+                                 "or control characters; a run folder's file names have none")
+        head = value.split("/")[0].split("\\")[0]
+        if ":" in head and head.split(":")[0][:1].isalpha():
+            raise RunFolderError(f"{where}: model.xml's {what} {_show(value)} is a drive or "
+                                 "resource name (MuJoCo reads it as absolute), not a file of "
+                                 "the run folder")
+
+    out: list[tuple[str, str, str, bool]] = []
+    for key, value in dirs.items():
+        if value:
+            check_name(f"<compiler {key}>", value)
+            out.append((f"<compiler {key}>", value, _mj_reduce(value), True))
+    for tag, attrs, _ in elements:
+        if tag in _REFUSED_ELEMENTS:
+            raise RunFolderError(f"{where}: model.xml {_REFUSED_ELEMENTS[tag]} "
+                                 f"({_show(attrs.get('file', attrs.get('plugin', tag)))}); "
                                  "a run folder's model is self-contained")
-        for key in ("file", "fileright", "fileleft", "fileup", "filedown", "filefront",
-                    "fileback"):
-            if key in el.attrib:
-                base = dirs.get("meshdir" if el.tag == "mesh" else "texturedir", folder)
-                path = (base / el.attrib[key]).resolve()
-                if folder not in path.parents:
-                    raise RunFolderError(f"{where}: model.xml reads {el.attrib[key]!r}, outside "
-                                         "the run folder")
-    for key, d in dirs.items():
-        if key and d != folder and folder not in d.parents:
-            raise RunFolderError(f"{where}: model.xml's {key} points outside the run folder")
+        known = _MESHDIR_FILES.get(tag, _TEXTUREDIR_FILES.get(tag, ()))
+        folder = dirs["meshdir" if tag in _MESHDIR_FILES else "texturedir"]
+        for key, value in attrs.items():
+            if not key.startswith("file"):
+                continue
+            what = f"<{_show(tag)[1:-1]} {_show(key)[1:-1]}>"
+            if key not in known:
+                raise RunFolderError(f"{where}: model.xml's {what} names a file "
+                                     f"({_show(value)}) that cellsim does not check; a run "
+                                     "folder's model reads none")
+            if not value:
+                continue
+            check_name(what, value)
+            name = _mj_strip(value) if strip else value
+            out.append((what, value, _mj_join(_mj_reduce(folder), _mj_reduce(name)), False))
+    return out
+
+
+def confine_model_files(model_path: Path, where: str) -> str:
+    """Refuse a ``model.xml`` that would make MuJoCo read a file outside its run folder, and
+    say how to load it.
+
+    Every file the model names is resolved exactly as MuJoCo (4.0) resolves it: the
+    ``<compiler>`` sections in order (``assetdir`` sets both ``meshdir`` and ``texturedir``,
+    ``meshdir``/``texturedir`` of the same section override it, a later section overrides an
+    earlier one, ``strippath`` drops a name's folders); ``meshdir`` for ``<mesh>``,
+    ``<hfield>``, ``<skin>`` and ``<flexcomp>`` files, ``texturedir`` for ``<texture>``'s
+    seven file attributes; an absolute name bypasses the dirs; ``\\`` separates like ``/``
+    and ``..`` is reduced lexically (MuJoCo's ``FilePath``). The result is resolved through
+    symbolic links and must lie inside the folder; what exists there must be a regular file
+    (a FIFO would block MuJoCo). ``<include>``, ``<model file>``, plugins, a DOCTYPE, a root
+    other than ``<mujoco>`` (a URDF), names MuJoCo would read relative to the working
+    directory or through a resource provider (``x:/..``, ``scheme:...``) and names with
+    white space or control characters (which expat and tinyxml2 read differently) are refused.
+
+    Args:
+        model_path: The run folder's ``model.xml``.
+        where: How messages name the run.
+
+    Returns:
+        The path to give ``mujoco.MjModel.from_xml_path`` (absolute, the folder resolved:
+        the one the files were resolved against).
+
+    Raises:
+        RunFolderError: The first file or element at fault, named, one line.
+    """
+    folder = Path(os.path.realpath(model_path.parent))
+    load = folder / model_path.name
+    if "\\" in str(load):  # MuJoCo would read the backslash as a separator
+        raise RunFolderError(f"{where}: the folder's path holds a backslash, which MuJoCo reads "
+                             "as a separator; move the run folder")
+    real = Path(os.path.realpath(load))
+    if folder not in real.parents:
+        raise RunFolderError(f"{where}: model.xml is a symbolic link to {str(real)!r}, outside "
+                             "the run folder")
+    data = read_input(load, _file_error(load, f"{where}: model.xml"), "model file",
+                      MAX_MODEL_BYTES)
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise RunFolderError(f"{where}: model.xml is not UTF-8 text ({exc.reason} at byte "
+                             f"{exc.start})") from None
+    base = f"{folder}/"  # MuJoCo's model file dir: from_xml_path(load)'s folder
+    for what, value, name, is_dir in model_file_names(data, where):
+        resolved = _mj_join(base, name)
+        if not resolved.startswith("/"):  # "x:/..": absolute to MuJoCo, relative to the OS
+            raise RunFolderError(f"{where}: model.xml's {what} {_show(value)} is read as "
+                                 f"{_show(resolved)}, relative to the working directory, not "
+                                 "the run folder")
+        target = Path(os.path.realpath(resolved))
+        if not (folder in target.parents or (is_dir and target == folder)):
+            raise RunFolderError(f"{where}: model.xml's {what} {_show(value)} resolves to "
+                                 f"{str(target)!r}, outside the run folder")
+        if not is_dir and os.path.lexists(target):
+            check_input(target, _file_error(target, f"{where}: model.xml's {what} "
+                                                    f"{_show(value)} ({str(target)!r})"),
+                        "model asset", MAX_ASSET_BYTES)
+    return str(load)
+
+
+# ------------------------------------------------------------------------------ reading
+def _file_error(path: Path, prefix: str) -> Callable[[str], RunFolderError]:
+    """The error :func:`~sim.core.files.read_input` raises for ``path``: its message (which
+    begins with the path) after ``prefix`` instead of the path."""
+    return lambda message: RunFolderError(f"{prefix}: {message.removeprefix(f'{path}: ')}")
+
+
+def _run_file(folder: Path, name: str, where: str, max_bytes: int) -> Path | None:
+    """The run folder's file ``name``, None when there is none; refused (one line) when it
+    resolves outside the folder (a symbolic link elsewhere), is not a regular file (a FIFO
+    would block the reader, a device never ends) or is larger than ``max_bytes``."""
+    path = folder / name
+    if not os.path.lexists(path):
+        return None
+    real = Path(os.path.realpath(path))
+    if Path(os.path.realpath(folder)) not in real.parents:
+        raise RunFolderError(f"{where}: {name} is a symbolic link to {str(real)!r}, outside the "
+                             "run folder")
+    check_input(path, _file_error(path, f"{where}: {name}"), "file", max_bytes)
+    return path
+
+
+def _read_trajectory(path: Path, where: str) -> dict[str, np.ndarray]:
+    """The arrays of ``trajectory.npz``, read without numpy's loader so that nothing is trusted
+    before it is checked: a zip of ``.npy`` members (stored or deflated, at most
+    :data:`MAX_TRAJECTORY_ARRAYS`), each a numeric array whose header's shape and dtype give
+    exactly the member's unpacked size, all together at most :data:`MAX_TRAJECTORY_BYTES`
+    (checked before a byte is unpacked: a header claiming a huge shape allocates nothing);
+    the zip's checksums are verified.
+
+    Raises:
+        RunFolderError: Naming the member and what is wrong (one line).
+    """
+    import lzma
+    import stat
+    import struct
+    import zlib
+
+    fmt = np.lib.format
+    damaged = (OSError, ValueError, EOFError, TypeError, KeyError, IndexError, OverflowError,
+               RuntimeError, NotImplementedError, struct.error, zlib.error, lzma.LZMAError,
+               zipfile.BadZipFile)
+    arrays: dict[str, np.ndarray] = {}
+    member = "?"
+    try:
+        # not blocking on a FIFO put in its place since it was checked; a regular file only
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise RunFolderError(f"{where}: trajectory.npz is not a regular file")
+        with os.fdopen(fd, "rb") as fh, zipfile.ZipFile(fh) as zf:
+            infos = zf.infolist()
+            if len(infos) > MAX_TRAJECTORY_ARRAYS:
+                raise RunFolderError(f"{where}: trajectory.npz holds {len(infos):,} members, "
+                                     f"more than the {MAX_TRAJECTORY_ARRAYS} arrays a run has")
+            # zipfile trusts the directory's size: a damaged one drops members silently; the
+            # end record's count of members (its zip64 mark 0xFFFF aside) must match
+            fh.seek(-22 - len(zf.comment), os.SEEK_END)
+            end = fh.read(22)
+            counts = struct.unpack("<HH", end[8:12]) if end[:4] == b"PK\x05\x06" else None
+            if counts is None or any(c not in (len(infos), 0xFFFF) for c in counts):
+                raise zipfile.BadZipFile(f"the end record counts {counts} members, the "
+                                         f"directory lists {len(infos)}")
+            if len({info.filename for info in infos}) != len(infos):
+                raise zipfile.BadZipFile("two members of one name")
+            total = sum(info.file_size for info in infos)
+            if total > MAX_TRAJECTORY_BYTES:
+                raise RunFolderError(f"{where}: trajectory.npz unpacks to {total:,} bytes, more "
+                                     f"than the {MAX_TRAJECTORY_BYTES:,} a run records")
+            for info in infos:
+                member = info.filename
+                if not member.endswith(".npy"):
+                    raise RunFolderError(f"{where}: trajectory.npz member {_show(member)} is not "
+                                         "an array (.npy)")
+                if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
+                    raise RunFolderError(f"{where}: trajectory.npz member {_show(member)} is "
+                                         f"packed with method {info.compress_type}, not stored "
+                                         "or deflated as numpy writes it")
+                with zf.open(info) as fp:
+                    version = fmt.read_magic(fp)
+                    if version == (1, 0):
+                        shape, fortran, dtype = fmt.read_array_header_1_0(fp)
+                    elif version == (2, 0):
+                        shape, fortran, dtype = fmt.read_array_header_2_0(fp)
+                    else:
+                        raise ValueError(f"unsupported .npy version {version}")
+                    if dtype.kind not in "fiub" or dtype.hasobject or dtype.itemsize == 0:
+                        raise RunFolderError(f"{where}: trajectory.npz {_show(member[:-4])} has "
+                                             f"dtype {_show(str(dtype))}, expected numbers")
+                    if any(not isinstance(d, int) or d < 0 for d in shape):
+                        raise ValueError(f"invalid shape {_show(shape)}")
+                    count = math.prod(shape)
+                    left = info.file_size - fp.tell()
+                    if count * dtype.itemsize != left:
+                        raise RunFolderError(
+                            f"{where}: trajectory.npz {_show(member[:-4])}: its header claims shape "
+                            f"{_show(shape)} of {dtype} ({count * dtype.itemsize:,} bytes) but "
+                            f"the member holds {left:,}")
+                    flat = np.empty(count, dtype)
+                    view = memoryview(flat).cast("B")
+                    done = 0
+                    while done < left:
+                        chunk = fp.read(min(left - done, 1 << 20))
+                        if not chunk:
+                            raise EOFError("the member ends early")
+                        view[done:done + len(chunk)] = chunk
+                        done += len(chunk)
+                    if fp.read(1):
+                        raise ValueError("the member is longer than its header says")
+                arrays[member[:-4]] = (flat.reshape(shape[::-1]).T if fortran
+                                       else flat.reshape(shape))
+    except RunFolderError:
+        raise
+    except MemoryError:
+        raise RunFolderError(f"{where}: trajectory.npz does not fit in memory (member "
+                             f"{_show(member)})") from None
+    except damaged as exc:
+        detail = str(exc).splitlines()[0] if str(exc).strip() else type(exc).__name__
+        inside = f"member {_show(member)} is " if member != "?" else ""
+        raise RunFolderError(f"{where}: trajectory.npz does not load ({inside}damaged: "
+                             f"{type(exc).__name__}: {_show(detail, 160)})") from None
+    return arrays
+
+
+def _read_summary(path: Path, where: str) -> dict[str, Any]:
+    """``summary.json`` as a dict (UTF-8, at most :data:`MAX_SUMMARY_BYTES`, a JSON object)."""
+    data = read_input(path, _file_error(path, f"{where}: summary.json"), "file",
+                      MAX_SUMMARY_BYTES)
+    try:
+        summary = json.loads(data.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise RunFolderError(f"{where}: summary.json is not UTF-8 text ({exc.reason} at byte "
+                             f"{exc.start})") from None
+    except RecursionError:
+        raise RunFolderError(f"{where}: summary.json nests too deeply to read") from None
+    except ValueError as exc:  # json.JSONDecodeError, and integers of too many digits
+        raise RunFolderError(f"{where}: summary.json is not valid JSON "
+                             f"({_show(str(exc), 160)})") from None
+    if not isinstance(summary, dict):
+        raise RunFolderError(f"{where}: summary.json must hold a JSON object, not "
+                             f"{type(summary).__name__}")
+    return summary
+
+
+def _number(value: Any) -> bool:
+    """Whether ``value`` is a real number (a JSON number; not a bool, not a string)."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_))
+
+
+def _interval(item: Mapping[str, Any], where: str) -> tuple[float, float]:
+    """``item``'s ``t0``, ``t1``: finite numbers with t0 <= t1."""
+    times = []
+    for key in ("t0", "t1"):
+        if key not in item:
+            raise RunFolderError(f"{where} has no {key!r}")
+        value = item[key]
+        if not _number(value) or not math.isfinite(float(value)):
+            raise RunFolderError(f"{where}.{key} must be a finite number of seconds, not "
+                                 f"{_show(value)}")
+        times.append(float(value))
+    if times[0] > times[1]:
+        raise RunFolderError(f"{where} ends (t1 {times[1]:g} s) before it starts (t0 "
+                             f"{times[0]:g} s)")
+    return times[0], times[1]
 
 
 def _phase(item: Phase | Mapping[str, Any], where: str) -> Phase:
+    """A :class:`Phase` from a phase or a summary-style dict ``{"name", "kind", "t0", "t1"}``.
+
+    Raises:
+        RunFolderError: Not an object, a name or kind that is not a string, times that are not
+            finite numbers or end before they start; ``where`` names the phase.
+    """
     if isinstance(item, Phase):
         return item
-    try:
-        return Phase(
-            str(item["name"]), str(item.get("kind", "")), float(item["t0"]), float(item["t1"])
-        )
-    except (KeyError, TypeError, ValueError) as exc:
-        raise RunFolderError(
-            f"{where}: each phase needs 'name', 't0', 't1' (got {dict(item)!r})"
-        ) from exc
+    if not isinstance(item, Mapping):
+        raise RunFolderError(f"{where} must be an object with 'name', 't0', 't1', not "
+                             f"{_show(item)}")
+    if not isinstance(item.get("name"), str):
+        raise RunFolderError(f"{where}.name must be a string, not {_show(item.get('name'))}")
+    kind = item.get("kind", "")
+    if not isinstance(kind, str):
+        raise RunFolderError(f"{where}.kind must be a string, not {_show(kind)}")
+    t0, t1 = _interval(item, where)
+    return Phase(item["name"], kind, t0, t1)
+
+
+def _check_collisions(collisions: Any, where: str) -> None:
+    """``summary.json``'s ``collisions`` as the video reads them: a list of objects with
+    finite ``t0`` <= ``t1`` and ``geoms``/``all_geoms`` lists of names."""
+    if not isinstance(collisions, list):
+        raise RunFolderError(f"{where} must be a list, not {type(collisions).__name__}")
+    for i, c in enumerate(collisions):
+        if not isinstance(c, dict):
+            raise RunFolderError(f"{where}[{i}] must be an object, not {_show(c)}")
+        for key in ("geoms", "all_geoms"):
+            if key in c and (not isinstance(c[key], list)
+                             or not all(isinstance(g, str) for g in c[key])):
+                raise RunFolderError(f"{where}[{i}].{key} must be a list of geom names")
+        if c.get("all_geoms", c.get("geoms")):
+            _interval(c, f"{where}[{i}]")
 
 
 def load_run(run_dir: str | Path) -> RunRecord:
     """Reads a run folder.
 
     ``summary.json`` is optional: without it (the runner renders before writing it) the
-    joints are named ``j1 .. jN`` and the phases are unnamed.
+    joints are named ``j1 .. jN`` and the phases are unnamed. Nothing outside the folder is
+    read (a file that is a symbolic link elsewhere, or a ``model.xml`` naming a file elsewhere,
+    is refused: :func:`confine_model_files`), every file is bounded in size, and any damage
+    is one :class:`RunFolderError` naming the folder and the file (and member or field).
 
     Args:
         run_dir: Folder written by ``cellsim run``.
@@ -398,25 +850,19 @@ def load_run(run_dir: str | Path) -> RunRecord:
         raise RunFolderError(f"{where} is a run that was still being written (a killed or "
                              "running `cellsim run`), not a result; the next run into that "
                              "place removes it")
-    missing = [n for n in (MODEL_XML, TRAJECTORY_NPZ) if not (folder / n).is_file()]
+    model = _run_file(folder, MODEL_XML, where, MAX_MODEL_BYTES)
+    npz = _run_file(folder, TRAJECTORY_NPZ, where, MAX_TRAJECTORY_BYTES)
+    missing = [n for n, p in ((MODEL_XML, model), (TRAJECTORY_NPZ, npz)) if p is None]
     if missing:
         raise RunFolderError(
             f"{where} lacks {', '.join(missing)} (a run folder holds model.xml, summary.json and "
             "trajectory.npz)"
         )
-    try:
-        with np.load(folder / TRAJECTORY_NPZ, allow_pickle=False) as npz:
-            arrays = {name: npz[name] for name in npz.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
-        raise RunFolderError(f"{where}: trajectory.npz does not load ({exc})") from exc
-    summary: Any = {}
-    if (folder / SUMMARY_JSON).is_file():
-        try:
-            summary = json.loads((folder / SUMMARY_JSON).read_text())
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise RunFolderError(f"{where}: summary.json is not valid JSON ({exc})") from exc
-        if not isinstance(summary, dict):
-            raise RunFolderError(f"{where}: summary.json must hold a JSON object")
+    assert model is not None and npz is not None
+    confine_model_files(model, where)
+    arrays = _read_trajectory(npz, where)
+    summary_path = _run_file(folder, SUMMARY_JSON, where, MAX_SUMMARY_BYTES)
+    summary = _read_summary(summary_path, where) if summary_path is not None else {}
     joints = summary.get("joints")
     if joints is None:  # no summary (yet): the project's default names j1..jN
         width = next((arrays[k].shape[1] for k in JOINT_ARRAYS
@@ -424,13 +870,23 @@ def load_run(run_dir: str | Path) -> RunRecord:
         joints = [f"j{i + 1}" for i in range(width)]
     if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
         raise RunFolderError(f"{where}: summary.json 'joints' must be a list of joint names")
+    if "joints" in summary:
+        for name in JOINT_ARRAYS:
+            if name in arrays and arrays[name].ndim == 2 and arrays[name].shape[1] != len(joints):
+                raise RunFolderError(f"{where}: summary.json 'joints' names {len(joints)} joints "
+                                     f"but trajectory.npz {name!r} has {arrays[name].shape[1]} "
+                                     "columns")
     phases_raw = summary.get("phases", [])
     if not isinstance(phases_raw, list):
         raise RunFolderError(f"{where}: summary.json 'phases' must be a list")
+    phases = [_phase(p, f"{where}: summary.json 'phases'[{i}]")
+              for i, p in enumerate(phases_raw)]
+    if "collisions" in summary:
+        _check_collisions(summary["collisions"], f"{where}: summary.json 'collisions'")
     record = RunRecord(
         arrays=arrays,
         joints=list(joints),
-        phases=[_phase(p, f"{where}: summary.json") for p in phases_raw],
+        phases=phases,
         model_path=folder / MODEL_XML,
         summary=summary,
         source=folder,
@@ -480,11 +936,24 @@ def write_marker(folder: str | Path, state: str = "complete") -> Path:
 
 def marker_state(folder: str | Path) -> str | None:
     """The marker's ``state`` (``"writing"``, ``"complete"``), None without a marker; a marker
-    of cellsim 0.2 without a state counts as complete."""
+    of cellsim 0.2 without a state counts as complete. Only a small regular file is read (a
+    FIFO or a symbolic link in its place counts as no marker: nothing blocks, nothing outside
+    the folder is read)."""
+    import stat
+
     try:
-        doc = json.loads((Path(folder) / MARKER).read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        fd = os.open(Path(folder) / MARKER,
+                     os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0))
+    except OSError:
         return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        doc = json.loads(os.read(fd, 4096).decode())
+    except (OSError, ValueError, RecursionError):  # JSON and UTF-8 errors are ValueErrors
+        return None
+    finally:
+        os.close(fd)
     return str(doc.get("state", "complete")) if isinstance(doc, dict) else None
 
 
