@@ -120,3 +120,64 @@ def test_list_shows_each_cells_objects_seams_and_cameras(capsys):
     assert "cameras: overview, tool" in table
     pick = blocks.split("  pick ", 1)[1].split("\n  weld_", 1)[0]
     assert "parts: part0, part1, part2, part3" in pick and "seams:" not in pick
+
+
+def _program(n: int, term: str) -> str:
+    """A generated TP program: a J move, then ``n`` L moves round a 20 mm square with
+    termination ``term`` (FINE or CNTx)."""
+    mn = ["UFRAME_NUM=0 ;", "UTOOL_NUM=1 ;", "J P[1] 50% FINE ;"]
+    mn += [f"L P[{k}] 100mm/sec {term} ;" for k in range(2, n + 2)]
+    pos = []
+    for k in range(1, n + 2):
+        x, y, z = (450 + (k % 2) * 20, -50 + (k % 4 // 2) * 20, 50 if k == 1 else 0)
+        pos.append(f"P[{k}]{{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',\n"
+                   f"\tX = {x:.3f} mm,\tY = {y:.3f} mm,\tZ = {z:.3f} mm,\n"
+                   "\tW = 180.000 deg,\tP = 0.000 deg,\tR = 0.000 deg\n};")
+    return ("/PROG  GEN\n/MN\n" + "\n".join(f"  {i + 1:4d}:  {m}" for i, m in enumerate(mn))
+            + "\n/POS\n" + "\n".join(pos) + "\n/END\n")
+
+
+def _program_scenario(tmp_path, n: int, term: str):
+    (tmp_path / "gen.ls").write_text(_program(n, term))
+    (tmp_path / "s.toml").write_text('name = "gen"\ndescription = "generated"\n'
+                                     'robot = "lrmate200ic5l"\ntool = "mig_torch"\n'
+                                     'program = "gen.ls"\n')
+    return tmp_path / "s.toml"
+
+
+@pytest.mark.parametrize("n", [6, 12])
+def test_blended_moves_list_their_own_segments_once(tmp_path, capsys, monkeypatch, n):
+    """Issue 31: blended moves share one trajectory, and `cellsim plan` listed all of it for
+    each move and checked its limits once per move: output and work grew as the square of
+    the number of moves (100 CNT moves: 251 s, 4.4 GB). Now the phases' segments tile the
+    trajectory's knots (each segment listed once, in order) and each trajectory is checked
+    once."""
+    import planners.limits as limits
+
+    calls = []
+    real = limits.find_limit_violations
+    monkeypatch.setattr(limits, "find_limit_violations",
+                        lambda traj, **kw: calls.append(id(traj)) or real(traj, **kw))
+    assert main(["plan", str(_program_scenario(tmp_path, n, "CNT50")), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    phases = doc["phases"]
+    assert len(phases) == n + 1
+    spans = [(s["t0"], s["t1"]) for ph in phases[1:] for s in ph["joints"][0]["segments"]]
+    distinct = sorted(set(spans))
+    # the distinct segments tile the blended moves' time without a gap, and consecutive
+    # windows share at most the one segment their boundary falls in
+    assert all(a[1] == b[0] for a, b in zip(distinct, distinct[1:]))
+    assert len(spans) <= len(distinct) + (n - 1)
+    assert spans == sorted(spans)
+    assert len(calls) == len(set(calls)) == 2  # the J move's trajectory and the blended one
+
+
+def test_a_program_longer_than_the_bound_is_refused_at_its_line(tmp_path, capsys):
+    from sim.scenario.fanuc_ls import MAX_PROGRAM_MOTIONS
+
+    assert main(["check", str(_program_scenario(tmp_path, MAX_PROGRAM_MOTIONS, "FINE"))]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    # the file's lines: /PROG, /MN, two frame lines, the J move, then the L moves
+    assert f"gen.ls: line {MAX_PROGRAM_MOTIONS + 5}: the program has " \
+           f"{MAX_PROGRAM_MOTIONS + 1:,} motion instructions" in err

@@ -66,10 +66,11 @@ def plan_json(scenario: Scenario, planned: list[PhaseMotion]) -> dict[str, Any]:
     for pp in planned:
         traj = pp.trajectory
         knots = np.asarray(traj.knots, dtype=float)
+        inside = _window(pp)
         joints = []
         for j in range(traj.n_joints):
             segments = []
-            for s in range(traj.n_segments):
+            for s in inside:
                 segments.append({
                     "t0": float(knots[s]),
                     "t1": float(knots[s + 1]),
@@ -80,10 +81,22 @@ def plan_json(scenario: Scenario, planned: list[PhaseMotion]) -> dict[str, Any]:
         phases.append({
             "name": pp.phase.name,
             "planner": pp.phase.planner,
-            "time_s": [float(t) for t in knots],
+            "time_s": [float(t) for t in knots[inside[0]:inside[-1] + 2]],
             "joints": joints,
         })
     return {"scenario": scenario.name, "phases": phases}
+
+
+def _window(pp: PhaseMotion) -> range:
+    """The segments of a phase's trajectory inside its time window: blended phases share
+    one trajectory, and each lists its own part of it (listing the whole one for each made
+    the output grow as the square of the number of moves)."""
+    knots = np.asarray(pp.trajectory.knots, dtype=float)
+    tol = 1e-9 * max(1.0, abs(pp.t1))
+    first = int(np.searchsorted(knots, pp.t0 + tol, side="right")) - 1
+    last = int(np.searchsorted(knots, pp.t1 - tol, side="left"))
+    first = min(max(first, 0), len(knots) - 2)
+    return range(first, max(last, first + 1))
 
 
 def _poly_text(coeffs: np.ndarray, var: str) -> str:
@@ -108,11 +121,12 @@ def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
         traj = pp.trajectory
         knots = np.asarray(traj.knots, dtype=float)
         lines.append("")
+        inside = _window(pp)
         lines.append(f"phase {pp.phase.index + 1} {pp.phase.name!r}: planner {pp.phase.planner}, "
-                     f"knots at {', '.join(f'{t:g}' for t in knots)} s")
+                     f"knots at {', '.join(f'{t:g}' for t in knots[inside[0]:inside[-1] + 2])} s")
         for j, jname in enumerate(scenario.robot.joints[: traj.n_joints]):
             lines.append(f"  joint {jname}")
-            for s in range(traj.n_segments):
+            for s in inside:
                 var = traj.segment_variable(s)
                 lines.append(f"    segment {s + 1}: {knots[s]:g} -> {knots[s + 1]:g} s "
                              f"(t_{s + 1} = {knots[s + 1] - knots[s]:g} s)")

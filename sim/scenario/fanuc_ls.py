@@ -159,6 +159,8 @@ _WEAVE_VALUES = (("frequency", "Hz"), ("amplitude", "mm"), ("right dwell", "s"),
                  ("left dwell", "s"))
 #: Highest weave frequency cellsim runs, Hz (as a scenario's ``[phases.weave]``).
 MAX_WEAVE_HZ = 20.0
+#: Most motion instructions a program may hold (a long weld program has some hundreds).
+MAX_PROGRAM_MOTIONS = 2000
 
 
 def _speed(value: str, unit: str, path, line: int) -> tuple[float, str]:
@@ -326,6 +328,12 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
         raise _err(path, ln, f"text outside a section: {s!r}")
     if pending_circ is not None:
         raise _err(path, pending_circ[1], "a circular move without its second line")
+    motions = [ins for ins in prog.instructions if isinstance(ins, LSMotion)]
+    if len(motions) > MAX_PROGRAM_MOTIONS:
+        raise _err(path, motions[MAX_PROGRAM_MOTIONS].line,
+                   f"the program has {len(motions):,} motion instructions, more than "
+                   f"{MAX_PROGRAM_MOTIONS:,} (planning takes about 0.1 s of CPU per blended "
+                   "move); split it into several programs")
     if not prog.name:
         raise _err(path, 1, "no /PROG line (is this a TP program in ASCII form?)")
     return prog
@@ -541,6 +549,6 @@ def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
     return "\n".join(L) + "\n"
 
 
-__all__ = ["MAX_WEAVE_HZ", "WEAVE_PATTERNS", "LSMotion", "LSOther", "LSPosition", "LSProgram",
+__all__ = ["MAX_PROGRAM_MOTIONS", "MAX_WEAVE_HZ", "WEAVE_PATTERNS", "LSMotion", "LSOther", "LSPosition", "LSProgram",
            "LSWeave", "WeaveSchedule", "parse_ls", "read_ls", "read_weave_schedules",
            "weave_table_path", "write_ls", "write_weave_schedules"]

@@ -490,17 +490,24 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
 
     rng = joint_ranges(scenario.robot)
     where = scenario.source.name
-    out = []
+    # blended phases share one trajectory: each trajectory is checked once (once per phase
+    # made the check grow as the square of the number of blended moves) and a violation is
+    # named after the phase whose window holds its time
+    groups: dict[int, list[PhaseMotion]] = {}
     for pm in motion.phases:
-        if isinstance(pm.trajectory, HoldTrajectory):
-            continue
+        if not isinstance(pm.trajectory, HoldTrajectory):
+            groups.setdefault(id(pm.trajectory), []).append(pm)
+    out = []
+    for group in groups.values():
         found = find_limit_violations(
-            pm.trajectory, lower=rng[:, 0], upper=rng[:, 1],
+            group[0].trajectory, lower=rng[:, 0], upper=rng[:, 1],
             max_velocity=np.asarray(scenario.robot.max_speed) if speed else None,
             max_acceleration=(np.asarray(scenario.robot.max_accel)
                               if accel and scenario.robot.max_accel else None),
             joint_names=scenario.robot.joints)
-        out += [f"{where}: phases[{pm.phase.index}] ({pm.name}): {v.message()}" for v in found]
+        for v in found:
+            pm = next((p for p in group if p.t0 <= v.time <= p.t1), group[0])
+            out.append(f"{where}: phases[{pm.phase.index}] ({pm.name}): {v.message()}")
     return out
 
 
