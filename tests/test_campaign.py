@@ -22,7 +22,6 @@ from typing import Any
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
 from test_cell_files import CELL, make_cell
 from test_robots_as_data import DH_ROBOT, DH_SCENARIO
 from test_weld_programs import DATA, TP_SCENARIO
