@@ -138,6 +138,44 @@ def test_a_cycle_that_never_grips_fails_its_verdict(tmp_path, capsys):
     np.testing.assert_allclose([c["value"] for c in checks], want, rtol=1e-9)
 
 
+def _part_masses_from_cell_file() -> list[float]:
+    import tomllib
+
+    from sim.core.resources import models_dir
+
+    doc = tomllib.loads((models_dir() / "cells" / "pick.toml").read_text())
+    return [o["mass_kg"] for o in doc["objects"] if o.get("role") == "part"]
+
+
+def test_the_gripper_holds_no_more_than_its_rating(scenario_run):
+    """``tool_payload``: the heaviest part (the cell file's numbers) against the vacuum
+    gripper's rating, its 40 N over twice a part's weight (computed here)."""
+    _, summary = scenario_run("lrmate200ic_pick_place")
+    (check,) = [c for c in summary["checks"] if c["name"] == "tool_payload"]
+    assert check["value"] == pytest.approx(max(_part_masses_from_cell_file()), rel=1e-9)
+    assert check["limit"] == pytest.approx(40.0 / (2 * 9.80665), rel=1e-12)
+    assert check["pass"] and check["severity"] == "error"
+
+
+@pytest.mark.slow
+def test_a_payload_over_the_gripper_s_rating_fails_the_verdict(tmp_path, capsys):
+    """Issue 31: the robot's rating (5 kg) is not the gripper's: 2.5 kg at the cup and a
+    0.25 kg part pass the first and fail the second; `--strict` exits 1."""
+    from sim.cli import main
+    from sim.core.resources import scenarios_dir
+
+    text = (scenarios_dir() / "lrmate200ic_pick_place.toml").read_text()
+    (tmp_path / "s.toml").write_text(text.replace('tool = "vacuum_gripper"\n',
+                                                  'tool = "vacuum_gripper"\npayload_kg = 2.5\n'))
+    rc = main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "r"), "--no-video",
+               "--no-plots", "--quiet", "--strict"])
+    capsys.readouterr()
+    summary = json.loads((tmp_path / "r" / "summary.json").read_text())
+    by = {c["name"]: c for c in summary["checks"] if c["name"] in ("payload", "tool_payload")}
+    assert rc == 1 and by["payload"]["pass"] and not by["tool_payload"]["pass"]
+    assert by["tool_payload"]["value"] == pytest.approx(2.5 + max(_part_masses_from_cell_file()))
+
+
 def test_weld_cycle_phase1_ends_at_seam_start(scenario_run):
     """The end of seed 001's phase I puts the torch on the seam start (the cell is built so)."""
     out, summary = scenario_run("bugnar_5r_weld_cycle")

@@ -29,7 +29,10 @@ is per joint:
   per joint, the chosen pair's smallest margin, %; fails when no pair serves the joint;
 * ``payload``: the mass at the flange, the tool's and the scenario's payload, kg, against the
   robot's rated payload (``[mass] payload_kg``; not checked for a robot that gives none): a
-  robot carrying three times its rating is no result to size from.
+  robot carrying three times its rating is no result to size from;
+* ``tool_payload``: for a tool with a rating (``max_payload_kg``: the vacuum gripper's is its
+  40 N over twice a part's weight), the mass it holds (the scenario's payload and the
+  heaviest part of the cell), kg, against that rating.
 * ``part_placed``: in a cell with slots, per slot, how far the centre of its part (part k goes
   to slot k) ends from it, mm, against 5 mm (``summary["place_tolerance_mm"]``): a pick cycle
   that drops a part or never lifts it fails.
@@ -80,12 +83,19 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                tracking_tolerance_deg: float, sizing: SizingResult | None = None,
                clearance_mm: float = 5.0, selection: Any = None, *,
                torch_angle_tolerance_deg: float,
-               flange_load_kg: tuple[float, float] | None = None) -> list[RunCheck]:
+               flange_load_kg: tuple[float, float] | None = None,
+               tool_load: tuple[str, float, float] | None = None) -> list[RunCheck]:
     """Every check of a run (module docstring): joint by joint, then collisions, clearance,
     the Cartesian phases' speeds, the weld phases' torch angles, the weaves, the actuator
     selection when one was made, and the payload (``flange_load_kg``: the tool's mass and the
-    scenario's payload, kg) against the robot's rating."""
+    scenario's payload, kg) against the robot's rating, and the mass the tool holds against
+    the tool's (``tool_load``: the tool's name, the mass it holds and its rating, kg)."""
     checks: list[RunCheck] = []
+    if tool_load is not None:
+        name, held, rating = tool_load
+        checks.append(RunCheck("tool_payload", "", float(held), float(rating), "kg",
+                               held <= rating * (1 + 1e-9),
+                               subject=f"the {name} holds {held:g} kg, rated {rating:.3g} kg"))
     if flange_load_kg is not None and spec.payload_kg > 0:
         tool, payload = flange_load_kg
         load = float(tool) + float(payload)

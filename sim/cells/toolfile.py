@@ -69,6 +69,7 @@ class ToolFileSpec(Strict):
     description: PlainText = ""
     kind: Literal["torch", "gripper"] = "torch"
     mass_kg: float = Field(gt=0, le=100)
+    max_payload_kg: float | None = Field(None, gt=0, le=10_000)
     com_mm: list[Mm] | None = Field(None, min_length=3, max_length=3)
     inertia_kg_m2: list[Annotated[float, Field(gt=0, le=1e3)]] | None = Field(
         None, min_length=3, max_length=3)
@@ -211,6 +212,7 @@ def load_tool_file(path: str | Path) -> ToolSpec:
     return ToolSpec(
         name=spec.name, description=spec.description or f"tool file {path.name}",
         mass_kg=mass, length_m=float(np.linalg.norm(X[:3, 3])), kind=spec.kind,
+        max_payload_kg=spec.max_payload_kg,
         work_geoms=("wire",) if spec.kind == "torch" else (),
         tcp_in_tool=None if straight else tuple(tuple(float(v) for v in row) for row in X),
         stickout_m=spec.stickout_mm * 1e-3, touch_depth_m=spec.touch_depth_mm * 1e-3,

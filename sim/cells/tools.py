@@ -92,6 +92,11 @@ CONTACT_CUP = 4  #: suction-cup lip: touches parts only
 CONTACT_PART_TYPE = 2  #: parts: contype
 CONTACT_PART_AFFINITY = 2 | 4  #: parts: conaffinity (fixtures, other parts, the cup)
 
+#: Standard gravity, m/s^2, and the factor of its weight a suction cup's holding force must
+#: give a part (the margin for the cycle's accelerations and a cup that does not seal
+#: perfectly): the vacuum gripper's rating is its 40 N over twice a part's weight, 2.04 kg.
+GRAVITY = 9.80665
+SUCTION_SAFETY = 2.0
 #: Name of the adhesion actuator, the cup body and the tip site inside a tool model.
 TIP_SITE = "tip"
 CUP_BODY = "cup"
@@ -135,6 +140,9 @@ class ToolSpec:
         touch_depth_m: How far the wire tip of a torch may press into a workpiece beyond the
             wire's radius with the arc off (touch sensing, the tip set on the root), m
             (:mod:`sim.simulation.collisions`).
+        max_payload_kg: The heaviest mass the tool is rated to hold (a gripper's part and
+            the scenario's payload), kg; None for a tool that holds nothing (a torch). The
+            verdict checks it (:mod:`sim.analysis.verdict`, ``tool_payload``).
         source: The tool file, for a tool given as a file (:mod:`sim.cells.toolfile`).
         builder: Builds the tool's MJCF (a tool file's own); None for the shipped tools.
     """
@@ -149,6 +157,7 @@ class ToolSpec:
     tcp_in_tool: tuple[tuple[float, ...], ...] | None = None
     stickout_m: float = 0.015
     touch_depth_m: float = 0.0005
+    max_payload_kg: float | None = None
     source: Path | None = None
     builder: Callable[[], object] | None = field(default=None, repr=False, compare=False)
 
@@ -208,6 +217,7 @@ for _spec in (
             kind="gripper",
             suction_gain_n=SUCTION_GAIN_N,
             work_geoms=tuple(f"lip{k}" for k in range(8)),
+            max_payload_kg=SUCTION_GAIN_N / (GRAVITY * SUCTION_SAFETY),
         ),
 ):
     TOOLS.add(_spec.name, _spec)

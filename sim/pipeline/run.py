@@ -271,11 +271,32 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
                             torch_angle_tolerance_deg=(
                                 scenario.simulation.torch_angle_tolerance_deg),
                             flange_load_kg=(built.cell.tool.mass_kg if built.cell.tool else 0.0,
-                                            scenario.payload_kg))
+                                            scenario.payload_kg),
+                            tool_load=_tool_load(built, scenario.payload_kg))
         summary["checks"] = [c.to_dict() for c in checks]
         summary["verdict"] = verdict(checks)
         summary["warnings"] = warnings_count(checks)
     return Evaluation(summary, record, sizing, selected, built)
+
+
+def _tool_load(built: Any, payload_kg: float) -> tuple[str, float, float] | None:
+    """The tool's name, the mass it holds (the payload and the heaviest part of the cell,
+    from the compiled model) and its rating, kg; None for a tool without a rating."""
+    tool = built.cell.tool
+    if tool is None or tool.max_payload_kg is None:
+        return None
+    model = built.model
+    parts = [float(model.body(name).mass[0]) for name in built.cell.parts
+             if _has_body(model, name)]
+    return tool.name, float(payload_kg) + max(parts, default=0.0), float(tool.max_payload_kg)
+
+
+def _has_body(model: Any, name: str) -> bool:
+    try:
+        model.body(name)
+    except KeyError:
+        return False
+    return True
 
 
 def evaluate_scenario(scenario: Scenario, options: RunOptions | None = None) -> Evaluation:
