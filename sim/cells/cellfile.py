@@ -37,7 +37,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -60,7 +60,7 @@ from sim.cells.tools import (
 )
 from sim.core.rotations import euler_zyx_to_matrix
 from sim.core.text import PlainText
-from sim.core.tomlschema import Strict, load_toml
+from sim.core.tomlschema import ANGLE_DEG, Quantity, Strict, load_toml
 from sim.errors import CellError, CellsimError
 
 _NAME = r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*$"
@@ -82,10 +82,27 @@ RESERVED = ("floor", "robot", "world", "frame0", "overview", "tool")
 #: Largest length a cell file takes, mm (1 km): a bigger one is a typo, and would only make
 #: MuJoCo's compiler or the closed forms fail later with less helpful words.
 MAX_MM = 1e6
+#: Smallest size of a solid, mm (1 um): a smaller one is a typo (MuJoCo's compiler refuses a
+#: geom of 1e-300 m: its volume and inertia vanish).
+MIN_SIZE_MM = 1e-3
+#: A coordinate (a position, a seam point) in mm (:class:`sim.core.tomlschema.Quantity`).
+COORD_MM = Quantity("a position in the cell", "mm", -MAX_MM, MAX_MM)
+#: A solid's size, radius or length in mm.
+SIZE_MM = Quantity("a size of a solid", "mm", MIN_SIZE_MM, MAX_MM)
+#: A ring's inner radius in mm (0: a full cylinder sector).
+INNER_RADIUS_MM = Quantity("an inner radius", "mm", 0.0, MAX_MM)
+#: A part's mass, kg.
+PART_MASS_KG = Quantity("a part's mass", "kg", 1e-6, 1000.0)
+#: A sliding friction coefficient.
+FRICTION = Quantity("a friction coefficient", "", 1e-6, 5.0)
+#: A colour component (RGB(A)).
+COLOR = Quantity("a colour component", "", 0.0, 1.0)
 #: A length or coordinate in mm, bounded.
-Mm = Annotated[float, Field(ge=-MAX_MM, le=MAX_MM)]
+Mm = COORD_MM.type
 #: A size in mm: positive, bounded.
-Size = Annotated[float, Field(gt=0, le=MAX_MM)]
+Size = SIZE_MM.type
+#: An orientation angle, deg (:data:`sim.core.tomlschema.ANGLE_DEG`).
+Deg = ANGLE_DEG.type
 
 
 def _vec3(default: list[float] | None = None):
@@ -99,7 +116,7 @@ class RobotBlock(Strict):
 
     model: str | None = None
     base_pos_mm: list[Mm] = _vec3([0.0, 0.0, 0.0])
-    base_euler_zyx_deg: list[float] = _vec3([0.0, 0.0, 0.0])
+    base_euler_zyx_deg: list[Deg] = _vec3([0.0, 0.0, 0.0])
     mount: Literal["floor", "ceiling"] = "floor"
     home_deg: list[float] | None = None
     start_deg: list[float] | None = None
@@ -111,20 +128,20 @@ class ObjectBlock(Strict):
     name: str = Field(pattern=_NAME)
     shape: Literal["box", "cylinder", "sphere", "mesh", "ring"]
     size_mm: list[Size] | None = Field(None, min_length=3, max_length=3)
-    radius_mm: float | None = Field(None, gt=0, le=MAX_MM)
-    inner_radius_mm: float | None = Field(None, ge=0, le=MAX_MM)
-    length_mm: float | None = Field(None, gt=0, le=MAX_MM)
-    arc_deg: list[float] | None = Field(None, min_length=2, max_length=2)
+    radius_mm: Size | None = None
+    inner_radius_mm: INNER_RADIUS_MM.type | None = None
+    length_mm: Size | None = None
+    arc_deg: list[Deg] | None = Field(None, min_length=2, max_length=2)
     segments: int | None = Field(None, ge=3, le=720)
     file: str | None = None
     mesh_unit: Literal["mm", "m"] = "mm"
     pos_mm: list[Mm] = _vec3([0.0, 0.0, 0.0])
-    euler_zyx_deg: list[float] = _vec3([0.0, 0.0, 0.0])
+    euler_zyx_deg: list[Deg] = _vec3([0.0, 0.0, 0.0])
     role: Literal["fixture", "workpiece", "part"] = "fixture"
-    mass_kg: float | None = Field(None, gt=0, le=1000)
-    color: list[float] | None = Field(None, min_length=3, max_length=4)
+    mass_kg: PART_MASS_KG.type | None = None
+    color: list[COLOR.type] | None = Field(None, min_length=3, max_length=4)
     material: Literal[MATERIALS] | None = None  # type: ignore[valid-type]
-    friction: float | None = Field(None, gt=0, le=5)
+    friction: FRICTION.type | None = None
     collide: bool = True
 
 

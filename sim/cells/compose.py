@@ -511,7 +511,9 @@ def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
     try:
         return mujoco.MjModel.from_xml_string(world.to_xml_string(), world.get_assets())
     except ValueError as exc:  # mujoco reports XML/compile errors as ValueError
-        raise CellsimError(f"cell model does not compile: {exc}") from None
+        # (on two lines: the error, then the element): one line
+        text = "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+        raise CellsimError(f"cell model does not compile: {text}") from None
 
 
 def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np.float64]

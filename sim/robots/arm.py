@@ -35,7 +35,13 @@ from numpy.typing import ArrayLike, NDArray
 from sim.core.tomlschema import load_toml
 from sim.errors import KinematicsError
 from sim.robots import opw
-from sim.robots.chain import Chain, chain_from_dh, chain_from_urdf
+from sim.robots.chain import (
+    Chain,
+    chain_from_dh,
+    chain_from_urdf,
+    range_problem,
+    turns_problem,
+)
 from sim.robots.five_axis import FiveAxisMap, five_axis_from_chain
 from sim.robots.numeric_ik import solve_ik as numeric_solve
 
@@ -201,10 +207,16 @@ def chain_from_robot_file(spec, path: Path) -> Chain:
             raise KinematicsError(f"{where}: kinematics.dh: required with convention = "
                                   f"\"{k.convention}\" (rows [a_mm, alpha_deg, d_mm, "
                                   "theta_offset_deg])")
+        from sim.robots.robotfile import DH_COLUMNS
+
+        names = ("a_mm", "alpha_deg", "d_mm", "theta_offset_deg")
         for i, row in enumerate(k.dh):
             if len(row) != 4:
                 raise KinematicsError(f"{where}: kinematics.dh[{i}]: {len(row)} values; a row is "
                                       "[a_mm, alpha_deg, d_mm, theta_offset_deg]")
+            for j, (value, quantity) in enumerate(zip(row, DH_COLUMNS.quantities, strict=True)):
+                quantity.read(value, f"{where}: kinematics.dh[{i}][{j}] ({names[j]})",
+                              KinematicsError)
         rows = np.array(k.dh, dtype=float)
         rows[:, 0] /= 1000.0
         rows[:, 2] /= 1000.0
@@ -221,10 +233,13 @@ def chain_from_robot_file(spec, path: Path) -> Chain:
             for i, r in enumerate(j.range_deg):
                 if len(r) != 2:
                     raise KinematicsError(f"{where}: joints.range_deg[{i}]: give [lower, upper]")
-                if r[0] > r[1]:
-                    raise KinematicsError(f"{where}: joints.range_deg[{i}]: lower {r[0]:g} > "
-                                          f"upper {r[1]:g}")
+                bad = range_problem(r[0], r[1])
+                if bad:
+                    raise KinematicsError(f"{where}: joints.range_deg[{i}]: {bad}")
             lo, hi = np.deg2rad(np.array(j.range_deg, dtype=float)).T
+            bad = turns_problem(lo, hi)
+            if bad:
+                raise KinematicsError(f"{where}: joints.range_deg: {bad}")
         chain = chain_from_dh(rows, k.convention, name=spec.name, lower=lo, upper=hi)
     return dataclasses.replace(chain, name=spec.name)
 

@@ -22,19 +22,76 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from sim.core.tomlschema import (
+    ANGLE_RAD,
+    INERTIA_KG_M2,
+    JOINT_RAD,
+    JOINT_SPEED_RAD_S,
+    LENGTH_M,
+    MASS_KG,
+    MIN_PRINCIPAL_INERTIA_KG_M2,
+    TORQUE_NM,
+    Quantity,
+)
 from sim.errors import KinematicsError
+
+#: A component of a URDF joint axis (normalised when read; a zero axis is refused).
+AXIS_COMPONENT = Quantity("an axis component", "", -1e6, 1e6)
+#: The numbers a URDF reader takes, by (element, attribute), with their physical ranges
+#: (:mod:`sim.core.tomlschema`); an ``<inertia>`` takes ``ixx`` ... ``izz``.
+URDF_QUANTITIES: dict[tuple[str, str], Quantity] = {
+    ("origin", "xyz"): LENGTH_M, ("origin", "rpy"): ANGLE_RAD, ("axis", "xyz"): AXIS_COMPONENT,
+    ("limit", "lower"): JOINT_RAD, ("limit", "upper"): JOINT_RAD,
+    ("limit", "velocity"): JOINT_SPEED_RAD_S, ("limit", "effort"): TORQUE_NM,
+    ("mass", "value"): MASS_KG,
+    **{("inertia", k): INERTIA_KG_M2 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
+}
+#: The URDF numbers for which 0 means "not given" (a massless link, a joint without an
+#: effort or velocity limit) rather than a value out of range.
+URDF_ZERO_IS_NONE = frozenset({("limit", "velocity"), ("limit", "effort"), ("mass", "value")})
+#: The most whole-turn variants one pose may have over a robot's joint ranges (the product over
+#: the joints of how many turns each range holds: +-360 deg on all six joints gives 3^6 = 729).
+#: The inverse kinematics lists every variant, so wider ranges would make it run for hours.
+MAX_TURN_VARIANTS = 1024
 
 
 def inertia_problem(inertia: NDArray[np.float64]) -> str:
-    """Why an inertia tensor about the centre of mass (3, 3) is not physical ("" when it is):
-    its principal moments must be >= 0 and satisfy the triangle inequality."""
+    """Why the inertia tensor about the centre of mass (3, 3) of a body with a mass is not
+    physical ("" when it is): its principal moments must be positive, at least
+    :data:`~sim.core.tomlschema.MIN_PRINCIPAL_INERTIA_KG_M2` (a zero tensor is a point mass,
+    which MuJoCo refuses for a moving body), and satisfy the triangle inequality."""
     ev = np.sort(np.linalg.eigvalsh(inertia))
-    scale = max(float(np.abs(ev).max()), 1e-300)
-    if ev[0] < -1e-9 * scale or ev[0] + ev[1] < ev[2] * (1 - 1e-9):
+    if ev[0] < MIN_PRINCIPAL_INERTIA_KG_M2 or ev[0] + ev[1] < ev[2] * (1 - 1e-9):
         return (f"inertia is not physical (principal moments "
-                f"{', '.join(f'{v:.4g}' for v in ev)} kg m^2: each must be >= 0 and no one "
-                "larger than the sum of the other two)")
+                f"{', '.join(f'{v:.4g}' for v in ev)} kg m^2: each must be at least "
+                f"{MIN_PRINCIPAL_INERTIA_KG_M2:g} and no one larger than the sum of the other "
+                "two)")
     return ""
+
+
+def range_problem(lower: float, upper: float) -> str:
+    """Why ``[lower, upper]`` is not a joint range ("" when it is): lower above upper, or an
+    empty range (a joint that cannot move, which MuJoCo's compiler refuses)."""
+    if lower > upper:
+        return f"lower {lower:g} > upper {upper:g}"
+    if lower == upper:
+        return f"lower {lower:g} = upper {upper:g} (an empty range: the joint cannot move)"
+    return ""
+
+
+def turns_problem(lower: ArrayLike, upper: ArrayLike) -> str:
+    """Why joint ranges (rad) hold too many whole-turn variants of a pose ("" when they do
+    not): more than :data:`MAX_TURN_VARIANTS`, counting ``floor(width / 2 pi) + 1`` per joint
+    with a finite range."""
+    counts = [int((hi - lo) // (2 * math.pi)) + 1
+              for lo, hi in zip(np.asarray(lower, float), np.asarray(upper, float), strict=True)
+              if math.isfinite(lo) and math.isfinite(hi)]
+    total = math.prod(counts)
+    if total <= MAX_TURN_VARIANTS:
+        return ""
+    return (f"the ranges give a pose up to {total} whole-turn variants ({' x '.join(map(str, counts))}"
+            f" over the joints), more than the {MAX_TURN_VARIANTS} the inverse kinematics lists: "
+            "narrow the ranges")
 
 
 def rot_axis(axis: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
@@ -250,7 +307,9 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
         path_joints.append(jname)
     path_joints.reverse()
 
-    def num(text: str | None, n: int, what: str) -> list[float]:
+    def num(text: str | None, n: int, what: str, key: tuple[str, str]) -> list[float]:
+        """The ``n`` numbers of an attribute (0 where it is absent), each in the range of
+        :data:`URDF_QUANTITIES` (0 too where :data:`URDF_ZERO_IS_NONE` says it means none)."""
         vals = (text or " ".join(["0"] * n)).split()
         try:
             out = [float(v) for v in vals]
@@ -258,6 +317,14 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
             raise KinematicsError(f"{path}: {what}: not numbers: {text!r}") from None
         if len(out) != n or not all(math.isfinite(v) for v in out):
             raise KinematicsError(f"{path}: {what}: needs {n} finite numbers, got {text!r}")
+        quantity = URDF_QUANTITIES[key]
+        for v in out:
+            if v == 0.0 and key in URDF_ZERO_IS_NONE:
+                continue
+            bad = quantity.problem(v)
+            if bad:
+                zero = " (or 0: none)" if key in URDF_ZERO_IS_NONE else ""
+                raise KinematicsError(f"{path}: {what}: {bad}{zero}")
         return out
 
     link_el = {ln.get("name"): ln for ln in root.findall("link")}
@@ -270,20 +337,21 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
         if el is None:
             return None
         o = el.find("origin")
-        xyz = num(None if o is None else o.get("xyz"), 3, f"link {link!r} inertial origin xyz")
-        rpy = num(None if o is None else o.get("rpy"), 3, f"link {link!r} inertial origin rpy")
+        xyz = num(None if o is None else o.get("xyz"), 3, f"link {link!r} inertial origin xyz",
+                  ("origin", "xyz"))
+        rpy = num(None if o is None else o.get("rpy"), 3, f"link {link!r} inertial origin rpy",
+                  ("origin", "rpy"))
         m_el, i_el = el.find("mass"), el.find("inertia")
-        mass = num(None if m_el is None else m_el.get("value"), 1, f"link {link!r} mass")[0]
-        if mass < 0:
-            raise KinematicsError(f"{path}: link {link!r}: mass {mass:g} < 0")
+        mass = num(None if m_el is None else m_el.get("value"), 1, f"link {link!r} mass value",
+                   ("mass", "value"))[0]
         if mass > 0 and i_el is None:
             raise KinematicsError(f"{path}: link {link!r}: <inertial> has a mass but no <inertia>")
         keys = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-        vals = [num(None if i_el is None else i_el.get(k), 1, f"link {link!r} inertia {k}")[0]
-                for k in keys]
+        vals = [num(None if i_el is None else i_el.get(k), 1, f"link {link!r} inertia {k}",
+                    ("inertia", k))[0] for k in keys]
         ixx, ixy, ixz, iyy, iyz, izz = vals
         Ic = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-        problem = inertia_problem(Ic)
+        problem = inertia_problem(Ic) if mass > 0 else ""  # a massless link is left out
         if problem:
             raise KinematicsError(f"{path}: link {link!r}: {problem}")
         T = where @ _T(rpy_matrix(*rpy), xyz)
@@ -306,8 +374,10 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
                 continue
             j = joints[jn]
             o = j.find("origin")
-            xyz = num(None if o is None else o.get("xyz"), 3, f"joint {jn!r} origin xyz")
-            rpy = num(None if o is None else o.get("rpy"), 3, f"joint {jn!r} origin rpy")
+            xyz = num(None if o is None else o.get("xyz"), 3, f"joint {jn!r} origin xyz",
+                      ("origin", "xyz"))
+            rpy = num(None if o is None else o.get("rpy"), 3, f"joint {jn!r} origin rpy",
+                      ("origin", "rpy"))
             parts += hanging(j.find("child").get("link"), where @ _T(rpy_matrix(*rpy), xyz),
                              seen | {link})
         return parts
@@ -331,8 +401,10 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
     for jname in path_joints:
         j = joints[jname]
         o = j.find("origin")
-        xyz = num(None if o is None else o.get("xyz"), 3, f"joint {jname!r} origin xyz")
-        rpy = num(None if o is None else o.get("rpy"), 3, f"joint {jname!r} origin rpy")
+        xyz = num(None if o is None else o.get("xyz"), 3, f"joint {jname!r} origin xyz",
+                  ("origin", "xyz"))
+        rpy = num(None if o is None else o.get("rpy"), 3, f"joint {jname!r} origin rpy",
+                  ("origin", "rpy"))
         T = pending @ _T(rpy_matrix(*rpy), xyz)
         jtype = j.get("type")
         child = j.find("child").get("link")
@@ -348,21 +420,22 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
                                   "(revolute and fixed joints only)")
         a = j.find("axis")
         axis = np.array(num("1 0 0" if a is None else a.get("xyz"), 3,
-                            f"joint {jname!r} axis"))
+                            f"joint {jname!r} axis xyz", ("axis", "xyz")))
         if np.linalg.norm(axis) < 1e-12:
             raise KinematicsError(f"{path}: joint {jname!r}: axis is zero")
         lim = j.find("limit")
         if lim is None or lim.get("lower") is None or lim.get("upper") is None:
             raise KinematicsError(f"{path}: joint {jname!r}: a revolute joint needs "
                                   "<limit lower=... upper=...>")
-        lower = num(lim.get("lower"), 1, f"joint {jname!r} limit lower")[0]
-        upper = num(lim.get("upper"), 1, f"joint {jname!r} limit upper")[0]
-        if lower > upper:
-            raise KinematicsError(f"{path}: joint {jname!r}: limit lower {lower:g} > upper "
-                                  f"{upper:g}")
+        lower = num(lim.get("lower"), 1, f"joint {jname!r} limit lower", ("limit", "lower"))[0]
+        upper = num(lim.get("upper"), 1, f"joint {jname!r} limit upper", ("limit", "upper"))[0]
+        bad = range_problem(lower, upper)
+        if bad:
+            raise KinematicsError(f"{path}: joint {jname!r}: limit {bad}")
         v = lim.get("velocity")
         e = lim.get("effort")
-        eff.append(num(e, 1, f"joint {jname!r} limit effort")[0] if e else 0.0)
+        eff.append(num(e, 1, f"joint {jname!r} limit effort", ("limit", "effort"))[0]
+                   if e else 0.0)
         parts = hanging(child, np.eye(4))
         bodies.append(parts)
         has_inertial.append(any(p is not None for p in parts))
@@ -371,10 +444,15 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
         names.append(jname)
         lo.append(lower)
         hi.append(upper)
-        vel.append(num(v, 1, f"joint {jname!r} limit velocity")[0] if v else np.inf)
+        speed = num(v, 1, f"joint {jname!r} limit velocity", ("limit", "velocity"))[0] \
+            if v else 0.0
+        vel.append(speed if speed > 0 else np.inf)  # 0: none given
         pending = np.eye(4)
     if not names:
         raise KinematicsError(f"{path}: no revolute joint between the root and {tip!r}")
+    bad = turns_problem(lo, hi)
+    if bad:
+        raise KinematicsError(f"{path}: joint limits: {bad}")
     fused = [fuse(b) for b in bodies]
     inertials = tuple(fused) if all(has_inertial) and all(f is not None for f in fused) else None
     note = "the moving links have no <inertial> (mass and inertia)"
@@ -387,4 +465,5 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
                  inertials, "" if inertials is not None else note)
 
 
-__all__ = ["Chain", "chain_from_dh", "chain_from_urdf", "rot_axis", "rpy_matrix"]
+__all__ = ["MAX_TURN_VARIANTS", "URDF_QUANTITIES", "Chain", "chain_from_dh", "chain_from_urdf",
+           "inertia_problem", "range_problem", "rot_axis", "rpy_matrix", "turns_problem"]

@@ -38,13 +38,37 @@ Every problem is one line naming the file and the key (:class:`sim.errors.Kinema
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field
 
-from sim.core.tomlschema import Strict, load_toml
+from sim.core.tomlschema import (
+    ANGLE_DEG,
+    EFFICIENCY,
+    GEAR_RATIO,
+    INERTIA_KG_M2,
+    JOINT_ACCEL_DEG_S2,
+    JOINT_DEG,
+    JOINT_SPEED_DEG_S,
+    LENGTH_MM,
+    MASS_KG,
+    PAYLOAD_KG,
+    ROTOR_INERTIA_KG_M2,
+    SPEED_RPM,
+    TORQUE_NM,
+    Columns,
+    Quantity,
+    Real,
+    Strict,
+    load_toml,
+)
 from sim.errors import HoldError, KinematicsError
+
+#: The quantities of a DH row's columns: ``[a_mm, alpha_deg, d_mm, theta_offset_deg]``.
+DH_COLUMNS = Columns((LENGTH_MM, ANGLE_DEG, LENGTH_MM, ANGLE_DEG))
+#: The entries of a maker matrix: joint-coupling factors (FANUC's J2/J3 coupling is 1).
+MAKER_FACTOR = Quantity("a joint-coupling factor", "", -100.0, 100.0)
 
 
 class FamilyKinematics(Strict):
@@ -52,22 +76,26 @@ class FamilyKinematics(Strict):
     or ``mdh``), or a URDF."""
 
     family: Literal["five_r", "fanuc6"] | None = None
-    dims_mm: dict[str, float] | None = None
+    dims_mm: dict[str, LENGTH_MM.type] | None = None
     convention: Literal["dh", "mdh", "urdf"] | None = None
-    dh: list[list[float]] | None = None
+    dh: Annotated[list[list[Real]], DH_COLUMNS] | None = None
     urdf: str | None = None
 
 
 class RobotJoints(Strict):
-    range_deg: list[list[float]] | None = None
-    home_deg: list[float] | None = None
-    max_speed_deg_s: list[float] | None = None
-    max_accel_deg_s2: list[float] | None = None
+    """``[joints]``: ranges and home (deg), speed and acceleration limits."""
+
+    range_deg: list[list[JOINT_DEG.type]] | None = None
+    home_deg: list[JOINT_DEG.type] | None = None
+    max_speed_deg_s: list[JOINT_SPEED_DEG_S.type] | None = None
+    max_accel_deg_s2: list[JOINT_ACCEL_DEG_S2.type] | None = None
 
 
 class RobotMass(Strict):
-    payload_kg: float = Field(0.0, ge=0)
-    total_kg: float | None = Field(None, gt=0)
+    """``[mass]``: the rated payload and, for a DH/URDF robot, the links' total mass."""
+
+    payload_kg: PAYLOAD_KG.type = 0.0
+    total_kg: MASS_KG.type | None = None
     estimated: bool | None = None
 
 
@@ -75,25 +103,29 @@ class LinkBlock(Strict):
     """One moving link's inertial (``[[links]]``, J1's link first), in its joint's frame at
     q = 0 (a URDF's child link frame of the joint; a DH arm's frame at the joint)."""
 
-    mass_kg: float = Field(gt=0)
-    com_mm: list[float] | None = Field(None, min_length=3, max_length=3)
-    inertia_kg_m2: list[float] | None = Field(None, min_length=6, max_length=6)
+    mass_kg: MASS_KG.type
+    com_mm: list[LENGTH_MM.type] | None = Field(None, min_length=3, max_length=3)
+    inertia_kg_m2: list[INERTIA_KG_M2.type] | None = Field(None, min_length=6, max_length=6)
     estimate: bool = False
     source: str = ""
 
 
 class DriveBlock(Strict):
-    gear_ratio: float = Field(gt=0)
-    efficiency: float = Field(gt=0, le=1)
-    rotor_inertia_kg_m2: float = Field(ge=0)
-    rated_torque_nm: float = Field(gt=0)
-    peak_torque_nm: float = Field(gt=0)
-    max_speed_rpm: float = Field(gt=0)
+    """``[[drives]]``: one joint's motor and reducer, motor side."""
+
+    gear_ratio: GEAR_RATIO.type
+    efficiency: EFFICIENCY.type
+    rotor_inertia_kg_m2: ROTOR_INERTIA_KG_M2.type
+    rated_torque_nm: TORQUE_NM.type
+    peak_torque_nm: TORQUE_NM.type
+    max_speed_rpm: SPEED_RPM.type
 
 
 class MakerBlock(Strict):
+    """``[maker]``: the controller's joint names and convention."""
+
     joints: list[str]
-    matrix: list[list[float]]
+    matrix: list[list[MAKER_FACTOR.type]]
 
 
 class RobotFolderSpec(Strict):

@@ -200,4 +200,4 @@ class Fanuc6(KinematicFamily):
 
     def reach(self) -> float:
         d = self._dims
-        return d["d2"] + d["d3"] + float(np.hypot(d["R4"], d["d4"]))
+        return abs(d["d2"]) + abs(d["d3"]) + float(np.hypot(d["R4"], d["d4"]))

@@ -214,7 +214,7 @@ class FiveR(KinematicFamily):
 
     def reach(self) -> float:
         d = self._dims
-        return d["l1"] + d["d1"] + d["l2"]
+        return abs(d["l1"]) + abs(d["d1"]) + abs(d["l2"])
 
     # ------------------------------------------------------------------ tcp frame
     def check_tcp_offset(self, robot: str, offset: NDArray[np.float64]) -> None:
