@@ -509,7 +509,7 @@ def test_a_reducers_average_torque_and_speed_limits_decide_the_pair(pick_selecti
     n_av = reducer["ratio"] * w_av * RPM
     scale = 1.01 if side == "under" else 0.99
     reducer.update(average_torque_limit_nm=scale * t_av,
-                   max_average_input_speed_rpm=(1.01 if side == "under" else 1e6) * n_av,
+                   max_average_input_speed_rpm=(1.01 if side == "under" else 100.0) * n_av,
                    life_exponent=10 / 3)
 
     def toml(entry: dict) -> str:
