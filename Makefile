@@ -1,7 +1,7 @@
 # cellsim: set-up and the two main commands.
 #   make run    set up everything, then run the default welding scenario
 #   make test   set up everything, then run the test suite (its fast share; make test-slow runs
-#               the slow share, which CI runs too)
+#               the slow share, make lint the static checks of the API; CI runs both too)
 # Set-up is idempotent: system packages are installed only when missing, the virtual
 # environment is (re)built only when pyproject.toml changes.
 
@@ -18,7 +18,7 @@ SLOW_JOBS ?= auto
 # Debian packages that headless rendering needs (EGL on Mesa, or OSMesa).
 SYSTEM_PACKAGES := libegl1 libgl1 libosmesa6 libglu1-mesa
 
-.PHONY: run test test-slow setup system-deps bench clean
+.PHONY: run test test-slow lint setup system-deps bench clean
 
 run: setup
 	$(BIN)/cellsim run $(SCENARIO) $(if $(OUT),--out $(OUT),)
@@ -32,6 +32,13 @@ test: setup
 test-slow: setup
 	@$(BIN)/python -m pytest -m slow -n $(SLOW_JOBS) $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
+
+# Static checks of the API face (the files pyproject.toml's [tool.mypy] names).
+LINT_FILES := sim/__init__.py sim/api sim/pipeline/variant_runs.py examples tests/test_api.py
+
+lint: setup
+	$(BIN)/ruff check $(LINT_FILES)
+	$(BIN)/python -m mypy
 
 bench: setup
 	$(BIN)/python benchmarks/run_all.py

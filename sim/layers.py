@@ -20,11 +20,16 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("analysis", ("sim.analysis",)),
     ("render", ("sim.render",)),
     ("pipeline", ("sim.pipeline",)),
+    ("api", ("sim.api",)),
     ("cli", ("sim.cli", "sim.__main__")),
 )
 
-#: The package root: every layer may import it (version, MUJOCO_GL default); it imports none.
+#: The package root: every layer may import it (version, MUJOCO_GL default); it imports only
+#: what it exports (:data:`ROOT_EXPORTS`), lazily, on first use of a name.
 ROOT = "sim"
+
+#: The modules the package root re-exports from: the API layer and the exception tree.
+ROOT_EXPORTS: tuple[str, ...] = ("sim.api", "sim.errors")
 
 
 def layer_of(module: str) -> int:

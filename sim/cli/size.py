@@ -19,9 +19,8 @@ import argparse
 import functools
 import os
 from pathlib import Path
-from typing import Any
 
-from sim.pipeline.sweep import Variant
+from sim.pipeline.variant_runs import run_batch, run_variant
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -97,76 +96,6 @@ def selection_overrides(args: argparse.Namespace) -> dict | None:
     return {"catalog": None if args.catalog is None else str(args.catalog),
             "life_h": args.life_h, "dwell_s": args.dwell_s, "rank": args.rank,
             "inertia_ratio_max": args.inertia_ratio_max}
-
-
-def run_variant(variant: Variant, selection: Any = None, keep_runs: bool = False,
-                plots: bool = False) -> Any:
-    """Run one sweep variant (module level, so worker processes and Ray tasks can import it).
-
-    Metrics only by default: the run is evaluated in memory and a
-    :class:`~sim.pipeline.sweep.VariantMetrics` (the variant's rows of the table) comes back.
-    With ``keep_runs`` the variant's run folder is also written (``variant.run_dir``; its rows
-    still come from every sample in memory). ``selection`` is the actuator selection's
-    settings with the catalogue loaded (:func:`sim.pipeline.run.selection_options`, once for
-    the whole sweep), or None.
-
-    A variant faster or heavier than the robot allows is still simulated (speed and
-    acceleration limits are not enforced): it stays in the tables with negative margins and a
-    failed verdict instead of being dropped.
-    """
-    from sim.pipeline.run import RunOptions, evaluate_scenario, run_and_write
-
-    scenario = _variant_scenario(variant)
-    if keep_runs:
-        ev = run_and_write(scenario, RunOptions(out_dir=variant.run_dir, video=False,
-                                                plots=plots, progress=False,
-                                                selection=selection))
-        return _metrics(variant, ev, run_dir=str(variant.run_dir))
-    return _metrics(variant, evaluate_scenario(scenario, RunOptions(
-        video=False, plots=False, progress=False, selection=selection)))
-
-
-def _variant_scenario(variant: Variant) -> Any:
-    import dataclasses
-
-    from sim.scenario import Scenario, load_scenario
-
-    base = variant.scenario if isinstance(variant.scenario, Scenario) \
-        else load_scenario(variant.scenario)
-    scenario = base.scaled(variant.speed_scale, variant.payload_kg)
-    return dataclasses.replace(scenario, simulation=scenario.simulation.model_copy(
-        update={"enforce_speed_limits": False, "enforce_accel_limits": False}))
-
-
-def _metrics(variant: Variant, ev: Any, run_dir: str | None = None) -> Any:
-    from sim.pipeline.sweep import VariantMetrics, rows_from
-
-    sized = ({j["joint"]: j for j in ev.sizing.to_dict()["joints"]}
-             if ev.sizing is not None else {})
-    rows = rows_from(variant, ev.record.arrays, ev.summary["joints"], ev.summary["verdict"],
-                     sized, run_dir or "")
-    return VariantMetrics(tuple(rows), ev.selection.to_dict() if ev.selection else None,
-                          timings_s=dict(ev.summary.get("timings_s", {})), run_dir=run_dir)
-
-
-def run_batch(variants: list[Variant], selection: Any = None) -> list[Any]:
-    """Every variant at once on MuJoCo Warp (``--backend warp``): planned one by one, simulated
-    as batches of one model structure, then checked and sized one by one; metrics only.
-    ``selection`` as for :func:`run_variant`."""
-    from sim.pipeline.run import RunOptions, evaluate_scenarios
-
-    # speed-major: the variants of one speed scale follow each other, so each plan is made
-    # once and reused for every payload
-    order = sorted(range(len(variants)),
-                   key=lambda i: (variants[i].speed_scale, variants[i].payload_kg))
-    scenarios = [_variant_scenario(variants[i]) for i in order]
-    evaluations = evaluate_scenarios(scenarios, RunOptions(
-        video=False, plots=False, progress=False, selection=selection, backend="warp"),
-        labels=[variants[i].label for i in order])
-    out: list[Any] = [None] * len(variants)
-    for i, ev in zip(order, evaluations):
-        out[i] = _metrics(variants[i], ev)
-    return out
 
 
 def run(args: argparse.Namespace) -> int:

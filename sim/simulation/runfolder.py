@@ -743,21 +743,22 @@ def _read_trajectory(path: Path, where: str) -> dict[str, np.ndarray]:
 
 
 def _read_summary(path: Path, where: str) -> dict[str, Any]:
-    """``summary.json`` as a dict (UTF-8, at most :data:`MAX_SUMMARY_BYTES`, a JSON object)."""
-    data = read_input(path, _file_error(path, f"{where}: summary.json"), "file",
+    """``summary.json`` (or another JSON file of the run) as a dict (UTF-8, at most
+    :data:`MAX_SUMMARY_BYTES`, a JSON object)."""
+    data = read_input(path, _file_error(path, f"{where}: {path.name}"), "file",
                       MAX_SUMMARY_BYTES)
     try:
         summary = json.loads(data.decode("utf-8"))
     except UnicodeDecodeError as exc:
-        raise RunFolderError(f"{where}: summary.json is not UTF-8 text ({exc.reason} at byte "
+        raise RunFolderError(f"{where}: {path.name} is not UTF-8 text ({exc.reason} at byte "
                              f"{exc.start})") from None
     except RecursionError:
-        raise RunFolderError(f"{where}: summary.json nests too deeply to read") from None
+        raise RunFolderError(f"{where}: {path.name} nests too deeply to read") from None
     except ValueError as exc:  # json.JSONDecodeError, and integers of too many digits
-        raise RunFolderError(f"{where}: summary.json is not valid JSON "
+        raise RunFolderError(f"{where}: {path.name} is not valid JSON "
                              f"({_show(str(exc), 160)})") from None
     if not isinstance(summary, dict):
-        raise RunFolderError(f"{where}: summary.json must hold a JSON object, not "
+        raise RunFolderError(f"{where}: {path.name} must hold a JSON object, not "
                              f"{type(summary).__name__}")
     return summary
 
@@ -1153,3 +1154,16 @@ def write_csv(folder: str | Path, arrays: Mapping[str, np.ndarray], joints: Sequ
 def failed_folder(out_dir: Path) -> Path:
     """Where a run that failed mid-simulation keeps what it recorded."""
     return out_dir.with_name(out_dir.name + FAILED_SUFFIX)
+
+
+def read_json(folder: str | Path, name: str) -> dict[str, Any] | None:
+    """A JSON file of a run folder (``summary.json``, ``sizing.json``) as a dict, read under the
+    same bounds as :func:`load_run` reads ``summary.json``; None when the folder has no such
+    file.
+
+    Raises:
+        RunFolderError: The file is a link out of the folder, too large, or not a JSON object.
+    """
+    where = f"run folder {str(folder)!r}"
+    path = _run_file(Path(folder), name, where, MAX_SUMMARY_BYTES)
+    return None if path is None else _read_summary(path, where)
