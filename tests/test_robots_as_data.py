@@ -757,7 +757,7 @@ def test_robot_format_reference_documents_every_key():
     """docs/robot-format.md and the declared robot.toml schema name the same keys."""
     import re
 
-    from sim.robots.robotfile import (
+    from sim.robots.schema import (
         DriveBlock,
         FamilyKinematics,
         LinkBlock,

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import HoldError
-from sim.robots.registry import RobotSpec, joint_ranges
+from sim.robots.spec import RobotSpec, joint_ranges
 
 #: Configurations sampled per robot (uniform in the joint ranges, fixed seed).
 SAMPLES = 4000

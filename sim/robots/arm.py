@@ -24,8 +24,10 @@ For a robot given by a DH table, frame 0 (``cellsim ik``) is the table's base fr
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,6 +46,7 @@ from sim.robots.chain import (
 )
 from sim.robots.five_axis import FiveAxisMap, five_axis_from_chain
 from sim.robots.numeric_ik import solve_ik as numeric_solve
+from sim.robots.schema import DH_COLUMNS, RobotFolderSpec
 
 
 @dataclass(frozen=True)
@@ -187,15 +190,13 @@ def arm_from_chain(chain: Chain, source: Path | None = None) -> Arm:
                "for 5 and 6)", source=source)
 
 
-def chain_from_robot_file(spec, path: Path) -> Chain:
-    """The chain of a ``robot.toml`` (:class:`sim.robots.robotfile.RobotFolderSpec`) that gives
+def chain_from_robot_file(spec: RobotFolderSpec, path: Path) -> Chain:
+    """The chain of a ``robot.toml`` (:class:`sim.robots.schema.RobotFolderSpec`) that gives
     a DH table or a URDF.
 
     Raises:
         KinematicsError: One line naming the file and the key.
     """
-    import dataclasses
-
     k = spec.kinematics
     where = str(path)
     if k.convention == "urdf":
@@ -207,8 +208,6 @@ def chain_from_robot_file(spec, path: Path) -> Chain:
             raise KinematicsError(f"{where}: kinematics.dh: required with convention = "
                                   f"\"{k.convention}\" (rows [a_mm, alpha_deg, d_mm, "
                                   "theta_offset_deg])")
-        from sim.robots.robotfile import DH_COLUMNS
-
         names = ("a_mm", "alpha_deg", "d_mm", "theta_offset_deg")
         for i, row in enumerate(k.dh):
             if len(row) != 4:
@@ -251,8 +250,6 @@ def load_arm(path: str | Path) -> Arm:
         KinematicsError: One line naming the file and the key or joint: missing file, a DH row
             of the wrong length, an unsupported joint type, limits with lower > upper.
     """
-    from sim.robots.robotfile import RobotFolderSpec
-
     path = Path(path)
     if path.is_dir():
         path = path / "robot.toml"
@@ -269,8 +266,6 @@ def is_arm_path(ref: str) -> bool:
     """A robot reference that names an arm given as data (a URDF, or a robot.toml with a DH
     table or a URDF) rather than a shipped robot or a robot folder with one of the seeds' closed
     forms (``[kinematics] family``, :mod:`sim.robots.robotfile`)."""
-    import tomllib
-
     p = Path(ref)
     if not (ref.endswith((".urdf", ".toml")) or "/" in ref or p.is_dir()):
         return False

@@ -27,11 +27,13 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from sim.core.resources import models_dir
 from sim.core.rotations import make_transform, rot_x, rot_z
 from sim.errors import KinematicsError
 
@@ -359,10 +361,6 @@ def write_examples(folder: str | None = None) -> list[str]:
     Returns:
         The paths written.
     """
-    from pathlib import Path
-
-    from sim.core.resources import models_dir
-
     out = Path(folder) if folder is not None else models_dir() / "examples"
     out.mkdir(parents=True, exist_ok=True)
     written = []

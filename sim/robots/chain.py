@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from sim.core.files import read_input
 from sim.core.tomlschema import (
     ANGLE_RAD,
     INERTIA_KG_M2,
@@ -34,6 +35,7 @@ from sim.core.tomlschema import (
     Quantity,
 )
 from sim.errors import KinematicsError
+from sim.robots.builder import DHRow, MDHRow
 
 #: A component of a URDF joint axis (normalised when read; a zero axis is refused).
 AXIS_COMPONENT = Quantity("an axis component", "", -1e6, 1e6)
@@ -227,8 +229,6 @@ def chain_from_dh(rows: ArrayLike, convention: str = "dh", *, name: str = "arm",
         raise KinematicsError(f"{name}: convention must be 'dh' or 'mdh', got {convention!r}")
     # the table rows of sim.robots.builder (the MJCF chain builder) give each row's constant
     # transform; the joint turns about the z axis before (dh) or after (mdh) it
-    from sim.robots.builder import DHRow, MDHRow
-
     n = len(rows_a)
     z = np.array([0.0, 0.0, 1.0])
     if convention == "dh":
@@ -259,8 +259,6 @@ def chain_from_urdf(path: str | Path, tip: str | None = None) -> Chain:
             planar or floating joint on the chain, limits with lower > upper (one line naming the
             file and the joint).
     """
-    from sim.core.files import read_input
-
     path = Path(path)
     data = read_input(path, KinematicsError, "URDF file")
     try:

@@ -15,7 +15,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
-from sim.robots.registry import Drive
+from sim.robots.drive import Drive
 
 _DRIVE_FIELDS = tuple(f.name for f in dataclasses.fields(Drive))
 

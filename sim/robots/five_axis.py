@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import KinematicsError, UnreachableError
+from sim.robots.families import FiveR
 
 TOL = 1e-9
 
@@ -43,9 +44,7 @@ class FiveAxisMap:
     offsets: tuple[float, ...]
     flange: NDArray[np.float64] = field(compare=False)
 
-    def family(self):
-        from sim.robots.families import FiveR
-
+    def family(self) -> FiveR:
         return FiveR(self.dims)
 
     def theta(self, q) -> NDArray[np.float64]:
@@ -133,8 +132,6 @@ def five_axis_from_chain(chain) -> FiveAxisMap:
              int(np.sign(axes[3] @ yf)), int(np.sign(a5 @ v4f)))
     offsets = (math.atan2(e[1], e[0]), th2, th23 - th2, th234 - th23, 0.0)
     dims = {"l1": l1, "d1": d1, "l2": l2, "l3": l3}
-    from sim.robots.families import FiveR
-
     T0 = FiveR(dims).fk(np.asarray(offsets))
     T0 = T0.copy()
     T0[2, 3] += h

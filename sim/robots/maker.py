@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sim.robots.registry import RobotSpec
+from sim.robots.spec import RobotSpec
 
 
 def maker_matrix(spec: RobotSpec) -> NDArray[np.float64]:

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from sim.core.rotations import invert_transform
 from sim.errors import KinematicsError
 from sim.robots.families import KinematicFamily
-from sim.robots.registry import RobotSpec, joint_ranges
+from sim.robots.spec import RobotSpec, joint_ranges
 
 
 def _as_batch(q: ArrayLike, n: int) -> tuple[NDArray[np.float64], bool]:
@@ -139,7 +139,7 @@ def kinematic_model(spec: RobotSpec) -> KinematicModel:
     ``frame0``); :mod:`sim.robots.mujoco_fk` checks it holds at every q (tests). An offset the
     family's analytic IK cannot handle falls back to the seed's tool frame with a warning.
     """
-    from sim.robots.mujoco_fk import MujocoKinematics
+    from sim.robots.mujoco_fk import MujocoKinematics  # imports mujoco: only when used
 
     model = closed_form_model(spec)
     mj = MujocoKinematics.for_robot(spec)

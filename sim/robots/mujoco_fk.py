@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sim.errors import KinematicsError
-from sim.robots.registry import RobotSpec
+from sim.robots.spec import RobotSpec
 
 
 class MujocoKinematics:

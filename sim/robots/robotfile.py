@@ -37,119 +37,37 @@ Every problem is one line naming the file and the key (:class:`sim.errors.Kinema
 
 from __future__ import annotations
 
+import dataclasses
+import json
+import math
+import os
+import re
+import tempfile
+import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import Field
 
-from sim.core.tomlschema import (
-    ANGLE_DEG,
-    EFFICIENCY,
-    GEAR_RATIO,
-    INERTIA_KG_M2,
-    JOINT_ACCEL_DEG_S2,
-    JOINT_DEG,
-    JOINT_SPEED_DEG_S,
-    LENGTH_MM,
-    MASS_KG,
-    PAYLOAD_KG,
-    ROTOR_INERTIA_KG_M2,
-    SPEED_RPM,
-    TORQUE_NM,
-    Columns,
-    Quantity,
-    Real,
-    Strict,
-    load_toml,
-)
+from sim.core.resources import models_dir
+from sim.core.tomlschema import load_toml
 from sim.errors import HoldError, KinematicsError
-
-#: The quantities of a DH row's columns: ``[a_mm, alpha_deg, d_mm, theta_offset_deg]``.
-DH_COLUMNS = Columns((LENGTH_MM, ANGLE_DEG, LENGTH_MM, ANGLE_DEG))
-#: The entries of a maker matrix: joint-coupling factors (FANUC's J2/J3 coupling is 1).
-MAKER_FACTOR = Quantity("a joint-coupling factor", "", -100.0, 100.0)
-
-
-class FamilyKinematics(Strict):
-    """``[kinematics]``: one of the seeds' families with its dimensions, or a DH table (``dh``
-    or ``mdh``), or a URDF."""
-
-    family: Literal["five_r", "fanuc6"] | None = None
-    dims_mm: dict[str, LENGTH_MM.type] | None = None
-    convention: Literal["dh", "mdh", "urdf"] | None = None
-    dh: Annotated[list[list[Real]], DH_COLUMNS] | None = None
-    urdf: str | None = None
+from sim.robots.accel_limits import derive_accel_limits
+from sim.robots.arm import arm_from_chain, chain_from_robot_file
+from sim.robots.chain import Chain, chain_from_urdf, inertia_problem
+from sim.robots.drive import Drive
+from sim.robots.families import Fanuc6, FiveR
+from sim.robots.families.chain_family import ChainFamily
+from sim.robots.generate import generated_model_path, model_text, scene_text
+from sim.robots.schema import RobotFolderSpec
+from sim.robots.spec import RobotSpec
 
 
-class RobotJoints(Strict):
-    """``[joints]``: ranges and home (deg), speed and acceleration limits."""
-
-    range_deg: list[list[JOINT_DEG.type]] | None = None
-    home_deg: list[JOINT_DEG.type] | None = None
-    max_speed_deg_s: list[JOINT_SPEED_DEG_S.type] | None = None
-    max_accel_deg_s2: list[JOINT_ACCEL_DEG_S2.type] | None = None
-
-
-class RobotMass(Strict):
-    """``[mass]``: the rated payload and, for a DH/URDF robot, the links' total mass."""
-
-    payload_kg: PAYLOAD_KG.type = 0.0
-    total_kg: MASS_KG.type | None = None
-    estimated: bool | None = None
-
-
-class LinkBlock(Strict):
-    """One moving link's inertial (``[[links]]``, J1's link first), in its joint's frame at
-    q = 0 (a URDF's child link frame of the joint; a DH arm's frame at the joint)."""
-
-    mass_kg: MASS_KG.type
-    com_mm: list[LENGTH_MM.type] | None = Field(None, min_length=3, max_length=3)
-    inertia_kg_m2: list[INERTIA_KG_M2.type] | None = Field(None, min_length=6, max_length=6)
-    estimate: bool = False
-    source: str = ""
-
-
-class DriveBlock(Strict):
-    """``[[drives]]``: one joint's motor and reducer, motor side."""
-
-    gear_ratio: GEAR_RATIO.type
-    efficiency: EFFICIENCY.type
-    rotor_inertia_kg_m2: ROTOR_INERTIA_KG_M2.type
-    rated_torque_nm: TORQUE_NM.type
-    peak_torque_nm: TORQUE_NM.type
-    max_speed_rpm: SPEED_RPM.type
-
-
-class MakerBlock(Strict):
-    """``[maker]``: the controller's joint names and convention."""
-
-    joints: list[str]
-    matrix: list[list[MAKER_FACTOR.type]]
-
-
-class RobotFolderSpec(Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_-][A-Za-z0-9_.-]*$")
-    title: str | None = None
-    description: str = ""
-    mjcf: str | None = None
-    kinematics: FamilyKinematics
-    joints: RobotJoints = RobotJoints()
-    mass: RobotMass = RobotMass()
-    links: list[LinkBlock] = []
-    drives: list[DriveBlock] = []
-    maker: MakerBlock | None = None
-
-
-def load_robot_folder(folder: str | Path):  # -> RobotSpec (imported lazily: no cycle)
+def load_robot_folder(folder: str | Path) -> RobotSpec:
     """The :class:`sim.robots.registry.RobotSpec` of a robot folder.
 
     Raises:
         KinematicsError: One line naming the file and the key.
     """
-    from sim.robots.families import Fanuc6, FiveR
-    from sim.robots.registry import Drive, RobotSpec
-
     folder = Path(folder)
     path = folder / "robot.toml" if folder.is_dir() else folder
     folder = path.parent
@@ -187,8 +105,6 @@ def load_robot_folder(folder: str | Path):  # -> RobotSpec (imported lazily: no 
                               "inertials there (give [mass] estimated = true where they are "
                               "estimates)")
     maker_joints, maker_matrix = _maker(spec, n, where)
-    from sim.core.resources import models_dir
-
     shipped = folder.resolve().parent == models_dir().resolve()
     return RobotSpec(
         name=spec.name, title=spec.title or spec.name,
@@ -197,9 +113,7 @@ def load_robot_folder(folder: str | Path):  # -> RobotSpec (imported lazily: no 
         family=family,
         max_speed=tuple(float(v) for v in np.deg2rad(spec.joints.max_speed_deg_s)),
         description=spec.description,
-        drives=tuple(Drive(d.gear_ratio, d.efficiency, d.rotor_inertia_kg_m2,
-                           d.rated_torque_nm, d.peak_torque_nm, d.max_speed_rpm)
-                     for d in spec.drives),
+        drives=_drives(spec),
         payload_kg=spec.mass.payload_kg,
         max_accel=() if spec.joints.max_accel_deg_s2 is None else tuple(
             float(v) for v in np.deg2rad(spec.joints.max_accel_deg_s2)),
@@ -207,13 +121,17 @@ def load_robot_folder(folder: str | Path):  # -> RobotSpec (imported lazily: no 
         estimated_links=(True,) * n if spec.mass.estimated else ())
 
 
-def _mass_model(spec: RobotFolderSpec, chain, where: str) -> tuple[object, tuple[bool, ...]]:
+def _drives(spec: RobotFolderSpec) -> tuple[Drive, ...]:
+    """``[[drives]]`` as :class:`~sim.robots.drive.Drive` objects, J1's first."""
+    return tuple(Drive(d.gear_ratio, d.efficiency, d.rotor_inertia_kg_m2, d.rated_torque_nm,
+                       d.peak_torque_nm, d.max_speed_rpm) for d in spec.drives)
+
+
+def _mass_model(spec: RobotFolderSpec, chain: Chain, where: str) -> tuple[object, tuple[bool, ...]]:
     """The links' mass model for :mod:`sim.robots.generate` (``[[links]]``, a URDF's inertials
     or ``[mass] total_kg``) and which links' inertials are estimates: every capsule of a total
     mass; a ``[[links]]`` entry marked ``estimate`` or without its centre of mass and inertia
     (a capsule of its mass); every link where ``[mass] estimated = true``."""
-    from sim.robots.chain import inertia_problem
-
     n = chain.n
     if spec.links:
         if len(spec.links) != n:
@@ -254,7 +172,8 @@ def _mass_model(spec: RobotFolderSpec, chain, where: str) -> tuple[object, tuple
     return mass, estimated
 
 
-def _maker(spec: RobotFolderSpec, n: int, where: str):
+def _maker(spec: RobotFolderSpec, n: int, where: str
+           ) -> tuple[tuple[str, ...], tuple[tuple[float, ...], ...]]:
     if spec.maker is None:
         return (), ()
     M = np.array(spec.maker.matrix, dtype=float)
@@ -265,15 +184,9 @@ def _maker(spec: RobotFolderSpec, n: int, where: str):
     return tuple(spec.maker.joints), tuple(tuple(float(v) for v in row) for row in M)
 
 
-def _data_robot(spec: RobotFolderSpec, path: Path):
+def _data_robot(spec: RobotFolderSpec, path: Path) -> RobotSpec:
     """A robot given by a DH table or a URDF: its chain, the :class:`ChainFamily`, a generated
     MJCF (:mod:`sim.robots.generate`) and acceleration limits derived from the drives."""
-    import dataclasses
-
-    from sim.robots.arm import arm_from_chain, chain_from_robot_file
-    from sim.robots.families.chain_family import ChainFamily
-    from sim.robots.registry import Drive, RobotSpec
-
     where = str(path)
     chain = chain_from_robot_file(spec, path)
     n = chain.n
@@ -291,8 +204,7 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     else:
         raise KinematicsError(f"{where}: joints.max_speed_deg_s: required (the URDF gives no "
                               "velocity limits)")
-    drives = tuple(Drive(d.gear_ratio, d.efficiency, d.rotor_inertia_kg_m2, d.rated_torque_nm,
-                         d.peak_torque_nm, d.max_speed_rpm) for d in spec.drives)
+    drives = _drives(spec)
     home = _home(spec, chain, where)
     if spec.mjcf is not None:
         # a shipped robot keeps its generated model in its folder (models/build_data_robots.py)
@@ -302,10 +214,6 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
                                   "cellsim generates the model into its cache)")
         _check_kept_model(model, chain, home, where)
     else:
-        # (imported here: it imports mujoco, which a shipped robot's load must not, so that
-        # the CLI can still choose the GL backend after loading the registry)
-        from sim.robots.generate import generated_model_path
-
         key = path.read_text(encoding="utf-8")
         if spec.kinematics.urdf is not None:
             key += (path.parent / spec.kinematics.urdf).read_text(encoding="utf-8",
@@ -314,8 +222,6 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
                                      key + f"|payload {spec.mass.payload_kg!r}",
                                      payload_kg=spec.mass.payload_kg, home=home)
     maker_joints, maker_matrix = _maker(spec, n, where)
-    from sim.core.resources import models_dir
-
     shipped = model.parent.resolve().parent == models_dir().resolve()
     robot = RobotSpec(
         name=spec.name, title=spec.title or spec.name,
@@ -333,12 +239,10 @@ def _data_robot(spec: RobotFolderSpec, path: Path):
     return dataclasses.replace(robot, max_accel=tuple(float(v) for v in accel))
 
 
-def _derived_accel(robot, payload_kg: float, cache: Path | None, where: str) -> np.ndarray:
+def _derived_accel(robot: RobotSpec, payload_kg: float, cache: Path | None, where: str) -> np.ndarray:
     """Acceleration limits derived from the drives (:mod:`sim.robots.accel_limits`), rad/s^2,
     kept beside a generated model in cellsim's cache (whose key covers the drives, the
     masses and the payload): a second load neither recomputes them nor imports mujoco."""
-    import json
-
     n = robot.n_joints
     path = None if cache is None else cache / "accel_limits.json"
     if path is not None and path.is_file():
@@ -348,16 +252,11 @@ def _derived_accel(robot, payload_kg: float, cache: Path | None, where: str) -> 
                 return v
         except (OSError, ValueError):
             pass  # recomputed below
-    from sim.robots.accel_limits import derive_accel_limits
-
     try:
         accel = np.asarray(derive_accel_limits(robot, payload_kg, samples=500), dtype=float)
     except HoldError as exc:
         raise HoldError(f"{where}: {exc}", exc.needs) from None
     if path is not None:
-        import os
-        import tempfile
-
         try:
             fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".accel.", suffix=".tmp")
             with os.fdopen(fd, "w", encoding="utf-8") as fh:
@@ -368,7 +267,7 @@ def _derived_accel(robot, payload_kg: float, cache: Path | None, where: str) -> 
     return accel
 
 
-def load_urdf_robot(path: str | Path):  # -> RobotSpec
+def load_urdf_robot(path: str | Path) -> RobotSpec:
     """A robot straight from a URDF file (``robot = "arm.urdf"`` in a scenario): the chain from
     the root link to ``tool0`` (else the last link), the URDF's own ``<inertial>`` elements as
     the link masses, and its ``<limit effort velocity>`` as the drives: a direct drive per
@@ -382,14 +281,6 @@ def load_urdf_robot(path: str | Path):  # -> RobotSpec
             run as it is (no inertials, no effort or velocity limits) says which robot.toml
             keys supply what is missing.
     """
-    import dataclasses
-    import math
-
-    from sim.robots.arm import arm_from_chain
-    from sim.robots.chain import chain_from_urdf
-    from sim.robots.families.chain_family import ChainFamily
-    from sim.robots.registry import Drive, RobotSpec
-
     path = Path(path)
     chain = chain_from_urdf(path)
     if chain.inertials is None:
@@ -405,10 +296,6 @@ def load_urdf_robot(path: str | Path):  # -> RobotSpec
                                   "give it a robot folder with joints.max_speed_deg_s")
     drives = tuple(Drive(1.0, 1.0, 0.0, float(e), float(e), float(v) * 60.0 / (2.0 * math.pi))
                    for e, v in zip(chain.max_effort, chain.max_speed, strict=True))
-    import re
-
-    from sim.robots.generate import generated_model_path
-
     # the model's file and MJCF name: the URDF's robot name where it is a plain name
     name = chain.name if re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9_.-]*", chain.name or "") else \
         re.sub(r"[^A-Za-z0-9_.-]", "_", path.stem).lstrip(".") or "robot"
@@ -423,11 +310,9 @@ def load_urdf_robot(path: str | Path):  # -> RobotSpec
     return dataclasses.replace(robot, max_accel=tuple(float(v) for v in accel))
 
 
-def _check_kept_model(model: Path, chain, home, where: str) -> None:
+def _check_kept_model(model: Path, chain: Chain, home: np.ndarray | None, where: str) -> None:
     """A generated model kept in the folder (``mjcf``) must still be the chain's: its joint
     ranges and ``home`` keyframe are compared (read as XML: mujoco is not imported here)."""
-    import xml.etree.ElementTree as ET
-
     try:
         root = ET.parse(model).getroot()
     except (ET.ParseError, OSError) as exc:
@@ -449,7 +334,7 @@ def _check_kept_model(model: Path, chain, home, where: str) -> None:
                               "(models/build_data_robots.py) or leave mjcf out")
 
 
-def _home(spec: RobotFolderSpec, chain, where: str):
+def _home(spec: RobotFolderSpec, chain: Chain, where: str) -> np.ndarray | None:
     """``[joints] home_deg`` in rad (None when not given), checked against the ranges."""
     h = spec.joints.home_deg
     if h is None:
@@ -469,11 +354,6 @@ def generated_files(folder: str | Path) -> dict[Path, str]:
     """The model files cellsim generates for a robot folder given by a DH table or a URDF with
     ``mjcf`` set: ``{folder/mjcf: MJCF text, folder/scene.xml: scene}`` (written and checked by
     ``models/build_data_robots.py``)."""
-    from types import SimpleNamespace
-
-    from sim.robots.arm import chain_from_robot_file
-    from sim.robots.generate import model_text, scene_text
-
     path = Path(folder) / "robot.toml"
     spec, _ = load_toml(path, RobotFolderSpec, KinematicsError)
     if spec.kinematics.convention is None or spec.mjcf is None:
@@ -486,10 +366,7 @@ def generated_files(folder: str | Path) -> dict[Path, str]:
     if len(spec.drives) != chain.n:
         raise KinematicsError(f"{path}: drives: {len(spec.drives)} drives for {chain.n} joints")
     mass, _ = _mass_model(spec, chain, str(path))
-    # the registry's Drive fields (not imported: the registry loads this very folder)
-    drives = tuple(SimpleNamespace(gear_ratio=d.gear_ratio, efficiency=d.efficiency,
-                                   rotor_inertia=d.rotor_inertia_kg_m2,
-                                   peak_torque=d.peak_torque_nm) for d in spec.drives)
+    drives = _drives(spec)
     xml = model_text(chain, spec.name, drives, mass, spec.mass.payload_kg,
                      home=_home(spec, chain, str(path)))
     return {path.parent / spec.mjcf: xml, path.parent / "scene.xml": scene_text(spec.name)}
