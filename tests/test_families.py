@@ -34,12 +34,75 @@ def _seed_fk(family: KinematicFamily, q: np.ndarray) -> np.ndarray:
     return T
 
 
+def _rz(t: float) -> np.ndarray:
+    T = np.eye(4)
+    T[:2, :2] = [[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]]
+    return T
+
+
+def _ry(t: float) -> np.ndarray:
+    T = np.eye(4)
+    T[0, 0], T[0, 2], T[2, 0], T[2, 2] = np.cos(t), np.sin(t), -np.sin(t), np.cos(t)
+    return T
+
+
+def _rx(t: float) -> np.ndarray:
+    T = np.eye(4)
+    T[1:3, 1:3] = [[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]]
+    return T
+
+
+def _move(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, 3] = x, y, z
+    return T
+
+
+def _product_fk(family_key: str, dims_mm: dict[str, float], q: np.ndarray) -> np.ndarray:
+    """Tool frame as a product of elementary transforms written here from the papers (not
+    cellsim's code): the 5R arm of seed 000 (J1 about z, J2..J4 about y, J5 about the tool's
+    x; l1, d1, l2, l3), and the 200iC's modified DH table of seed 004 (Khalil-Dombre rows
+    ``Rx(alpha) Tx(d) Rz(theta) Tz(r)``, theta2 offset pi/2, the tool R6 along z6)."""
+    d = {k: v / 1000.0 for k, v in dims_mm.items()}
+    if family_key == "five_r":
+        q1, q2, q3, q4, q5 = q
+        return (_rz(q1) @ _move(x=d["l1"]) @ _ry(q2) @ _move(z=d["d1"]) @ _ry(q3)
+                @ _move(x=d["l2"]) @ _ry(q4) @ _move(x=d["l3"]) @ _rx(q5))
+    assert family_key == "fanuc6"
+    h = np.pi / 2
+    rows = [(0.0, 0.0, q[0], 0.0), (h, d["d2"], h + q[1], 0.0), (0.0, d["d3"], q[2], 0.0),
+            (h, d["d4"], q[3], d["R4"]), (-h, 0.0, q[4], 0.0), (h, 0.0, q[5], 0.0)]
+    T = np.eye(4)
+    for alpha, a, theta, r in rows:
+        T = T @ _rx(alpha) @ _move(x=a) @ _rz(theta) @ _move(z=r)
+    return T @ _move(z=d["R6"])
+
+
 @pytest.mark.parametrize("name", ALL_ROBOTS)
-def test_spec_holds_a_family_object(name):
-    family = ROBOTS[name].family
+def test_family_is_the_robot_files_data(name):
+    """Replaces test_spec_holds_a_family_object, whose ``spec.dims == family.dims`` restated
+    the property (``RobotSpec.dims`` returns ``family.dims``): the family has as many joints as
+    the shipped MJCF has hinges and robot.toml has drives, and a seed family's dims and forward
+    kinematics are those of robot.toml's ``dims_mm`` put through a product of transforms
+    written in this test (so a loader that scaled, dropped or swapped a dimension fails)."""
+    import tomllib
+
+    import mujoco
+
+    spec = ROBOTS[name]
+    family = spec.family
+    toml = tomllib.loads((spec.robot_path.parent / "robot.toml").read_text(encoding="utf-8"))
     assert isinstance(family, KinematicFamily)
-    assert family.n_joints == ROBOTS[name].n_joints
-    assert ROBOTS[name].dims == family.dims
+    model = mujoco.MjModel.from_xml_path(str(spec.robot_path))
+    assert family.n_joints == model.njnt == len(toml["drives"])
+    key = toml["kinematics"].get("family")
+    if key is None:  # an arm given as data: checked against its URDF in test_robots_as_data
+        return
+    dims_mm = toml["kinematics"]["dims_mm"]
+    assert {k: family.dims[k] for k in dims_mm} == pytest.approx(
+        {k: v / 1000.0 for k, v in dims_mm.items()}, abs=1e-15)
+    for q in _random_q(name, 20, seed=5):
+        np.testing.assert_allclose(family.fk(q), _product_fk(key, dims_mm, q), atol=1e-12)
 
 
 @pytest.mark.parametrize("name", SEED_ROBOTS)

@@ -248,9 +248,37 @@ def test_bad_pose_input():
         ik_path(m, np.eye(4))
 
 
-def test_registry_dims_used():
-    for name in ALL_ROBOTS:
-        assert closed_form_model(ROBOTS[name]).dims == get_robot(name).dims
+@pytest.mark.parametrize("name", ALL_ROBOTS)
+def test_ik_puts_mujocos_tcp_on_the_pose(name):
+    """Replaces test_registry_dims_used (``closed_form_model(spec).dims == spec.dims``, the
+    same dict passed through): poses taken from MuJoCo's compile of the shipped MJCF (site
+    ``tcp`` in site ``frame0``) at random in-range configurations; every IK solution of the
+    robot's kinematic model, set in MuJoCo, puts the tcp on the pose, and one of them is the
+    configuration the pose came from. Fails when the model's dimensions, tcp offset or IK
+    differ from the MJCF a person edits."""
+    import mujoco
+
+    spec = get_robot(name)
+    m = kinematic_model(spec)
+    mj = mujoco.MjModel.from_xml_path(str(spec.robot_path))
+    data = mujoco.MjData(mj)
+    f0, tcp = mj.site("frame0").id, mj.site("tcp").id
+
+    def tcp_in_frame0(q: np.ndarray) -> np.ndarray:
+        data.qpos[:] = q
+        mujoco.mj_kinematics(mj, data)
+        R0 = data.site_xmat[f0].reshape(3, 3)
+        return make_transform(R0.T @ data.site_xmat[tcp].reshape(3, 3),
+                              R0.T @ (data.site_xpos[tcp] - data.site_xpos[f0]))
+
+    lo, hi = np.clip(mj.jnt_range.T, -np.pi, np.pi)
+    for q in np.random.default_rng(11).uniform(lo, hi, size=(5, mj.njnt)):
+        T = tcp_in_frame0(q)
+        sols = solve_ik(m, T, current=q)
+        assert sols
+        for s in sols:
+            np.testing.assert_allclose(tcp_in_frame0(s.q), T, atol=1e-7)
+        assert min(np.abs(wrap_to_pi(s.q - q)).max() for s in sols) < 1e-6
 
 
 def test_5axis_orientation_tolerance_for_typed_angles():

@@ -85,7 +85,8 @@ def test_compiles_and_steps_with_random_controls(name, which):
 
 @pytest.mark.parametrize("name", NAMES)
 def test_structure_names_and_sites(name):
-    """One top-level body without free joint; j1..jN, a1..aN; sites; frame0 at the J2 height."""
+    """One top-level body without free joint; j1..jN, a1..aN; frame0 at the J2 height; the
+    ``wrist`` site on every wrist axis (J4 onwards) wherever the arm is."""
     spec = ROBOTS[name]
     model = _model(spec.robot_path)
     tops = [b for b in range(1, model.nbody) if model.body_parentid[b] == 0]
@@ -93,9 +94,18 @@ def test_structure_names_and_sites(name):
     assert model.njnt == spec.n_joints and np.all(model.jnt_type == mujoco.mjtJoint.mjJNT_HINGE)
     assert [model.joint(i).name for i in range(model.njnt)] == list(spec.joints)
     assert [model.actuator(i).name for i in range(model.nu)] == [f"a{i + 1}" for i in range(spec.n_joints)]
-    for site in ("frame0", "wrist", "flange", "tcp"):
-        assert model.site(site).id >= 0
     data = mujoco.MjData(model)
+    # (replaces ``model.site(s).id >= 0``, which could not fail: model.site raises first)
+    # the wrist centre the IK and the reach use is where the wrist axes meet: the site lies on
+    # the line of J4, J5 (and J6) in MuJoCo's own joint frames, at random configurations
+    wrist = model.site("wrist").id
+    for q in np.random.default_rng(4).uniform(*model.jnt_range.T, size=(20, model.njnt)):
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        for j in range(3, model.njnt):
+            off = data.site_xpos[wrist] - data.xanchor[j]
+            assert np.linalg.norm(np.cross(off, data.xaxis[j])) < 1e-9, (model.joint(j).name, q)
+    data.qpos[:] = model.qpos0
     mujoco.mj_kinematics(model, data)
     h = _frame0_height(spec)
     np.testing.assert_allclose(data.site_xpos[model.site("frame0").id], [0, 0, h], atol=1e-12)
