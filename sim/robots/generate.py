@@ -2,7 +2,7 @@
 
 For a robot folder whose ``robot.toml`` gives a DH table or a URDF
 (:mod:`sim.robots.robotfile`), cellsim writes the model itself, in the Menagerie style of the
-shipped robots (``models/build_models.py``):
+seeds' shipped robots (``models/README.md``):
 
 * one body per joint at the chain's joint frame, a hinge ``j1..jn`` about the joint axis with
   the range, the armature (each drive's reflected rotor inertia, ``rotor * ratio^2``), and a
@@ -325,7 +325,7 @@ def diag_inertia_range(model: mujoco.MjModel, n: int, lower, upper, samples: int
                        seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Smallest and largest diagonal of the joint-space inertia matrix (armature included),
     per joint, over random configurations in the joint ranges, kg m^2 (the gains' basis here
-    and in ``models/build_models.py``)."""
+    and in the seeds' shipped models)."""
     import mujoco
 
     data = mujoco.MjData(model)
