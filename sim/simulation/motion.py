@@ -616,7 +616,7 @@ def _seam_pose(tgt: Any, ctx: CartesianContext, label: str) -> NDArray[np.float6
     ``retract_mm``)."""
     seam = _seam(ctx, tgt.seam, f"{label}.to_seam")
     s = 0.0 if tgt.seam_end == "start" else seam.length()
-    if getattr(ctx.kinematics.family, "approach_column", 2) == 0:
+    if ctx.kinematics.family.five_axis:
         _check_five_axis_torch(seam, label, "to_seam", at=(s,))
     T = np.eye(4)
     T[:3, 3] = ctx.to_frame0(seam.tcp_point(s) - tgt.offset * seam.torch_axis(s))
@@ -758,8 +758,7 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
                 f"{phase.seam!r} starts at {np.round(start * 1e3, 2).tolist()} mm, {gap * 1e3:.2f} mm "
                 "away; end the previous phase at the seam start")
 
-    if seam is not None and phase.orientation == "seam" \
-            and getattr(ctx.kinematics.family, "approach_column", 2) == 0:
+    if seam is not None and phase.orientation == "seam" and ctx.kinematics.family.five_axis:
         _check_five_axis_torch(seam, label)
 
     rot_end = None
@@ -809,7 +808,7 @@ def _along_seam(cart: Any, seam: Any, R0: NDArray[np.float64], ctx: CartesianCon
         roll_about,
     )
 
-    column = int(getattr(ctx.kinematics.family, "approach_column", 2))
+    column = int(ctx.kinematics.family.approach_column)
     to0 = ctx.frame0_from_world[:3, :3]
     if roll is None:
         roll = (roll_about(to0 @ seam.torch_rotation(0.0), R0, column) if column == 2 and not corner
@@ -1422,7 +1421,7 @@ def _wrist_roll(plan: _BlendedPlan, geo: _BlendGeometry, of: list[int], t0: floa
     from sim.simulation.seam_orientation import SeamOrientation
 
     kin = ctx.kinematics
-    if getattr(kin.family, "approach_column", 2) != 2:
+    if kin.family.five_axis:
         return {}
 
     def clearance(q: NDArray[np.float64]) -> float:
@@ -1574,8 +1573,8 @@ def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[C
             sel = which == k
             if np.any(sel):
                 poses[sel] = _poses(win.at(ts[sel] - bounds[k]))
-        if getattr(kin.family, "approach_column", 2) == 0:  # a 5-axis arm: corners in its
-            poses = _into_j1_plane(poses)                   # plane
+        if kin.family.five_axis:  # a 5-axis arm: corners in its plane
+            poses = _into_j1_plane(poses)
         return poses
 
     ts, q_via = _ik_knots_refined(kin, ts, poses_at, q0, labels[0], ctx.robot, one_branch)

@@ -50,6 +50,9 @@ class KinematicFamily(ABC):
         wrist_centre_index: Index, in :meth:`joint_frames`' points, of the wrist centre.
         approach_column: Column of the seed tool frame that points along the tool (the torch
             axis of a straight tool).
+        five_axis: Whether the arm has five axes and holds its tool axis in the vertical plane
+            through J1 and the tool point (the 5R family): it cannot take a torch posture out
+            of that plane, and the roll about the torch axis is not free.
         reach_free_joints: Joints a reach search varies (J1 and the last joint do not change the
             tcp's distance from the J1 axis).
         joint_symbol: ``"q"`` or ``"theta"``, as the family's seed writes its joints.
@@ -66,6 +69,7 @@ class KinematicFamily(ABC):
     #: Whether the workspace section also scatters the tcp (5-axis arms: the tool point, not
     #: the wrist, is what a 5-axis task constrains).
     section_shows_tcp: ClassVar[bool] = False
+    five_axis: ClassVar[bool] = False
 
     def __init__(self, dims: Mapping[str, float]) -> None:
         missing = [k for k in self.dim_names if k not in dims]

@@ -95,6 +95,7 @@ class FiveR(KinematicFamily):
     reach_free_joints: ClassVar[tuple[int, ...]] = (1, 2, 3)
     joint_symbol: ClassVar[str] = "q"
     section_shows_tcp: ClassVar[bool] = True
+    five_axis: ClassVar[bool] = True
 
     # ------------------------------------------------------------------ forward
     def joint_frames(self, Q: NDArray[np.float64]) -> tuple[NDArray[np.float64],
