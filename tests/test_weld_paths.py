@@ -217,7 +217,7 @@ def test_a_torch_frozen_through_the_corner_fails_the_torch_angle_check(tmp_path,
     verdict fails on ``torch_angle``: the metric is measured, not restated."""
     from planners.adnia import CartesianTrajectory
     from planners.rotations import GeodesicOrientation
-    from sim.simulation import motion
+    from sim.simulation.motion import cartesian as motion
 
     real = motion._along_seam
 

@@ -1,0 +1,72 @@
+"""What Cartesian phases need from the cell and the robot: :class:`CartesianContext`.
+
+Owns the robot's kinematics with its tool, the cell's seams, frames and home, and the frame
+conversions into the robot's frame 0 (cell seams and objects are given in the world frame).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sim.errors import ScenarioError
+
+
+@dataclass
+class CartesianContext:
+    """What Cartesian phases need from the cell and the robot.
+
+    Attributes:
+        kinematics: A :class:`sim.robots.model.KinematicModel` of the robot with its tool
+            (``fk(q)`` gives the tcp pose in frame 0; used by ``ik_path``).
+        seams: Cell seams by name (world frame).
+        world_from_frame0: Pose of frame 0 in the world, (4, 4).
+        frames: Poses of the cell's objects in the world by name, (4, 4) each: scenario points
+            may be given in them (``frame = "<object>"``).
+        home_q: The cell's home configuration, rad (where a TP program starts).
+        flange_to_tcp: The tcp in the flange frame, (4, 4) (a TP program's UT 0 poses are the
+            flange's).
+        robot: The robot's registry entry (its maker's joint convention, for TP CONFIG).
+    """
+
+    kinematics: Any
+    seams: dict[str, Any] = field(default_factory=dict)
+    world_from_frame0: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    frames: dict[str, NDArray[np.float64]] = field(default_factory=dict)
+    home_q: NDArray[np.float64] | None = None
+    flange_to_tcp: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
+    robot: Any = None
+
+    def frame0_from(self, frame: str, label: str) -> NDArray[np.float64]:
+        """Pose of a named frame in frame 0, (4, 4): ``frame0`` (the robot's), ``world`` or a
+        cell object (:attr:`frames`: each object's pose in world).
+
+        Raises:
+            ScenarioError: Unknown frame (the message lists the valid ones).
+        """
+        if frame == "frame0":
+            return np.eye(4)
+        if frame == "world":
+            return self.frame0_from_world
+        if frame not in self.frames:
+            from sim.errors import UnknownNameError
+
+            raise ScenarioError(f"{label}.frame: "
+                                f"{UnknownNameError('frame', frame, ['frame0', 'world', *self.frames])}")
+        return self.frame0_from_world @ self.frames[frame]
+
+    @property
+    def frame0_from_world(self) -> NDArray[np.float64]:
+        from sim.core.rotations import invert_transform
+
+        return invert_transform(self.world_from_frame0)
+
+    def to_frame0(self, p: ArrayLike) -> NDArray[np.float64]:
+        T = self.frame0_from_world
+        return T[:3, :3] @ np.asarray(p, dtype=float) + T[:3, 3]
+
+    def rot_to_frame0(self, R: ArrayLike) -> NDArray[np.float64]:
+        return self.frame0_from_world[:3, :3] @ np.asarray(R, dtype=float)
