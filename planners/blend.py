@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from planners.errors import InvalidMoveError
+from planners.profiles import quintic_smoothstep
 
 
 class SubPath:
@@ -186,12 +187,6 @@ class SubOrientation:
         return R, dR * (self.b - self.a)
 
 
-def _h(x):  # quintic smoothstep and its derivatives and integral
-    x = np.clip(x, 0.0, 1.0)
-    return (x**3 * (10 - 15 * x + 6 * x * x), 30 * x * x * (1 - x) ** 2,
-            60 * x * (1 - x) * (1 - 2 * x), x**4 * (2.5 - 3 * x + x * x))
-
-
 class CornerOrientation:
     """The tool turning from one move's orientation to the next inside a corner blend.
 
@@ -245,13 +240,13 @@ class CornerOrientation:
         Ra = carried(self.start, self._wa, u)
         Rb = carried(self.end, self._wb, u - 1.0)
         v = Rotation.from_matrix(np.swapaxes(Ra, -1, -2) @ Rb).as_rotvec()
-        h = _h(u)[0]
+        h = quintic_smoothstep(u)[0]
         return Ra @ Rotation.from_rotvec(v * h[..., None]).as_matrix()
 
     def evaluate(self, u: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         u = np.asarray(u, dtype=float)
         if not self._turning:
-            h, h1 = _h(u)[:2]
+            h, h1 = quintic_smoothstep(u)[:2]
             R, dR = self._geo.evaluate(h)
             return R, dR * h1[..., None, None]
         e = 1e-6  # dR/du by central differences (the carried rotations are smooth past 0, 1)
@@ -322,7 +317,7 @@ class PiecewiseProfile:
             if p.T <= 0:
                 continue
             x = tau / p.T
-            h, h1, h2, H = _h(x)
+            h, h1, h2, H = quintic_smoothstep(x)
             dv = p.vb - p.va
             out[0][sel] = p.s0 + p.va * tau + dv * p.T * H
             out[1][sel] = p.va + dv * h

@@ -43,6 +43,7 @@ __all__ = [
     "ConstantSpeedShare",
     "SpeedProfile",
     "smoothstep",
+    "quintic_smoothstep",
 ]
 
 #: Smoothstep speed-ramp shapes, by name: coefficients of h(x) in increasing powers of x.
@@ -85,6 +86,18 @@ def _shape(name: str) -> _Shape:
 def smoothstep(x: ArrayLike, shape: str = "quintic") -> NDArray[np.float64]:
     """The speed-ramp function h(x) of ``shape`` (x clipped to [0, 1]); dimensionless."""
     return _shape(shape).h(np.clip(np.asarray(x, dtype=float), 0.0, 1.0))
+
+
+def quintic_smoothstep(x: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                               NDArray[np.float64], NDArray[np.float64]]:
+    """The quintic smoothstep ``h = 10 x^3 - 15 x^4 + 6 x^5`` (:data:`RAMP_SHAPES`'
+    ``"quintic"``) in closed form, x clipped to [0, 1]: ``(h, h', h'', H)``, ``H`` its integral
+    from 0 (``H(1) = 1/2``). What a corner blend's turn and speed changes
+    (:mod:`planners.blend`) and a weave's fade (:mod:`planners.weave`) ramp with;
+    :class:`SpeedProfile` evaluates its shapes from their coefficients instead."""
+    x = np.clip(x, 0.0, 1.0)
+    return (x**3 * (10 - 15 * x + 6 * x * x), 30 * x * x * (1 - x) ** 2,
+            60 * x * (1 - x) * (1 - 2 * x), x**4 * (2.5 - 3 * x + x * x))
 
 
 @dataclass(frozen=True)

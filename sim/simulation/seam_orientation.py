@@ -33,9 +33,9 @@ MAX_START_MISALIGNMENT_DEG = 2.0
 
 
 def _smooth(x: NDArray[np.float64]) -> NDArray[np.float64]:
-    from planners.blend import _h
+    from planners.profiles import quintic_smoothstep
 
-    return _h(x)[0]
+    return quintic_smoothstep(x)[0]
 
 
 def roll_about(R_from: NDArray[np.float64], R_to: NDArray[np.float64], column: int) -> float:
