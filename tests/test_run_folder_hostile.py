@@ -615,7 +615,7 @@ def test_trajectory_size_is_bounded_before_it_is_unpacked(base, tmp_path, capsys
     _set("zeros", lambda a: np.zeros((len(a["t"]), 12_000)))(folder)
     assert (folder / "trajectory.npz").stat().st_size < 100_000
     assert load_run(folder).get("zeros").shape == (21, 12_000)
-    monkeypatch.setattr(runfolder, "MAX_TRAJECTORY_BYTES", 100_000)
+    monkeypatch.setattr(runfolder.reading, "MAX_TRAJECTORY_BYTES", 100_000)  # the reader's bound
     _refused(folder, capsys, "trajectory.npz", "unpacks to", "100,000")
 
 

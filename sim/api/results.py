@@ -301,10 +301,10 @@ class RunResult:
             raise RunFolderError(f"{where} does not exist or is not a folder")
         if runfolder.marker_state(folder) == "writing":
             raise RunFolderError(f"{where} is a run that was still being written, not a result")
-        summary = runfolder.read_json(folder, runfolder.SUMMARY_JSON)
+        summary = runfolder.read_run_json(folder, runfolder.SUMMARY_JSON)
         if summary is None:
             raise RunFolderError(f"{where} has no summary.json (not a finished run)")
-        sizing = runfolder.read_json(folder, runfolder.SIZING_JSON)
+        sizing = runfolder.read_run_json(folder, runfolder.SIZING_JSON)
         return cls.from_summary(summary, sizing, path=folder)
 
 
