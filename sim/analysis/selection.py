@@ -69,7 +69,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.analysis.catalog import Catalog, Motor, Reducer, describe_entry
-from sim.analysis.sizing import PEAK_WINDOW_S, sustained
+from sim.analysis.sizing import PEAK_WINDOW_S
+from sim.analysis.statistics import sustained
+from sim.core.files import write_atomic
 from sim.robots.registry import COULOMB_SPEED, RPM_PER_RAD_S
 from sim.simulation.runfolder import SELECTION_CSV, SELECTION_JSON, RunRecord
 
@@ -541,8 +543,6 @@ def _csvnum(x: float) -> str:
 
 def write_selection(folder: str | Path, result: SelectionResult) -> dict[str, Path]:
     """Write ``selection.json`` and ``selection.csv`` into a run folder."""
-    from sim.analysis.report import write_atomic
-
     folder = Path(folder)
     return {
         "json": write_atomic(folder / SELECTION_JSON,

@@ -1,0 +1,131 @@
+"""Time-signal statistics of a sampled record: time-weighted integrals, RMS, peaks, the
+signal sustained over a window, margins.
+
+Owns the signal primitives sizing and selection compute their numbers from. Every integral is
+the trapezoidal rule over the samples' own, possibly non-uniform, times (not a plain mean of
+samples); ``T`` is the record's duration ``t[-1] - t[0]``.
+May import: numpy and :mod:`sim.errors` only.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sim.errors import CellsimError
+
+
+def as_time(t: ArrayLike) -> NDArray[np.float64]:
+    """``t`` as a float time vector, checked: 1-D, at least 2 samples, finite, strictly
+    increasing.
+
+    Raises:
+        CellsimError: Otherwise.
+    """
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or t.size < 2:
+        raise CellsimError(f"time vector t must be 1-D with at least 2 samples, got shape {t.shape}")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise CellsimError("time vector t must be finite and strictly increasing")
+    return t
+
+
+def time_integral(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64] | float:
+    """Trapezoidal integral ``int x dt`` over the samples' own times.
+
+    Args:
+        t: Sample times, s, shape (N,), strictly increasing (spacing may vary).
+        x: Samples, shape (N,) or (N, n).
+
+    Returns:
+        The integral, a float or shape (n,).
+    """
+    t = as_time(t)
+    x = np.asarray(x, dtype=float)
+    dt = np.diff(t)
+    mid = 0.5 * (x[1:] + x[:-1])
+    terms = dt.reshape((-1,) + (1,) * (mid.ndim - 1)) * mid
+    flat = terms.reshape(terms.shape[0], -1)
+    # an exactly rounded sum (math.fsum): the same bits whatever BLAS, its thread count or the
+    # arrays' alignment (a sweep on Ray, one thread per task, gives the pool's table exactly);
+    # numpy's sum where a term is not finite (fsum raises on inf - inf and on overflow)
+    out = np.array([math.fsum(col) if np.all(np.isfinite(col)) else float(np.sum(col))
+                    for col in flat.T])
+    return float(out[0]) if terms.ndim == 1 else out.reshape(terms.shape[1:])
+
+
+def rms(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64] | float:
+    """Time-weighted RMS ``sqrt(1/T int x^2 dt)`` (trapezoidal), ``T = t[-1] - t[0]``.
+
+    Args:
+        t: Sample times, s, shape (N,).
+        x: Samples, shape (N,) or (N, n).
+
+    Returns:
+        The RMS value(s), same unit as ``x``; a float or shape (n,).
+    """
+    t = as_time(t)
+    x = np.asarray(x, dtype=float)
+    return np.sqrt(time_integral(t, x * x) / (t[-1] - t[0]))
+
+
+def peak_abs(t: ArrayLike, x: ArrayLike) -> tuple[float, float]:
+    """Largest ``|x|`` and the (first) time it occurs.
+
+    Args:
+        t: Sample times, s, shape (N,).
+        x: Samples, shape (N,).
+
+    Returns:
+        ``(value, time)``; value >= 0 in the unit of ``x``, time in s.
+    """
+    x = np.abs(np.asarray(x, dtype=float))
+    i = int(np.argmax(x))
+    return float(x[i]), float(np.asarray(t, dtype=float)[i])
+
+
+def sustained(t: ArrayLike, x: ArrayLike, window: float) -> NDArray[np.float64]:
+    """The centred sliding mean of ``x`` over ``window`` s at each sample: ``1/w int x dt``
+    over ``[t - w/2, t + w/2]`` clipped to the record, the exact integral of the samples'
+    piecewise-linear interpolant (the trapezoidal rule on the samples' own times, the window's
+    ends interpolated); ``x`` itself when ``window <= 0``.
+
+    Args:
+        t: Sample times, s, shape (N,), strictly increasing.
+        x: Samples, shape (N,) or (N, n).
+        window: Window length, s.
+
+    Returns:
+        The sustained signal, shape of ``x``.
+    """
+    t = as_time(t)
+    x = np.asarray(x, dtype=float)
+    if window <= 0.0:
+        return x
+    flat = x.reshape(t.size, -1)
+    c = np.concatenate([np.zeros((1, flat.shape[1])),
+                        np.cumsum(0.5 * (flat[1:] + flat[:-1]) * np.diff(t)[:, None], axis=0)])
+    lo = np.maximum(t - 0.5 * window, t[0])
+    hi = np.minimum(t + 0.5 * window, t[-1])
+
+    def integral_to(s: NDArray[np.float64]) -> NDArray[np.float64]:
+        # int from t[0] to s: whole trapezoids up to the sample before s, then the part
+        # trapezoid from that sample to s (x linear in between)
+        k = np.clip(np.searchsorted(t, s, side="right") - 1, 0, t.size - 2)
+        xs = np.stack([np.interp(s, t, flat[:, m]) for m in range(flat.shape[1])], axis=1)
+        return c[k] + (s - t[k])[:, None] * 0.5 * (flat[k] + xs)
+
+    width = hi - lo
+    inside = width > 0.0  # else a window below the times' resolution: the sample itself
+    out = flat.copy()
+    out[inside] = ((integral_to(hi) - integral_to(lo))[inside] / width[inside, None])
+    return out.reshape(x.shape)
+
+
+def margin_pct(limit: float, used: float) -> float:
+    """Margin in percent, ``(limit - used) / limit * 100`` (NaN when there is no finite limit)."""
+    if not np.isfinite(limit) or limit <= 0:
+        return float("nan")
+    return float((limit - used) / limit * 100.0)
