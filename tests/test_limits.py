@@ -124,4 +124,25 @@ def test_bad_limits(traj, kwargs, pattern):
 
 
 def test_infinite_limit_means_none(traj):
-    check_limits(traj, lower=-np.inf, upper=np.inf, max_velocity=np.inf, max_acceleration=np.inf)
+    """An infinite limit checks nothing. Joint 1 under infinite limits on every quantity, joint 2
+    under finite ones just inside its closed-form extremes (the 4-4 case scaled by -0.5:
+    positions -D/2 .. 0, velocity -D/(2h) at t = h, |acceleration| 0.75 D/h^2): exactly joint
+    2's four violations are found, at those values; with every limit infinite, none."""
+    inf = np.inf
+    found = find_limit_violations(traj, lower=[-inf, -0.45 * D], upper=[inf, -0.01],
+                                  max_velocity=[inf, 0.45 * VPEAK],
+                                  max_acceleration=[inf, 0.45 * APEAK])
+    assert [(v.joint, v.quantity, v.limit) for v in found] == [
+        (1, "position", -0.45 * D), (1, "position", -0.01), (1, "velocity", 0.45 * VPEAK),
+        (1, "acceleration", 0.45 * APEAK)]
+    lower, upper, velocity, acceleration = found
+    assert lower.value == pytest.approx(-D / 2, rel=1e-9)
+    assert upper.value == pytest.approx(0.0, abs=1e-12)
+    assert velocity.value == pytest.approx(-VPEAK / 2, rel=1e-9)
+    assert velocity.time == pytest.approx(H, abs=1e-9)
+    assert abs(acceleration.value) == pytest.approx(APEAK / 2, rel=1e-9)
+    # the same finite limits on joint 1 too: its violations appear (the infinite ones hid them)
+    assert len(find_limit_violations(traj, upper=[0.5 * D, -0.01])) == 2
+    everything = {"lower": -inf, "upper": inf, "max_velocity": inf, "max_acceleration": inf}
+    assert find_limit_violations(traj, **everything) == []
+    check_limits(traj, **everything)  # does not raise
