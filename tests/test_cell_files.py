@@ -397,7 +397,8 @@ def test_a_seam_stickout_moves_the_tool_point_back_along_the_torch():
 def test_the_ring_sector_distance_is_exact_at_its_cut_faces():
     """Solid.distance of a ring sector against a brute-force distance to a dense sampling of
     its surface (outside points) and to its nearest face (inside points)."""
-    from sim.cells.cellfile import ObjectBlock, _ring_distance
+    from sim.cells.cellfile.schema import ObjectBlock
+    from sim.cells.cellfile.solids import ring_distance
 
     b = ObjectBlock(name="r", shape="ring", radius_mm=300.0, inner_radius_mm=200.0,
                     length_mm=100.0, arc_deg=[10.0, 100.0])
@@ -417,7 +418,7 @@ def test_the_ring_sector_distance_is_exact_at_its_cut_faces():
     rng = np.random.default_rng(0)
     for _ in range(300):
         p = rng.uniform([-0.4, -0.4, -0.15], [0.4, 0.4, 0.15])
-        d = _ring_distance(p, b)
+        d = ring_distance(p, b)
         brute = float(np.min(np.linalg.norm(S - p, axis=1)))
         assert abs(abs(d) - brute) < 3e-3, (p, d, brute)  # the sampling's resolution
         rho, phi = np.hypot(p[0], p[1]), np.mod(np.arctan2(p[1], p[0]), 2 * np.pi)
@@ -425,7 +426,7 @@ def test_the_ring_sector_distance_is_exact_at_its_cut_faces():
         assert (d < 0) == inside
     # 0.24 mm inside a cut face is 0.24 mm deep, not the distance to the walls
     p = np.array([0.25 * np.cos(a0 + 0.00024 / 0.25), 0.25 * np.sin(a0 + 0.00024 / 0.25), 0.0])
-    assert _ring_distance(p, b) == pytest.approx(-0.00024, abs=1e-6)
+    assert ring_distance(p, b) == pytest.approx(-0.00024, abs=1e-6)
 
 
 def test_start_deg_is_checked_for_the_cells_own_tool_file(tmp_path):

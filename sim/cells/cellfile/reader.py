@@ -1,0 +1,168 @@
+"""Reading a cell file: the schema's content checked as a whole (names, solids, seams on
+their objects, cameras, the robot base) into a :class:`CellFile`, once, with no robot needed;
+every problem is one line naming the file and the key."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.cells.cellfile.schema import (
+    BASE_TOLERANCE_M,
+    DIM_UNITS,
+    RESERVED,
+    SEAM_TOLERANCE_M,
+    CellFileSpec,
+)
+from sim.cells.cellfile.seams import ctwd_key, seam_in_world, seam_points
+from sim.cells.cellfile.solids import Solid, geom_names, object_pose, read_solid
+from sim.core.tomlschema import load_toml
+from sim.errors import CellError, CellsimError
+
+
+@dataclass
+class CellFile:
+    """A checked cell file (what the builder needs besides the robot).
+
+    Attributes:
+        path: The file. spec: Its validated content. solids: Its objects by name.
+        base_pose: The robot base frame in world (mount included), (4, 4).
+        default_tool: The default tool reference as written (resolved by :mod:`sim.cells`).
+    """
+
+    path: Path
+    spec: CellFileSpec
+    solids: dict[str, Solid]
+    base_pose: NDArray[np.float64]
+    default_tool: object = None  # the resolved ``tool`` (a ToolSpec), set by sim.cells
+
+    @property
+    def where(self) -> str:
+        return str(self.path)
+
+
+def read_cell_file(path: str | Path) -> CellFile:
+    """Read and check a cell file (no robot needed).
+
+    Raises:
+        CellError: One line naming the file and the key: unreadable file, unknown key, wrong
+            type, a mesh file missing, duplicate names, a seam naming an unknown object, a seam
+            point more than 1 mm outside its object, a robot base inside a fixture.
+    """
+    path = Path(path)
+    spec, _ = load_toml(path, CellFileSpec, CellError)
+    where = str(path)
+    solids: dict[str, Solid] = {}
+    for i, ob in enumerate(spec.objects):
+        if ob.name in solids or ob.name in RESERVED:
+            what = (f"is already the name of objects[{solids[ob.name].index}]"
+                    if ob.name in solids else "is reserved")
+            raise CellError(f"{where}: objects[{i}].name: {ob.name!r} {what}")
+        solids[ob.name] = read_solid(ob, i, path.parent, where)
+    owner: dict[str, int] = {}  # every geom name the objects become -> the object's index
+    for sd in solids.values():
+        for g in geom_names(sd.block, len(sd.pieces)):
+            if g in owner or (g != sd.block.name and g in solids) or g in RESERVED:
+                other = owner.get(g, solids[g].index if g in solids else None)
+                clash = f"objects[{other}]" if other is not None else "a reserved name"
+                raise CellError(f"{where}: objects[{sd.index}].name: {sd.block.name!r} gives a "
+                                f"geom named {g!r}, which clashes with {clash}; rename one")
+            owner[g] = sd.index
+
+    def known(name: str, key: str, static: bool = False) -> Solid:
+        if name not in solids:
+            from sim.errors import UnknownNameError
+
+            valid = [n for n, s in solids.items() if not static or s.block.role != "part"]
+            raise CellError(f"{where}: {key}: {UnknownNameError('object', name, valid)}")
+        return solids[name]
+
+    seam_names: set[str] = set()
+    for i, sb in enumerate(spec.seams):
+        key = f"{where}: seams[{i}]"
+        if sb.name in seam_names:
+            raise CellError(f"{key}.name: {sb.name!r} is already a seam's name")
+        seam_names.add(sb.name)
+        obj = known(sb.object, f"seams[{i}].object", static=True)
+        if obj.block.role == "part":
+            raise CellError(f"{key}.object: {sb.object!r} is a part (a free body); seams lie on "
+                            "fixtures or workpieces")
+        for j, other in enumerate(sb.joins):
+            known(other, f"seams[{i}].joins[{j}]", static=True)
+        pts = seam_points(sb, key)
+        for k, p in enumerate(pts):
+            pw = obj.pose[:3, :3] @ p + obj.pose[:3, 3]
+            d = obj.distance(pw)
+            if d > SEAM_TOLERANCE_M:
+                raise CellError(f"{key}.points_mm[{k}]: {np.round(p * 1e3, 3).tolist()} mm is "
+                                f"{d * 1e3:.2f} mm outside object {sb.object!r} (at most "
+                                f"{SEAM_TOLERANCE_M * 1e3:g} mm); the points are in the "
+                                "object's frame")
+        try:
+            seam = seam_in_world(sb, obj.pose, pts, tool_axis=2, world_from_frame0=np.eye(4),
+                                  standoff=0.0)
+        except CellsimError as exc:
+            raise CellError(f"{key}: {exc}") from None
+        # the torch posture must exist all along (a polyline's every segment, an arc's every
+        # point): the normal may not run along the seam anywhere
+        if seam.kind == "polyline":  # each segment at its middle
+            cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(seam.points, axis=0),
+                                                                  axis=1))])
+            where_s = [(0.5 * (cum[k] + cum[k + 1]), f"segment {k + 1}")
+                       for k in range(len(cum) - 1)]
+        else:
+            where_s = [(x, f"{x * 1e3:.1f} mm from its start")
+                       for x in np.linspace(0.0, seam.length(), 65)]
+        for s_, label in where_s:
+            t = seam.tangent(float(s_))
+            n_w = seam.surface_normal
+            if np.linalg.norm(n_w - (n_w @ t) * t) < 1e-6:
+                raise CellError(f"{key}.normal: {np.round(sb.normal, 6).tolist()} runs along the "
+                                f"seam ({label}); the reference surface's normal must be across "
+                                "the seam")
+        if sb.stickout_mm is not None and sb.ctwd_mm is not None:
+            raise CellError(f"{key}.ctwd_mm: give one of stickout_mm or ctwd_mm (both set the "
+                            "contact-tip-to-work distance)")
+        dist_key = ctwd_key(sb)
+        if sb.kind == "arc" and dist_key is not None:
+            axis = seam.normal
+            if abs(abs(axis @ seam.surface_normal) - 1.0) > 1e-6:
+                raise CellError(f"{key}.{dist_key}: on an arc a stand-off other than the tool's "
+                                "needs the normal along the arc's axis (the torch then keeps its "
+                                "posture to the circle, and the tool point runs a coaxial arc)")
+    for i, sl in enumerate(spec.slots):
+        if sl.object is not None:
+            known(sl.object, f"slots[{i}].object")
+    cams = [c.name for c in spec.cameras]
+    for i, c in enumerate(spec.cameras):
+        if cams.count(c.name) > 1:
+            raise CellError(f"{where}: cameras[{i}].name: {c.name!r} is used twice")
+        if (c.look_at_mm is None) == (c.follow is None):
+            raise CellError(f"{where}: cameras[{i}]: give one of look_at_mm (a fixed view) or "
+                            "follow = \"tool\" (a fixed camera turning to follow the tool)")
+        if c.look_at_mm is not None and np.linalg.norm(np.subtract(c.look_at_mm, c.pos_mm)) < 1.0:
+            raise CellError(f"{where}: cameras[{i}].look_at_mm: the camera looks at itself")
+    for k in spec.dims:
+        if not k.endswith(DIM_UNITS):
+            raise CellError(f"{where}: dims.{k}: a dimension's key ends in its unit: "
+                            f"{', '.join(DIM_UNITS)}")
+
+    rb = spec.robot
+    base = object_pose(rb.base_pos_mm, rb.base_euler_zyx_deg)
+    if rb.mount == "ceiling":  # a half turn about the base's x axis (exact)
+        base[:3, :3] = base[:3, :3] @ np.diag([1.0, -1.0, -1.0])
+    for s in solids.values():
+        if s.block.role == "part" or not s.block.collide:
+            continue
+        d = s.distance(base[:3, 3])
+        if d < -BASE_TOLERANCE_M:
+            raise CellError(f"{where}: robot.base_pos_mm: the robot base {rb.base_pos_mm} mm is "
+                            f"{-d * 1e3:.1f} mm inside {s.block.role} {s.block.name!r} "
+                            f"(objects[{s.index}]); stand it on the object, not in it")
+    return CellFile(path=path, spec=spec, solids=solids, base_pose=base)
+
+
+__all__ = ["CellFile", "read_cell_file"]
