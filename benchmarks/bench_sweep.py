@@ -37,7 +37,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sim.pipeline.variant_runs import run_batch, run_variant  # noqa: E402
+from sim.pipeline.sweep.evaluation import evaluate_batch, evaluate_variant  # noqa: E402
 from sim.pipeline.sweep import run_sweep  # noqa: E402
 
 GRIDS = {8: (2, 4), 64: (8, 8), 256: (16, 16)}
@@ -63,7 +63,7 @@ def sweep(scenario: str, n: int, engine: str, workers: int, **kw) -> dict:
     payloads, speeds = grid(n)
     with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
         t0 = time.perf_counter()
-        res = run_sweep(scenario, payloads, speeds, run_variant, workers=workers,
+        res = run_sweep(scenario, payloads, speeds, evaluate_variant, workers=workers,
                         out_dir=Path(tmp) / "sweep", progress=False, engine=engine, **kw)
         wall = time.perf_counter() - t0
     stages: dict[str, list[float]] = {}
@@ -83,9 +83,9 @@ def warp_parity(scenario: str, workers: int) -> dict:
     payloads, speeds = [1.0, 3.0], [0.7, 0.8, 0.9, 1.0]
     out = {}
     with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
-        for name, kw in (("pool", {}), ("warp", {"batch": functools.partial(run_batch)})):
+        for name, kw in (("pool", {}), ("warp", {"batch": functools.partial(evaluate_batch)})):
             t0 = time.perf_counter()
-            res = run_sweep(scenario, payloads, speeds, run_variant, workers=workers,
+            res = run_sweep(scenario, payloads, speeds, evaluate_variant, workers=workers,
                             out_dir=Path(tmp) / name, progress=False, **kw)
             wall = time.perf_counter() - t0
             out[name] = {"wall_s": wall, "rows": res.rows,

@@ -17,15 +17,14 @@ import pytest
 from window_oracle import sustained_peak
 
 from sim.analysis.sizing import PEAK_WINDOW_S
+from sim.cli.size import parse_float_list
 from sim.errors import CellsimError, UnknownNameError
 from sim.pipeline.sweep import (
     SWEEP_COLUMNS,
     SweepError,
     Variant,
     make_variants,
-    parse_float_list,
     run_sweep,
-    scale_knot_times,
 )
 
 G, L, K = 9.81, 0.5, 3.0
@@ -188,14 +187,6 @@ def test_variants_are_every_combination_payload_major(tmp_path) -> None:
     assert [v.index for v in vs] == [0, 1, 2, 3]
     assert len({v.run_dir for v in vs}) == 4 and all(v.scenario == "base" for v in vs)
     assert vs[2].slug == "payload_2.5kg_speed_1x"
-
-
-def test_scale_knot_times_divides() -> None:
-    # Speed scale 2: every knot reached in half the time.
-    assert scale_knot_times([0.0, 3.335, 6.665, 10.0], 2.0) == pytest.approx(
-        [0.0, 1.6675, 3.3325, 5.0])
-    with pytest.raises(SweepError, match="speed scale"):
-        scale_knot_times([0.0, 1.0], 0.0)
 
 
 def test_parse_float_list() -> None:

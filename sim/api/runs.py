@@ -104,16 +104,16 @@ def sweep(scenario: ScenarioLike, payloads_kg: Sequence[float] | None = None,
     """
     import functools
 
-    from sim.pipeline.variant_runs import run_batch, run_variant
+    from sim.pipeline.sweep.evaluation import evaluate_batch, evaluate_variant
 
     loaded = _scenario(scenario)
     payloads = validate_payloads(list(payloads_kg) if payloads_kg is not None
                                  else [loaded.payload_kg], field="payloads_kg")
     scales = validate_speed_scales(list(speed_scales), field="speed_scales")
     selection = selection_options(loaded) if select or loaded.sizing.select else None
-    batch = functools.partial(run_batch, selection=selection) if backend == "warp" else None
+    batch = functools.partial(evaluate_batch, selection=selection) if backend == "warp" else None
     return run_sweep(loaded, payloads, scales,
-                     functools.partial(run_variant, selection=selection, keep_runs=keep_runs),
+                     functools.partial(evaluate_variant, selection=selection, keep_runs=keep_runs),
                      workers=min(workers, len(payloads) * len(scales)),
                      out_dir=out_dir or Path("runs") / f"{loaded.name}_sweep",
                      progress=progress, engine=engine, batch=batch)

@@ -17,10 +17,70 @@ from __future__ import annotations
 
 import argparse
 import functools
+import math
 import os
 from pathlib import Path
 
-from sim.pipeline.variant_runs import run_batch, run_variant
+from sim.errors import SweepError
+from sim.pipeline.sweep.evaluation import evaluate_batch, evaluate_variant
+
+
+# ---------------------------------------------------------------------------- value lists
+def _number(token: str, field: str) -> float:
+    try:
+        value = float(token)
+    except ValueError:
+        raise SweepError(f"{field}: {token!r} is not a number (expected a comma-separated list "
+                         "like 0,2.5,5 or a range start:stop:step like 0:10:2.5)") from None
+    if not math.isfinite(value):
+        raise SweepError(f"{field}: {token!r} is not a finite number")
+    return value
+
+
+#: Most values one option may list.
+MAX_SWEEP_VALUES = 10_000
+
+
+def parse_float_list(text: str, field: str = "value") -> list[float]:
+    """Numbers from a command-line list: ``"0,2.5,5"`` or an inclusive range ``"0:10:2.5"``
+    (items may mix: ``"0,1:3:1"``). Duplicates are dropped, the order kept.
+
+    Args:
+        text: The option's text.
+        field: Option name for error messages (``"--payload"``).
+
+    Returns:
+        The numbers, in order of appearance.
+
+    Raises:
+        SweepError: Empty list, empty item, non-number, or a bad range (names ``field``).
+    """
+    if text is None or not str(text).strip():
+        raise SweepError(f"{field}: empty list (expected numbers like 0,2.5,5)")
+    out: list[float] = []
+    for item in str(text).split(","):
+        item = item.strip()
+        if not item:
+            raise SweepError(f"{field}: empty item in {text!r} (expected numbers like 0,2.5,5)")
+        if ":" in item:
+            parts = item.split(":")
+            if len(parts) != 3:
+                raise SweepError(f"{field}: range {item!r} must be start:stop:step")
+            a, b, step = (_number(p.strip(), field) for p in parts)
+            if step <= 0:
+                raise SweepError(f"{field}: range {item!r} needs a positive step")
+            if b < a:
+                raise SweepError(f"{field}: range {item!r} has stop < start")
+            span = (b - a) / step  # inf for a huge range or a tiny step: refused, not allocated
+            if not math.isfinite(span) or span + 1 > MAX_SWEEP_VALUES:
+                shown = "more than 1e308" if not math.isfinite(span) else f"{int(span) + 1}"
+                raise SweepError(f"{field}: range {item!r} has {shown} values (at most "
+                                 f"{MAX_SWEEP_VALUES})")
+            count = int(math.floor(span + 1e-9)) + 1
+            out.extend(round(a + k * step, 12) for k in range(count))
+        else:
+            out.append(_number(item, field))
+    return list(dict.fromkeys(out))
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -100,12 +160,7 @@ def selection_overrides(args: argparse.Namespace) -> dict | None:
 
 def run(args: argparse.Namespace) -> int:
     from sim.errors import CellsimError
-    from sim.pipeline.sweep import (
-        parse_float_list,
-        run_sweep,
-        validate_payloads,
-        validate_speed_scales,
-    )
+    from sim.pipeline.sweep import run_sweep, validate_payloads, validate_speed_scales
     from sim.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)  # validates before any process starts
@@ -139,10 +194,10 @@ def run(args: argparse.Namespace) -> int:
         from sim.simulation.warp_batch import default_device
 
         default_device()  # MuJoCo Warp is there (else one line), before any folder is made
-        batch = functools.partial(run_batch, selection=selection)
+        batch = functools.partial(evaluate_batch, selection=selection)
     # the loaded scenario travels with each variant (a Ray node needs no copy of the file)
     result = run_sweep(scenario, payloads, scales,
-                       functools.partial(run_variant, selection=selection,
+                       functools.partial(evaluate_variant, selection=selection,
                                          keep_runs=args.keep_runs,
                                          plots=args.plots),
                        workers=min(workers, len(payloads) * len(scales)), out_dir=out,

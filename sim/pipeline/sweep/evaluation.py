@@ -1,19 +1,20 @@
 """One sweep variant evaluated: what a worker process, a Ray task or a Warp batch runs.
 
-:func:`run_variant` and :func:`run_batch` are module-level (worker processes and Ray tasks
-import them by name); :func:`sim.pipeline.sweep.run_sweep` calls them for each
-:class:`~sim.pipeline.sweep.Variant`, ``cellsim size`` and :func:`sim.sweep` pass them.
+:func:`evaluate_variant` and :func:`evaluate_batch` are module-level (worker processes and Ray
+tasks import them by name): ``cellsim size`` and :func:`sim.sweep` give them to
+:func:`sim.pipeline.sweep.run_sweep`, which calls them for each
+:class:`~sim.pipeline.sweep.Variant`.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from sim.pipeline.sweep import Variant
+from sim.pipeline.sweep.variants import Variant
 
 
-def run_variant(variant: Variant, selection: Any = None, keep_runs: bool = False,
-                plots: bool = False) -> Any:
+def evaluate_variant(variant: Variant, selection: Any = None, keep_runs: bool = False,
+                     plots: bool = False) -> Any:
     """Run one sweep variant (module level, so worker processes and Ray tasks can import it).
 
     Metrics only by default: the run is evaluated in memory and a
@@ -52,7 +53,7 @@ def _variant_scenario(variant: Variant) -> Any:
 
 
 def _metrics(variant: Variant, ev: Any, run_dir: str | None = None) -> Any:
-    from sim.pipeline.sweep import VariantMetrics, rows_from
+    from sim.pipeline.sweep.variants import VariantMetrics, rows_from
 
     sized = ({j["joint"]: j for j in ev.sizing.to_dict()["joints"]}
              if ev.sizing is not None else {})
@@ -62,10 +63,10 @@ def _metrics(variant: Variant, ev: Any, run_dir: str | None = None) -> Any:
                           timings_s=dict(ev.summary.get("timings_s", {})), run_dir=run_dir)
 
 
-def run_batch(variants: list[Variant], selection: Any = None) -> list[Any]:
+def evaluate_batch(variants: list[Variant], selection: Any = None) -> list[Any]:
     """Every variant at once on MuJoCo Warp (``--backend warp``): planned one by one, simulated
     as batches of one model structure, then checked and sized one by one; metrics only.
-    ``selection`` as for :func:`run_variant`."""
+    ``selection`` as for :func:`evaluate_variant`."""
     from sim.pipeline.run import RunOptions, evaluate_scenarios
 
     # speed-major: the variants of one speed scale follow each other, so each plan is made

@@ -1,0 +1,193 @@
+"""Where a sweep's variants run: this process, a process pool on this machine, Ray tasks (a
+local instance or a cluster), or one batched call (MuJoCo Warp). Whatever the engine, the
+outcomes are gathered in variant order, and a variant that fails (or whose worker dies) is
+reported as that variant's error while the others go on."""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import time
+import traceback
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from typing import Any
+
+from sim.errors import SweepError
+from sim.pipeline.sweep.variants import (
+    Outcome,
+    SweepResult,
+    Variant,
+    outcome_of,
+    run_variant,
+)
+
+#: Where variants run: a process pool on this machine, or Ray (a local instance or a cluster).
+ENGINES: tuple[str, ...] = ("pool", "ray")
+
+def import_ray() -> Any:
+    try:
+        import ray
+    except ImportError:
+        raise SweepError("--engine ray needs Ray: pip install 'cellsim[ray]' (or use "
+                         "--engine pool)") from None
+    return ray
+
+
+def task_groups(variants: Sequence[Variant], workers: int) -> list[list[Variant]]:
+    """The variants cut into tasks for ``workers`` parallel workers: the variants of one speed
+    scale run together, in one worker, one after the other (a plan depends on the speed scale,
+    not on the payload, so the worker plans once and reuses it), split into enough tasks that
+    every worker has at least two to take. The results do not depend on the grouping (they
+    are gathered by variant index)."""
+    by_speed: dict[float, list[Variant]] = {}
+    for v in variants:
+        by_speed.setdefault(v.speed_scale, []).append(v)
+    per_speed = max(1, math.ceil(2 * max(workers, 1) / len(by_speed)))
+    groups: list[list[Variant]] = []
+    for members in by_speed.values():
+        size = max(1, math.ceil(len(members) / per_speed))
+        groups.extend(members[k:k + size] for k in range(0, len(members), size))
+    return groups
+
+
+def run_group(runner: Callable[[Variant], Any], variants: Sequence[Variant]) -> list[Outcome]:
+    """Run variants one after the other in this process (a task of a parallel sweep)."""
+    return [run_variant(runner, v) for v in variants]
+
+
+def _run_batch(batch: Callable[[Sequence[Variant]], Sequence[Any]],
+               variants: Sequence[Variant], results: list[Outcome | None]) -> None:
+    """One batched call for every variant; an error stops them all (it is reported for each)."""
+    t0 = time.perf_counter()
+    try:
+        got = list(batch(variants))
+    except BaseException as exc:  # noqa: BLE001 - reported per variant
+        if isinstance(exc, KeyboardInterrupt):
+            raise
+        msg = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        tb = traceback.format_exc()
+        for v in variants:
+            results[v.index] = Outcome(v, None, (), msg, tb)
+        return
+    if len(got) != len(variants):
+        msg = (f"InternalError: the batch returned {len(got)} results for {len(variants)} "
+               "variants")
+        for v in variants:
+            results[v.index] = Outcome(v, None, (), msg)
+        return
+    share = (time.perf_counter() - t0) / max(len(variants), 1)
+    for v, item in zip(variants, got):
+        try:
+            results[v.index] = outcome_of(v, item, share)
+        except Exception as exc:  # noqa: BLE001 - reported per variant
+            results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {exc}".splitlines()[0],
+                                       traceback.format_exc(), wall_s=share)
+
+
+def check_reachable(address: str, timeout_s: float = 5.0) -> None:
+    """Refuse a cluster address nobody answers at (Ray itself would retry for minutes)."""
+    import socket
+
+    where = address.split("://", 1)[-1]
+    host, _, port = where.rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise SweepError(f"--address {address!r}: expected auto or HOST:PORT (the Ray head "
+                         "node's GCS port, 6379 by default)")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s):
+            pass
+    except OSError as exc:
+        raise SweepError(f"--address {address}: cannot connect to Ray: "
+                         f"{exc.strerror or exc}") from None
+
+
+def _run_on_ray(runner: Callable[[Variant], Any], variants: Sequence[Variant],
+                results: list[Outcome | None], address: str | None, workers: int,
+                bar: Any) -> None:
+    """Run the variants as Ray tasks (one CPU each) and put their outcomes in ``results``
+    (variant order, whatever the completion order).
+
+    With ``address`` None a local Ray instance with ``workers`` CPUs is started and shut down
+    afterwards; otherwise cellsim connects to that cluster (which must have the same cellsim
+    installed on every node) and leaves it running. A task that dies (a worker killed, a node
+    lost) becomes that variant's error; the others go on.
+    """
+    import logging
+
+    ray = import_ray()
+    started = not ray.is_initialized()
+    if started:
+        kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
+                                  "logging_level": logging.ERROR, "configure_logging": False}
+        if address is None:
+            kwargs["num_cpus"] = workers
+        try:
+            ray.init(address=address, **kwargs)
+        except (ConnectionError, RuntimeError, ValueError) as exc:
+            first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            raise SweepError(f"--address {address}: cannot connect to Ray: {first}"
+                             if address else f"cannot start a local Ray instance: {first}"
+                             ) from None
+    try:
+        task = ray.remote(num_cpus=1, max_retries=0)(run_group)
+        cpus = workers if address is None else int(ray.cluster_resources().get("CPU", workers))
+        pending = {task.remote(runner, g): g for g in task_groups(variants, cpus)}
+        while pending:
+            done, _ = ray.wait(list(pending), num_returns=1)
+            for ref in done:
+                group = pending.pop(ref)
+                try:
+                    for o in ray.get(ref):
+                        results[o.variant.index] = o
+                except Exception as exc:  # noqa: BLE001 - a lost worker or node
+                    first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+                    for v in group:
+                        results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {first}")
+                bar.update(len(group))
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def run_variants(runner: Callable[[Variant], Any], variants: list[Variant], workers: int,
+                  mp_context: str, engine: str, address: str | None, batch: Any,
+                  progress: bool) -> SweepResult:
+    """Run every variant (a batch, Ray, this process or a process pool)."""
+    from tqdm import tqdm
+
+    bar = tqdm(total=len(variants), desc="sweep", unit="run", disable=None if progress else True)
+    t0 = time.perf_counter()
+    results: list[Outcome | None] = [None] * len(variants)
+    try:
+        if batch is not None:
+            _run_batch(batch, variants, results)
+            bar.update(len(variants))
+        elif engine == "ray":
+            _run_on_ray(runner, variants, results, address, workers, bar)
+        elif workers == 1:  # in this process, a speed scale's variants one after the other
+            for group in task_groups(variants, 1):
+                for v in group:
+                    results[v.index] = run_variant(runner, v)
+                    bar.update()
+        else:
+            ctx = multiprocessing.get_context(mp_context)
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+                futures = {pool.submit(run_group, runner, g): g
+                           for g in task_groups(variants, workers)}
+                for fut in as_completed(futures):
+                    group = futures[fut]
+                    try:
+                        for o in fut.result():
+                            results[o.variant.index] = o
+                    except Exception as exc:  # the worker died (BrokenProcessPool, pickling)
+                        for v in group:
+                            results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {exc}")
+                    bar.update(len(group))
+    finally:
+        bar.close()
+    return SweepResult(outcomes=[r for r in results if r is not None], workers=workers,
+                       wall_s=time.perf_counter() - t0)
+
+
+__all__ = ["ENGINES", "check_reachable", "import_ray", "run_group", "run_variants", "task_groups"]

@@ -1,0 +1,134 @@
+"""A sweep's report: ``sweep.csv`` (one row per variant and joint), ``sweep.md`` (pivot tables of
+peak and RMS torque, sizing margins, failures), ``sweep.png`` (torque against payload and
+against speed scale) and ``sweep.json``."""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sim.analysis.report import csv_text, figure_png, write_atomic
+from sim.pipeline.sweep.variants import SweepResult
+
+#: Columns of sweep.csv, in order.
+SWEEP_COLUMNS = ("payload_kg", "speed_scale", "joint", "peak_torque_nm", "rms_torque_nm",
+                 "peak_torque_id_nm", "peak_torque_sim_nm", "rms_torque_id_nm", "rms_torque_sim_nm",
+                 "peak_speed_rad_s", "peak_power_w", "duration_s", "margin_pct", "pass",
+                 "limiting", "verdict", "run_dir")
+
+
+def _pivot(rows: Sequence[dict[str, Any]], key: str, joints: Sequence[str]) -> list[list[str]]:
+    table: dict[tuple[float, float], dict[str, float]] = {}
+    for r in rows:
+        table.setdefault((r["payload_kg"], r["speed_scale"]), {})[r["joint"]] = r[key]
+    out = []
+    for (p, s), vals in table.items():
+        cells = [f"{vals[j]:.4g}" if j in vals and np.isfinite(vals[j]) else "n/a" for j in joints]
+        out.append([f"{p:g}", f"{s:g}", *cells])
+    return out
+
+
+def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
+    """Text of ``sweep.md``: pivot tables (variant rows, joint columns), failures, chart."""
+    rows = result.rows
+    joints = list(dict.fromkeys(r["joint"] for r in rows))
+    ok = len(result.outcomes) - len(result.failures)
+    parts = ["# Sweep", "",
+             f"{len(result.outcomes)} variants ({ok} succeeded), {result.workers} worker(s), "
+             f"{result.wall_s:.1f} s wall-clock. Speed scale s divides the knot times "
+             "(s = 2: twice as fast). Torques are the larger of inverse dynamics and simulation.",
+             ""]
+    head = ["payload kg", "speed scale", *joints]
+
+    def table(title: str, key: str) -> None:
+        parts.extend([f"## {title}", "",
+                      "| " + " | ".join(head) + " |", "|" + "---|" * len(head)])
+        parts.extend("| " + " | ".join(r) + " |" for r in _pivot(rows, key, joints))
+        parts.append("")
+
+    if rows:
+        table("Peak |torque| (N m)", "peak_torque_nm")
+        table("RMS torque (N m)", "rms_torque_nm")
+        if any(np.isfinite(r["margin_pct"]) for r in rows):
+            table("Sizing margin (%)", "margin_pct")
+    if result.failures:
+        parts += ["## Failed variants", ""]
+        parts += [f"- {o.variant.label}: {o.error}" for o in result.failures]
+        parts.append("")
+    if chart and rows:
+        parts += ["## Chart", "", f"![peak and RMS torque]({chart})", ""]
+    return "\n".join(parts)
+
+
+def sweep_chart(result: SweepResult) -> bytes:
+    """PNG: per joint (rows), peak (solid) and RMS (dashed) torque against payload (left, one
+    line per speed scale) and against speed scale (right, one line per payload)."""
+    import matplotlib
+    from matplotlib.figure import Figure
+
+    rows = result.rows
+    joints = list(dict.fromkeys(r["joint"] for r in rows))
+    payloads = sorted({r["payload_kg"] for r in rows})
+    scales = sorted({r["speed_scale"] for r in rows})
+    idx = {(r["payload_kg"], r["speed_scale"], r["joint"]): r for r in rows}
+    fig = Figure(figsize=(10, 2.3 * len(joints) + 0.8), layout="constrained")
+    axes = fig.subplots(len(joints), 2, squeeze=False)
+    cmap = matplotlib.colormaps["viridis"]
+
+    def lines(ax, xs, series_keys, label_fmt, make_key):
+        for i, other in enumerate(series_keys):
+            color = cmap(i / max(len(series_keys) - 1, 1))
+            for key, style in (("peak_torque_nm", "-o"), ("rms_torque_nm", "--s")):
+                pts = [(x, idx[make_key(x, other)][key]) for x in xs if make_key(x, other) in idx]
+                if pts:
+                    x, y = zip(*pts)
+                    ax.plot(x, y, style, color=color, ms=3.5, lw=1.2,
+                            label=label_fmt(other) if key == "peak_torque_nm" else None)
+
+    for k, j in enumerate(joints):
+        ax_p, ax_s = axes[k]
+        lines(ax_p, payloads, scales, lambda s: f"speed x{s:g}", lambda x, s: (x, s, j))
+        lines(ax_s, scales, payloads, lambda p: f"{p:g} kg", lambda x, p: (p, x, j))
+        ax_p.set_ylabel(f"{j} torque (N m)")
+        for ax in (ax_p, ax_s):
+            ax.grid(alpha=0.3)
+        if k == 0:
+            ax_p.set_title("against payload (solid: peak, dashed: RMS)", fontsize=9)
+            ax_s.set_title("against speed scale (solid: peak, dashed: RMS)", fontsize=9)
+            ax_p.legend(fontsize=7)
+            ax_s.legend(fontsize=7)
+    axes[-1][0].set_xlabel("payload (kg)")
+    axes[-1][1].set_xlabel("speed scale")
+    return figure_png(fig)
+
+
+def write_sweep(out_dir: str | Path, result: SweepResult) -> dict[str, Path]:
+    """Write ``sweep.csv``, ``sweep.json``, ``sweep.png`` (when any variant succeeded) and
+    ``sweep.md`` into ``out_dir`` (atomically). Returns the paths by name."""
+    out = Path(out_dir)
+    files: dict[str, Path] = {}
+    rows = result.rows
+    files["csv"] = write_atomic(out / "sweep.csv", csv_text(SWEEP_COLUMNS, rows))
+    payload = {
+        "workers": result.workers, "wall_s": result.wall_s,
+        "variants": [{"payload_kg": o.variant.payload_kg, "speed_scale": o.variant.speed_scale,
+                      "run_dir": o.run_dir, "error": o.error, "wall_s": o.wall_s}
+                     for o in result.outcomes],
+        "rows": [{k: (v if not isinstance(v, float) or math.isfinite(v) else None)
+                  for k, v in r.items()} for r in rows],
+    }
+    files["json"] = write_atomic(out / "sweep.json", json.dumps(payload, indent=2) + "\n")
+    chart = None
+    if rows:
+        files["png"] = write_atomic(out / "sweep.png", sweep_chart(result))
+        chart = "sweep.png"
+    files["md"] = write_atomic(out / "sweep.md", sweep_markdown(result, chart))
+    return files
+
+
+__all__ = ["SWEEP_COLUMNS", "sweep_chart", "sweep_markdown", "write_sweep"]
