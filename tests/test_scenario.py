@@ -399,7 +399,7 @@ def test_knot_times_at_any_scale_plan_or_are_one_line_without_numpy_warnings(tim
     knot times within MAX_TIME_S of 0), and numpy warns of nothing (warnings are errors)."""
     import warnings
 
-    from sim.scenario.loader import MAX_TIME_S, MIN_SEGMENT_S
+    from sim.scenario.phases import MAX_TIME_S, MIN_SEGMENT_S
     from sim.simulation.motion import build_motion
 
     text = GOOD.replace("time_s = [0.0, 1.0, 2.0]", f"time_s = {times!r}")

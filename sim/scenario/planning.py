@@ -1,0 +1,42 @@
+"""Planning a scenario's joint phases with their planners (:mod:`planners`): one trajectory
+per phase, a planner's refusal as one line naming the phase."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from planners.errors import PlannerError
+from planners.registry import get_planner
+from sim.errors import ScenarioError
+from sim.scenario.model import JointPhase, Scenario
+
+
+@dataclass(frozen=True)
+class PlannedPhase:
+    """A phase with its trajectory."""
+
+    phase: JointPhase
+    trajectory: Any  # planners.trajectory.PiecewisePolynomialTrajectory
+
+
+def plan_phase(phase: JointPhase, where: str = "") -> Any:
+    """Plan one joint phase with its planner.
+
+    Raises:
+        ScenarioError: The planner rejected the phase (message prefixed with ``where``).
+    """
+    try:
+        return get_planner(phase.planner)(phase.times, phase.q, **phase.boundary)
+    except PlannerError as exc:
+        prefix = f"{where}: " if where else ""
+        raise ScenarioError(f"{prefix}phases[{phase.index}] ({phase.name}): {exc}") from None
+
+
+def plan_scenario(scenario: Scenario) -> list[PlannedPhase]:
+    """Plan every phase of a scenario, in order."""
+    where = scenario.source.name
+    return [PlannedPhase(p, plan_phase(p, where)) for p in scenario.phases]
+
+
+__all__ = ["PlannedPhase", "plan_phase", "plan_scenario"]
