@@ -14,9 +14,16 @@ Differences, all measured by ``tests/test_warp_backend.py`` against the CPU path
 
 * MuJoCo Warp computes in float32: joint paths agree to about 1e-5 rad and torques to a
   fraction of a percent on the shipped robots (the tests bound them at 1e-4 rad and 1 %).
-* A drive's torque-speed envelope (``simulation.motor_speed_limits``) follows the reference's
-  speeds step by step (the CPU path also watches the joint's own speed, in chunks); where a
-  drive runs past its curve's knee the two may differ, and the CPU path is the reference.
+* The drives' limit is the CPU path's (:class:`_MotorBounds`): every step, in every world,
+  each drive may give at most the joint torque at which its motor gives exactly its peak at
+  the motor's own speed (:meth:`sim.robots.registry.Drive.joint_torque_for`, the gear's
+  efficiency in the direction power flows, the rotor's inertia on the motor side), and never
+  more than its torque-speed curve at the joint. The step's acceleration enters that bound and
+  is known only after the step, so a step whose acceleration moved the bound is run again
+  (the whole batch, from the saved state) until the motors agree within
+  :data:`WARP_MOTOR_TOL` of their peaks: float32 instead of the CPU path's 1e-9. The CPU path
+  sets its curve limit in chunks of ten steps from the highest speed reached; here it follows
+  the speed step by step, so past a curve's knee the two differ by that chunking.
 * Variants of different durations (speed scales) run to the longest; a shorter one holds its
   last control after its end and its arrays stop at its own end.
 
@@ -35,13 +42,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import SimulationError
-from sim.robots.registry import Drive
+from sim.robots.registry import RPM_PER_RAD_S, Drive
 from sim.simulation.compile import BuiltCell
 from sim.simulation.motion import Motion
 from sim.simulation.simulate import (
+    MOTOR_ITERATIONS,
     SimulationRecord,
     _arrays,
-    _joint_peak,
     reference_controls,
 )
 
@@ -178,41 +185,32 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
     drives = list(drives) if drives is not None else [None] * nworld
     nu = models[0].nu
 
-    # host side: references, feed-forward, controls and drive limits per variant
+    # host side: references, feed-forward and controls per variant
     per: list[dict[str, Any]] = []
-    for built, motion, drv in zip(builts, motions, drives):
+    for built, motion in zip(builts, motions):
         n = int(round((motion.duration + settle_s) / dt))
         t = motion.t0 + dt * np.arange(n + 1)
         ref = motion.at(t)
         tau_id, ff, controls = reference_controls(built, motion, t, ref, feedforward)
-        flat = built.force_limits[:, 1]
-        limit = np.tile(flat, (n + 1, 1))
-        if drv is not None:
-            limit = np.minimum(_joint_peak(drv, np.abs(ref.qd)), flat)
         per.append({"n": n, "t": t, "ref": ref, "tau_id": tau_id, "ff": ff,
-                    "controls": controls, "limit": limit})
+                    "controls": controls})
     n_max = max(p["n"] for p in per)
-    # every step's controls and force ranges, the shorter variants holding their last values
+    ends = np.array([p["n"] for p in per])
+    # every step's controls, the shorter variants holding their last values
     ctrl = np.zeros((n_max + 1, nworld, nu), dtype=np.float32)
-    frange = np.zeros((n_max + 1, nworld, nu, 2), dtype=np.float32)
-    for w, (p, built) in enumerate(zip(per, builts)):
+    for w, p in enumerate(per):
         pad = n_max - p["n"]
         ctrl[:, w] = np.concatenate([p["controls"], np.repeat(p["controls"][-1:], pad, 0)])
-        base = built.model.actuator_forcerange.astype(np.float32)
-        lim = np.concatenate([p["limit"], np.repeat(p["limit"][-1:], pad, 0)])
-        frange[:, w] = base
-        frange[:, w, built.robot_act, 0] = -lim
-        frange[:, w, built.robot_act, 1] = lim
-    # limits that differ from the models' force ranges at any step (a drive's torque-speed
-    # curve binding) are copied to the device every step
-    model_ranges = np.stack([m.actuator_forcerange for m in models]).astype(np.float32)
-    varying_limits = bool(np.any(frange != model_ranges[None]))
+    motor = _MotorBounds(builts, drives) if any(d is not None for d in drives) else None
+    nj = len(builts[0].robot_act)
+    # the limit each step applied, per world and joint (float32, as the device clamps)
+    limits = np.empty((n_max + 1, nworld, nj))
 
     device = device or default_device()
     try:
         with wp.ScopedDevice(device):
             batched = _batched_fields(models, labels)
-            if varying_limits and "actuator_forcerange" not in batched:
+            if motor is not None and "actuator_forcerange" not in batched:
                 batched.append("actuator_forcerange")
             try:
                 mw = mjw.put_model(models[0], batch_sizes={f: nworld for f in batched})
@@ -238,8 +236,6 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
             dw.time.assign(np.array([m.t0 for m in motions], dtype=np.float32))
 
             ctrl_dev = wp.array(ctrl, dtype=float)
-            frange_dev = wp.array(frange.reshape(n_max + 1, nworld, nu, 2), dtype=wp.vec2) \
-                if varying_limits else None
             nq, nv, ns = models[0].nq, models[0].nv, models[0].nsensordata
             qpos_dev = wp.zeros((n_max + 1, nworld, nq), dtype=float)
             qvel_dev = wp.zeros((n_max + 1, nworld, nv), dtype=float)
@@ -249,20 +245,20 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
             start = time.perf_counter()
             nacon_dev = wp.zeros(n_max + 1, dtype=int)
             nefc_dev = wp.zeros((n_max + 1, nworld), dtype=int)
-            for k in range(n_max):
-                wp.copy(dw.ctrl, ctrl_dev[k])
-                if frange_dev is not None:
-                    wp.copy(mw.actuator_forcerange, frange_dev[k])
-                mjw.step(mw, dw)
-                wp.copy(qpos_dev[k + 1], dw.qpos)
-                wp.copy(qvel_dev[k + 1], dw.qvel)
-                wp.copy(sens_dev[k], dw.sensordata)  # computed at state k, before the step
-                wp.copy(nacon_dev, dw.nacon, dest_offset=k, count=1)
-                wp.copy(nefc_dev[k], dw.nefc)
+            if motor is None:
+                flat = np.stack([b.force_limits[:, 1] for b in builts]).astype(np.float32)
+                limits[:] = flat
+                for k in range(n_max):
+                    wp.copy(dw.ctrl, ctrl_dev[k])
+                    mjw.step(mw, dw)
+                    _record_step(wp, dw, k, qpos_dev, qvel_dev, sens_dev, nacon_dev, nefc_dev)
+            else:
+                first_qdd = np.stack([p["ref"].qdd[0] for p in per])
+                _motor_steps(wp, mjw, mw, dw, motor, ctrl_dev, n_max, ends, first_qdd, labels,
+                             limits, (qpos_dev, qvel_dev, sens_dev, nacon_dev, nefc_dev))
             wp.copy(dw.ctrl, ctrl_dev[n_max])
-            if frange_dev is not None:
-                wp.copy(mw.actuator_forcerange, frange_dev[n_max])
-            mjw.forward(mw, dw)
+            if motor is None:
+                mjw.forward(mw, dw)
             wp.copy(sens_dev[n_max], dw.sensordata)
             wp.synchronize()
             wall = time.perf_counter() - start
@@ -296,7 +292,186 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
                                   "(NaN in the state, MuJoCo Warp); try a smaller "
                                   "simulation.timestep_s")
         arrays = _arrays(built, motion, p["t"], p["ref"], p["tau_id"], p["ff"], q, v, s,
-                         p["limit"])
+                         limits[:n + 1, w])
         records.append(SimulationRecord(arrays=arrays, wall_s=wall / nworld, steps=n,
                                         timestep=dt))
     return records
+
+
+def _record_step(wp: Any, dw: Any, k: int, qpos_dev: Any, qvel_dev: Any, sens_dev: Any,
+                 nacon_dev: Any, nefc_dev: Any) -> None:
+    """Keep step ``k``'s outcome: the state after it, the sensors before it (computed at state
+    ``k``) and its contact and constraint counts."""
+    wp.copy(qpos_dev[k + 1], dw.qpos)
+    wp.copy(qvel_dev[k + 1], dw.qvel)
+    wp.copy(sens_dev[k], dw.sensordata)
+    wp.copy(nacon_dev, dw.nacon, dest_offset=k, count=1)
+    wp.copy(nefc_dev[k], dw.nefc)
+
+
+#: Motor torque tolerance of the batched step, in peak torques: a step runs again until every
+#: motor at its limit gives its peak within it, and no other motor passes it by more (float32
+#: speeds put about 1e-6 of a peak of noise into a motor torque through the step's acceleration).
+WARP_MOTOR_TOL = 2e-5
+#: Largest motor torque error accepted after ``MOTOR_ITERATIONS`` passes of a step, in peak
+#: torques (as the CPU path's ``MOTOR_SETTLE_TOL``).
+WARP_SETTLE_TOL = 1e-4
+
+
+class _MotorBounds:
+    """The drives' motor limit of every world of a batch, as the CPU path's ``_MotorLimit``.
+
+    Per world and joint, at joint speed ``qd`` (the step's start: the motor's own speed) and
+    the step's acceleration ``qdd``, a drive's force range is where its motor torque
+    (:meth:`~sim.robots.registry.Drive.motor_torque`) stays within the peak curve at the
+    motor's speed: ``[joint_torque_for(-peak(qd), qd, qdd), joint_torque_for(peak(qd), qd,
+    qdd)]``, and within the curve at the joint (``joint_peak_torque_at``, never above the
+    actuator's ``forcerange``), as on the CPU path, where the force range stays the curve's and
+    the motor's law only lowers it. The drive's own methods are called on the worlds that share
+    it (vectorised over the batch). Where the two ranges do not meet (a motor past its top
+    speed, which gives 0 N m, while the rotor accelerates), the motor's law wins, as on the CPU
+    path. A joint whose actuator has no force limit has none here either.
+    """
+
+    def __init__(self, builts: Sequence[BuiltCell],
+                 drives: Sequence[Sequence[Drive] | None]) -> None:
+        b0 = builts[0]
+        self.act = np.asarray(b0.robot_act)
+        self.dof = np.asarray(b0.robot_dof)
+        nj = len(self.act)
+        rows = np.arange(b0.model.nsensordata)
+        self.tau_cols = np.concatenate([rows[b0.sensor_slices[f"tau{i}"]] for i in range(nj)])
+        self.h = float(b0.model.opt.timestep)
+        self.flat = np.stack([b.force_limits[:, 1] for b in builts])
+        self.arm = np.stack([b.model.dof_armature[self.dof] for b in builts])
+        self.kv = np.stack([-b.model.actuator_biasprm[self.act, 2] for b in builts])
+        self.base = np.stack([b.model.actuator_forcerange for b in builts])
+        limited = np.stack([b.model.actuator_forcelimited[self.act].astype(bool) for b in builts])
+        groups: dict[tuple[int, Drive], list[int]] = {}
+        for w, drv in enumerate(drives):
+            for j, d in enumerate(drv or ()):
+                if limited[w, j]:
+                    groups.setdefault((j, d), []).append(w)
+        self.groups = [(j, d, np.array(ws)) for (j, d), ws in groups.items()]
+        self.active = np.zeros(self.flat.shape, dtype=bool)
+        #: one motor peak torque as a joint torque (N eta): the tolerances' scale, N m
+        self.scale = np.ones(self.flat.shape)
+        for j, d, ws in self.groups:
+            self.active[ws, j] = True
+            self.scale[ws, j] = d.peak_torque * d.gear_ratio * d.efficiency
+
+    def bounds(self, qd: NDArray[np.float64], qdd: NDArray[np.float64]
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The force range ``(lo, hi)`` of every world and joint (nworld, n), float32 values."""
+        lo, hi = -self.flat.copy(), self.flat.copy()
+        for j, d, ws in self.groups:
+            v, a, arm = qd[ws, j], qdd[ws, j], self.arm[ws, j]
+            avail = d.peak_torque_at(v * d.gear_ratio * RPM_PER_RAD_S)
+            curve = np.minimum(d.joint_peak_torque_at(v), self.flat[ws, j])
+            top = d.joint_torque_for(avail, v, a, arm)
+            bottom = d.joint_torque_for(-avail, v, a, arm)
+            h, low = np.minimum(curve, top), np.maximum(-curve, bottom)
+            near = np.where(bottom > curve, bottom, top)
+            empty = low > h
+            lo[ws, j] = np.where(empty, near, low)
+            hi[ws, j] = np.where(empty, near, h)
+        return (lo.astype(np.float32).astype(np.float64),
+                hi.astype(np.float32).astype(np.float64))
+
+    def forcerange(self, lo: NDArray[np.float64], hi: NDArray[np.float64]) -> NDArray[np.float32]:
+        """Every actuator's force range of every world (nworld, nu, 2), the drives' set."""
+        out = self.base.copy()
+        out[:, self.act, 0] = lo
+        out[:, self.act, 1] = hi
+        return out.astype(np.float32)
+
+    def error(self, qd0: NDArray[np.float64], qdd: NDArray[np.float64],
+              tau_act: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
+              ) -> NDArray[np.float64]:
+        """How far each drive's torque in a step that ran with force range ``(lo, hi)`` is from
+        where its motor law puts it at the acceleration the step had, in peak torques: a drive
+        at its limit by the distance of that limit from the limit at this acceleration, any
+        other by how far its torque (as recorded: the implicit step's velocity term at the
+        end-of-step speed) passes the latter."""
+        lo_a, hi_a = self.bounds(qd0, qdd)
+        at_hi, at_lo = tau_act >= hi, tau_act <= lo
+        tau = tau_act - self.h * self.kv * qdd
+        err = np.where(at_hi, np.abs(hi_a - hi), np.where(
+            at_lo, np.abs(lo_a - lo), np.maximum(np.maximum(tau - hi_a, lo_a - tau), 0.0)))
+        return np.where(self.active, err / self.scale, 0.0)
+
+
+def _motor_steps(wp: Any, mjw: Any, mw: Any, dw: Any, motor: _MotorBounds, ctrl_dev: Any,
+                 n_max: int, ends: NDArray[np.int_], first_qdd: NDArray[np.float64],
+                 labels: Sequence[str], limits: NDArray[np.float64],
+                 out: tuple[Any, ...]) -> None:
+    """Step the batch ``n_max`` times with the drives' motor limit (:class:`_MotorBounds`), and
+    set the final state's force ranges (for its sensors).
+
+    Each step starts from the acceleration the last one had (the reference's at the first):
+    the bounds at it are set on the device and the batch steps; where a drive's torque is off
+    its motor law at the acceleration the step really had by more than :data:`WARP_MOTOR_TOL`,
+    the batch runs the step again from the saved state with a new acceleration for that drive
+    (first the step's own, then a secant on the last two passes: the bound moves with the
+    acceleration by ``J_r N^2 (1 - eta)`` or ``J_r N^2 (1 - 1/eta)``, a fraction of the
+    joint's inertia, so this converges in two or three passes). Worlds past their own end
+    (shorter variants) run along unchecked. ``limits`` gets the limit each step applied on the
+    side the drive pushed (what the records call ``tau_limit``).
+    """
+    qpos_dev, qvel_dev, sens_dev, nacon_dev, nefc_dev = out
+    saved = {name: wp.clone(getattr(dw, name))
+             for name in ("qpos", "qvel", "act", "time", "qacc_warmstart")}
+    qd0 = dw.qvel.numpy()[:, motor.dof].astype(np.float64)
+    last = np.zeros((2,) + qd0.shape)  # the accelerations of the last two steps
+    for k in range(n_max + 1):
+        live = k < ends  # worlds whose step k is recorded
+        est = first_qdd if k == 0 else (last[1] if k == 1 else 2 * last[1] - last[0])
+        # a world's final sample repeats its last step's acceleration (as recorded)
+        est = np.where((k == ends)[:, None] & (k > 0), last[1], est)
+        wp.copy(dw.ctrl, ctrl_dev[k])
+        if k == n_max:
+            lo, hi = motor.bounds(qd0, est)
+            mw.actuator_forcerange.assign(motor.forcerange(lo, hi))
+            mjw.forward(mw, dw)
+            tau_act = dw.sensordata.numpy()[:, motor.tau_cols].astype(np.float64)
+            limits[k] = np.where(tau_act >= 0, hi, -lo)
+            return
+        for name, arr in saved.items():
+            wp.copy(arr, getattr(dw, name))
+        prev = None
+        for it in range(MOTOR_ITERATIONS):
+            if it:  # the step again, from the saved state
+                for name, arr in saved.items():
+                    wp.copy(getattr(dw, name), arr)
+            lo, hi = motor.bounds(qd0, est)
+            mw.actuator_forcerange.assign(motor.forcerange(lo, hi))
+            mjw.step(mw, dw)
+            qd1 = dw.qvel.numpy()[:, motor.dof].astype(np.float64)
+            tau_act = dw.sensordata.numpy()[:, motor.tau_cols].astype(np.float64)
+            qdd = (qd1 - qd0) / motor.h
+            err = np.where(live[:, None], motor.error(qd0, qdd, tau_act, lo, hi), 0.0)
+            bad = err > WARP_MOTOR_TOL
+            if not bad.any():
+                break
+            # the next guess of the step's acceleration, drive by drive: a secant through the
+            # last two passes where there are two, else this pass's
+            new = qdd.copy()
+            if prev is not None:
+                p_est, p_qdd = prev
+                r, p_r = qdd - est, p_qdd - p_est
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    sec = est - r * (est - p_est) / (r - p_r)
+                new = np.where(np.isfinite(sec), sec, qdd)
+            prev = (est, qdd)
+            est = np.where(bad, new, est)
+        else:
+            if np.any(err > WARP_SETTLE_TOL):
+                w, j = np.unravel_index(int(np.argmax(err)), err.shape)
+                raise SimulationError(
+                    f"{labels[w]}: the drives' motor torque limit did not settle in "
+                    f"{MOTOR_ITERATIONS} passes at step {k} (joint {j + 1}, {err[w, j]:.2g} of "
+                    "the peak torque off, MuJoCo Warp); try a smaller simulation.timestep_s")
+        _record_step(wp, dw, k, qpos_dev, qvel_dev, sens_dev, nacon_dev, nefc_dev)
+        limits[k] = np.where(tau_act >= 0, hi, -lo)
+        last = np.stack([last[1], qdd])
+        qd0 = qd1
