@@ -140,3 +140,99 @@ def test_a_drive_torque_speed_curve_reaches_the_device(tmp_path):
         (a["tau_limit"] < flat * (1 - 1e-6))
     assert held.any(), "no drive is held at its curve: pick a faster move"
     assert np.all(np.abs(a["tau_actuator"]) <= a["tau_limit"] * (1 + 1e-5) + 1e-3)
+
+
+#: The 5R's J2 drive made too weak for its arm (models/robot_5r/README.md: ratio 160, efficiency
+#: 0.8; here a twentieth of its 46 N m peak motor torque, rated half of that, another rotor
+#: and a 2500 rpm motor): the arm sags, the drive saturates, and the arm falls faster than the
+#: motor's top speed, where the motor has nothing to give.
+WEAK_J2 = {"peak": 46.0 / 20, "rated": 46.0 / 40, "ratio": 160.0, "eta": 0.8, "rotor": 1.0e-3,
+           "top_rpm": 2500.0}
+
+
+def _weak_j2(tmp_path: Path):
+    d = WEAK_J2
+    path = _scenario(tmp_path, "robot_5r")
+    path.write_text(path.read_text() + f"\n[drives.j2]\npeak_torque_nm = {d['peak']}\n"
+                    f"rated_torque_nm = {d['rated']}\nrotor_inertia_kg_m2 = {d['rotor']}\n"
+                    f"max_speed_rpm = {d['top_rpm']}\n")
+    return load_scenario(path)
+
+
+def _motor_excess(arrays) -> np.ndarray:
+    """Per sample, J2's motor torque past the motor's peak at the motor's own speed, in peak
+    torques, recomputed from the recorded joint torque, speed and acceleration with
+    :data:`WEAK_J2`'s numbers: the gear's efficiency on the load torque in the direction power
+    flows (the motor drives at standstill), the rotor's inertia on the motor side; the peak
+    flat to 70 % of the top speed, then straight down to the rated torque at it, 0 beyond."""
+    d = WEAK_J2
+    tau, qd, qdd = (arrays[k][:, 1] for k in ("tau", "qd", "qdd"))
+    n, eta, rotor, peak, top = d["ratio"], d["eta"], d["rotor"], d["peak"], d["top_rpm"]
+    load = tau - rotor * n**2 * qdd
+    drives = (load * qd >= 0) | (np.abs(qd) < 1e-3)
+    motor = np.where(drives, load / (n * eta), load * eta / n) + rotor * n * qdd
+    rpm = np.abs(qd) * n * 60 / (2 * np.pi)
+    curve = np.where(rpm <= 0.7 * top, peak, np.where(
+        rpm <= top, peak + (d["rated"] - peak) * (rpm - 0.7 * top) / (0.3 * top), 0.0))
+    return (np.abs(motor) - curve) / peak
+
+
+#: float32 state: the step's acceleration from float32 speeds, the torque a float32 clamp
+F32_MOTOR_TOL = 1e-4
+
+
+@pytest.mark.slow
+def test_a_saturated_drive_is_held_at_its_motor_peak_at_the_motor_speed(tmp_path):
+    """Issue 26, one drive everywhere: the Warp worlds clamp each drive where its motor gives
+    its peak at the motor's own speed and acceleration, as the CPU path does. Two payloads in
+    one batch; the oracle is the drive's numbers written above, applied to what was recorded."""
+    base = _weak_j2(tmp_path)
+    variants = [base.scaled(1.0, 1.0), base.scaled(1.0, 2.0)]
+    options = dict(video=False, plots=False, progress=False)
+    gpu = evaluate_scenarios(variants, RunOptions(**options, backend="warp"))
+    cpu = evaluate_scenarios(variants, RunOptions(**options, backend="mujoco"))
+    top = WEAK_J2["top_rpm"] * 2 * np.pi / 60 / WEAK_J2["ratio"]
+    for g, c in zip(gpu, cpu):
+        a = g.record.arrays
+        excess = _motor_excess(a)
+        assert excess.max() <= F32_MOTOR_TOL, (int(np.argmax(excess)), excess.max())
+        # the case reaches what it is meant to: the drive at its limit, the curve's falling
+        # part and the motor past its top speed, where the drive is held where its motor
+        # gives 0 N m (not at 0 N m: its rotor accelerates with the arm)
+        held = np.abs(a["tau_actuator"][:, 1]) >= a["tau_limit"][:, 1] * (1 - 1e-6)
+        assert held.sum() > 100
+        fast = held & (np.abs(a["qd"][:, 1]) > 1.01 * top)
+        assert fast.any() and np.all(np.abs(a["tau"][fast, 1]) > 1.0)
+        assert np.all(np.abs(excess[fast]) <= F32_MOTOR_TOL)
+        # and the MuJoCo backend's record passes the same oracle, at its own 1e-9
+        assert _motor_excess(c.record.arrays).max() <= 1e-9
+        # the verdict reports the saturation as the MuJoCo backend's does
+        failed = {k["name"] for k in g.summary["checks"] if not k["pass"]}
+        assert "saturation" in failed
+        assert failed == {k["name"] for k in c.summary["checks"] if not k["pass"]}
+        assert "j2" in {s["joint"] for s in g.summary["saturation"]}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("fault", ["flat force range", "curve at the joint, no motor law"])
+def test_the_motor_oracle_catches_a_planted_clamp_fault(tmp_path, monkeypatch, fault):
+    """The oracle above is not blind: a Warp batch whose drives keep the actuator's flat force
+    range (the limit the reference's speed gives below the curve's knee), or follow the curve
+    at the joint's speed without the motor's law (no gear direction, no rotor), lets J2's
+    motor pass its curve at its own speed."""
+    from sim.simulation import warp_batch
+
+    def flat(self, qd, qdd):
+        return -self.flat.copy(), self.flat.copy()
+
+    def joint_curve(self, qd, qdd):
+        hi = self.flat.copy()
+        for j, d, ws in self.groups:
+            hi[ws, j] = np.minimum(d.joint_peak_torque_at(qd[ws, j]), hi[ws, j])
+        return -hi, hi
+
+    monkeypatch.setattr(warp_batch._MotorBounds, "bounds",
+                        flat if fault == "flat force range" else joint_curve)
+    (ev,) = evaluate_scenarios([_weak_j2(tmp_path)], RunOptions(
+        video=False, plots=False, progress=False, backend="warp"))
+    assert _motor_excess(ev.record.arrays).max() > 100 * F32_MOTOR_TOL

@@ -378,27 +378,37 @@ class _MotorBounds:
         return (lo.astype(np.float32).astype(np.float64),
                 hi.astype(np.float32).astype(np.float64))
 
-    def forcerange(self, lo: NDArray[np.float64], hi: NDArray[np.float64]) -> NDArray[np.float32]:
-        """Every actuator's force range of every world (nworld, nu, 2), the drives' set."""
+    def forcerange(self, lo: NDArray[np.float64], hi: NDArray[np.float64],
+                   hold: NDArray[np.int_]) -> NDArray[np.float32]:
+        """Every actuator's force range of every world (nworld, nu, 2), the drives' set: ``(lo,
+        hi)``, or the one value ``hi`` (``lo``) for a drive held there (``hold`` 1 (-1))."""
         out = self.base.copy()
-        out[:, self.act, 0] = lo
-        out[:, self.act, 1] = hi
+        out[:, self.act, 0] = np.where(hold > 0, hi, lo)
+        out[:, self.act, 1] = np.where(hold < 0, lo, hi)
         return out.astype(np.float32)
 
-    def error(self, qd0: NDArray[np.float64], qdd: NDArray[np.float64],
-              tau_act: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
-              ) -> NDArray[np.float64]:
-        """How far each drive's torque in a step that ran with force range ``(lo, hi)`` is from
-        where its motor law puts it at the acceleration the step had, in peak torques: a drive
-        at its limit by the distance of that limit from the limit at this acceleration, any
-        other by how far its torque (as recorded: the implicit step's velocity term at the
-        end-of-step speed) passes the latter."""
+    def check(self, qd0: NDArray[np.float64], qdd: NDArray[np.float64],
+              tau_act: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64],
+              hold: NDArray[np.int_]
+              ) -> tuple[NDArray[np.int_], NDArray[np.float64], NDArray[np.int_]]:
+        """A step that ran with the bounds ``(lo, hi)`` and holds ``hold``, and had the
+        acceleration ``qdd``: per world and joint, the side of its range the drive was at (1,
+        -1; 0 inside it), how far it is from its motor law at that acceleration, in peak
+        torques (a drive at its limit: the distance of that limit from the limit at this
+        acceleration; any other: how far its torque, as recorded, with the implicit step's
+        velocity term at the end-of-step speed, passes the latter), and the holds for the next
+        pass (a drive inside its range whose torque passed it: held at it, as the CPU path
+        holds one)."""
         lo_a, hi_a = self.bounds(qd0, qdd)
-        at_hi, at_lo = tau_act >= hi, tau_act <= lo
+        side = np.where(hold != 0, hold, np.where(tau_act >= hi, 1, np.where(tau_act <= lo, -1, 0)))
         tau = tau_act - self.h * self.kv * qdd
-        err = np.where(at_hi, np.abs(hi_a - hi), np.where(
-            at_lo, np.abs(lo_a - lo), np.maximum(np.maximum(tau - hi_a, lo_a - tau), 0.0)))
-        return np.where(self.active, err / self.scale, 0.0)
+        over, under = tau - hi_a, lo_a - tau
+        err = np.where(side > 0, np.abs(hi_a - hi), np.where(
+            side < 0, np.abs(lo_a - lo), np.maximum(np.maximum(over, under), 0.0)))
+        err = np.where(self.active, err / self.scale, 0.0)
+        passed = (side == 0) & self.active & (err > WARP_MOTOR_TOL)
+        new_hold = np.where(passed, np.where(over > under, 1, -1), hold)
+        return side, err, new_hold
 
 
 def _motor_steps(wp: Any, mjw: Any, mw: Any, dw: Any, motor: _MotorBounds, ctrl_dev: Any,
@@ -408,15 +418,17 @@ def _motor_steps(wp: Any, mjw: Any, mw: Any, dw: Any, motor: _MotorBounds, ctrl_
     """Step the batch ``n_max`` times with the drives' motor limit (:class:`_MotorBounds`), and
     set the final state's force ranges (for its sensors).
 
-    Each step starts from the acceleration the last one had (the reference's at the first):
-    the bounds at it are set on the device and the batch steps; where a drive's torque is off
-    its motor law at the acceleration the step really had by more than :data:`WARP_MOTOR_TOL`,
-    the batch runs the step again from the saved state with a new acceleration for that drive
-    (first the step's own, then a secant on the last two passes: the bound moves with the
-    acceleration by ``J_r N^2 (1 - eta)`` or ``J_r N^2 (1 - 1/eta)``, a fraction of the
-    joint's inertia, so this converges in two or three passes). Worlds past their own end
-    (shorter variants) run along unchecked. ``limits`` gets the limit each step applied on the
-    side the drive pushed (what the records call ``tau_limit``).
+    Each step starts from an estimate of its acceleration (the last two steps' extrapolated;
+    the reference's at the first): the bounds at it are set on the device and the batch steps.
+    Where a drive's torque is off its motor law at the acceleration the step really had by
+    more than :data:`WARP_MOTOR_TOL`, the batch runs the step again from the saved state, with
+    a new acceleration for that drive (first the step's own, then a secant on the last two
+    passes: the bound moves with the acceleration by ``J_r N^2 (1 - eta)`` or ``J_r N^2
+    (1 - 1/eta)``, a fraction of the joint's inertia, so this settles in two or three passes),
+    and a drive whose torque passed its bound inside its range (the implicit step's velocity
+    term) held at the bound. Worlds past their own end (shorter variants) run along unchecked.
+    ``limits`` gets the limit each step applied on the side the drive pushed (the records'
+    ``tau_limit``).
     """
     qpos_dev, qvel_dev, sens_dev, nacon_dev, nefc_dev = out
     saved = {name: wp.clone(getattr(dw, name))
@@ -428,13 +440,14 @@ def _motor_steps(wp: Any, mjw: Any, mw: Any, dw: Any, motor: _MotorBounds, ctrl_
         est = first_qdd if k == 0 else (last[1] if k == 1 else 2 * last[1] - last[0])
         # a world's final sample repeats its last step's acceleration (as recorded)
         est = np.where((k == ends)[:, None] & (k > 0), last[1], est)
+        hold = np.zeros(qd0.shape, dtype=int)
         wp.copy(dw.ctrl, ctrl_dev[k])
-        if k == n_max:
+        if k == n_max:  # the final state: its sensors
             lo, hi = motor.bounds(qd0, est)
-            mw.actuator_forcerange.assign(motor.forcerange(lo, hi))
+            mw.actuator_forcerange.assign(motor.forcerange(lo, hi, hold))
             mjw.forward(mw, dw)
             tau_act = dw.sensordata.numpy()[:, motor.tau_cols].astype(np.float64)
-            limits[k] = np.where(tau_act >= 0, hi, -lo)
+            limits[k] = np.abs(np.where(tau_act >= 0, hi, lo))
             return
         for name, arr in saved.items():
             wp.copy(arr, getattr(dw, name))
@@ -444,13 +457,13 @@ def _motor_steps(wp: Any, mjw: Any, mw: Any, dw: Any, motor: _MotorBounds, ctrl_
                 for name, arr in saved.items():
                     wp.copy(getattr(dw, name), arr)
             lo, hi = motor.bounds(qd0, est)
-            mw.actuator_forcerange.assign(motor.forcerange(lo, hi))
+            mw.actuator_forcerange.assign(motor.forcerange(lo, hi, hold))
             mjw.step(mw, dw)
             qd1 = dw.qvel.numpy()[:, motor.dof].astype(np.float64)
             tau_act = dw.sensordata.numpy()[:, motor.tau_cols].astype(np.float64)
             qdd = (qd1 - qd0) / motor.h
-            err = np.where(live[:, None], motor.error(qd0, qdd, tau_act, lo, hi), 0.0)
-            bad = err > WARP_MOTOR_TOL
+            side, err, new_hold = motor.check(qd0, qdd, tau_act, lo, hi, hold)
+            bad = live[:, None] & ((err > WARP_MOTOR_TOL) | (new_hold != hold))
             if not bad.any():
                 break
             # the next guess of the step's acceleration, drive by drive: a secant through the
@@ -464,14 +477,17 @@ def _motor_steps(wp: Any, mjw: Any, mw: Any, dw: Any, motor: _MotorBounds, ctrl_
                 new = np.where(np.isfinite(sec), sec, qdd)
             prev = (est, qdd)
             est = np.where(bad, new, est)
+            hold = np.where(live[:, None], new_hold, hold)
         else:
-            if np.any(err > WARP_SETTLE_TOL):
-                w, j = np.unravel_index(int(np.argmax(err)), err.shape)
+            left = np.where(live[:, None], err, 0.0)
+            if np.any(left > WARP_SETTLE_TOL):
+                w, j = np.unravel_index(int(np.argmax(left)), left.shape)
                 raise SimulationError(
                     f"{labels[w]}: the drives' motor torque limit did not settle in "
-                    f"{MOTOR_ITERATIONS} passes at step {k} (joint {j + 1}, {err[w, j]:.2g} of "
-                    "the peak torque off, MuJoCo Warp); try a smaller simulation.timestep_s")
+                    f"{MOTOR_ITERATIONS} passes at step {k} (joint {j + 1}, {left[w, j]:.2g} "
+                    "of the peak torque off, MuJoCo Warp); try a smaller simulation.timestep_s")
         _record_step(wp, dw, k, qpos_dev, qvel_dev, sens_dev, nacon_dev, nefc_dev)
-        limits[k] = np.where(tau_act >= 0, hi, -lo)
+        limits[k] = np.abs(np.where(side > 0, hi, np.where(side < 0, lo,
+                                                            np.where(tau_act >= 0, hi, lo))))
         last = np.stack([last[1], qdd])
         qd0 = qd1
