@@ -37,8 +37,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sim.pipeline.sweep.evaluation import evaluate_batch, evaluate_variant  # noqa: E402
 from sim.pipeline.sweep import run_sweep  # noqa: E402
+from sim.pipeline.sweep.evaluation import evaluate_batch, evaluate_variant  # noqa: E402
 
 GRIDS = {8: (2, 4), 64: (8, 8), 256: (16, 16)}
 
