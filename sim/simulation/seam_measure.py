@@ -172,7 +172,7 @@ class SeamMeasurement:
         s: Nearest seam parameter of each sample's tool point, m (N,).
         in_corner: Samples whose ``s`` lies in a corner zone (N,).
         axis_error_deg: Angle of the torch axis from the seam's commanded axis, deg (N,).
-        workangle_deg, travelangle_deg: The measured work angle (from the reference normal,
+        work_angle_deg, travel_angle_deg: The measured work angle (from the reference normal,
             as :class:`sim.cells.seam.Seam` holds it) and travel angle, deg (N,).
         deviation: Distance of the tool point, the programmed weave offset taken out, from the
             seam's tool point nearest to it, m (N,).
@@ -195,8 +195,8 @@ class SeamMeasurement:
     s: NDArray[np.float64]
     in_corner: NDArray[np.bool_]
     axis_error_deg: NDArray[np.float64]
-    workangle_deg: NDArray[np.float64]
-    travelangle_deg: NDArray[np.float64]
+    work_angle_deg: NDArray[np.float64]
+    travel_angle_deg: NDArray[np.float64]
     deviation: NDArray[np.float64]
     lateral: NDArray[np.float64]
     travel_speed: float
@@ -275,8 +275,8 @@ def measure_seam(t: NDArray[np.float64], pos: NDArray[np.float64], rot: NDArray[
     travel = np.degrees(np.arcsin(np.clip(np.einsum("ij,ij->i", a, tan), -1.0, 1.0)))
     work = np.degrees(np.arctan2(-np.einsum("ij,ij->i", a, e), -np.einsum("ij,ij->i", a, n)))
     axis_err = angle_deg(a, a_cmd)
-    work_err = np.abs((work - seam.torch_workangle_deg + 180.0) % 360.0 - 180.0)
-    travel_err = np.abs(travel - seam.torch_travelangle_deg)
+    work_err = np.abs((work - seam.torch_work_angle_deg + 180.0) % 360.0 - 180.0)
+    travel_err = np.abs(travel - seam.torch_travel_angle_deg)
     corner = in_zones(s, corner_zones)
     # the weave's lateral direction: travel x torch axis, in the plane normal to the torch
     lat = np.cross(tan - np.einsum("ij,ij->i", tan, a_cmd)[:, None] * a_cmd, a_cmd)
@@ -296,8 +296,8 @@ def measure_seam(t: NDArray[np.float64], pos: NDArray[np.float64], rot: NDArray[
         wlo, whi = (lo, hi) if weave_window is None else weave_window
         weave = _weave_figures(t, lateral, (t >= wlo) & (t <= whi) & ~corner, weave_period)
     return SeamMeasurement(
-        s=s, in_corner=corner, axis_error_deg=axis_err, workangle_deg=work,
-        travelangle_deg=travel, deviation=deviation, lateral=lateral,
+        s=s, in_corner=corner, axis_error_deg=axis_err, work_angle_deg=work,
+        travel_angle_deg=travel, deviation=deviation, lateral=lateral,
         travel_speed=speed,
         travel_speed_cv=float(np.std(pieces) / max(abs(speed), 1e-12)) if pieces.size else 0.0,
         torch_angle_error_deg=float(axis_err[worst]) if worst is not None else 0.0,

@@ -45,8 +45,8 @@ from sim.errors import SimulationError
 from sim.robots.registry import RPM_PER_RAD_S, Drive
 from sim.simulation.compile import BuiltCell
 from sim.simulation.motion import Motion
+from sim.simulation.motor_limit import MOTOR_ITERATIONS
 from sim.simulation.simulate import (
-    MOTOR_ITERATIONS,
     SimulationRecord,
     _arrays,
     reference_controls,
@@ -319,7 +319,7 @@ WARP_SETTLE_TOL = 1e-4
 
 
 class _MotorBounds:
-    """The drives' motor limit of every world of a batch, as the CPU path's ``_MotorLimit``.
+    """The drives' motor limit of every world of a batch, as the CPU path's :class:`~sim.simulation.motor_limit.MotorLimit`.
 
     Per world and joint, at joint speed ``qd`` (the step's start: the motor's own speed) and
     the step's acceleration ``qdd``, a drive's force range is where its motor torque
