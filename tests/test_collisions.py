@@ -388,7 +388,7 @@ def test_the_coarse_scan_skips_no_sample_that_collides(text):
     names = [pm.name for pm in motion.phases]
     fast = C.find_collisions(cm, samples, names, allowed)
     every = cm.scan(samples.qpos, np.arange(samples.t.size))
-    every = every.select(~C._allowed_mask(every, allowed))
+    every = every.select(~C.allowed_mask(every, allowed))
     colliding = np.unique(every.s)
     assert colliding.size > 0
     # every colliding sample lies in a reported interval of its pair

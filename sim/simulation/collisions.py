@@ -64,453 +64,56 @@ pairs closer than :data:`CLEARANCE_RANGE_M` (the check model's geom margin); the
 :data:`CLEARANCE_STRIDE_S` and is refined at every sample around each phase's closest sample. A
 phase farther than the range reports ``null``; a phase closer than the scenario's
 ``simulation.clearance_mm`` (default 5 mm) is a failed warning check of the verdict.
+
+Owns the search along a motion (collision intervals, clearance) and the entry points
+(:func:`check_motion`, the samples of a motion); the check model is
+:mod:`sim.simulation.collision_model`'s, the declarations of what may touch
+:mod:`sim.simulation.allowed_contacts`' (their names importable from here, as before).
+May import: :mod:`sim.errors` and the simulation modules below it.
 """
+
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.errors import InternalError, SimulationError
+from sim.errors import SimulationError
+from sim.simulation.allowed_contacts import (  # the declarations, importable from here as before
+    PART_CONTACT_DEPTH_M,  # noqa: F401
+    PICK_REACH_M,  # noqa: F401
+    WIRE_ARC_DEPTH_M,  # noqa: F401
+    allowed_contacts,
+    allowed_mask,
+    weave_reach,
+)
+from sim.simulation.collision_model import (  # the check model, importable from here as before
+    CELL,
+    CLEARANCE_RANGE_M,
+    DETECTION_MARGIN_M,  # noqa: F401
+    LINK,
+    PART,
+    PENETRATION_TOLERANCE_M,
+    ROLE_CODE,
+    TOOL,
+    AllowedContact,
+    CheckGeom,  # noqa: F401
+    CollisionModel,
+    Contacts,
+    MotionSamples,
+    coarse_scan,
+    mujoco_module,
+)
 from sim.simulation.compile import BuiltCell
 
-#: Penetration a contact may have without being a collision, m.
-PENETRATION_TOLERANCE_M = 1e-4
-#: Pairs closer than this are measured for penetration (``mj_geomDistance``), m.
-DETECTION_MARGIN_M = 1e-3
-#: Distances are measured up to this range, m (the check model's geom margin).
-CLEARANCE_RANGE_M = 0.1
 #: Period of the coarse scan (clearance, and the intervals a collision may hide in), s.
 CLEARANCE_STRIDE_S = 0.01
-#: Depth the welding wire may reach beyond its radius (and the phase's weave reach) in the seam's
-#: workpiece while the arc is on (the tip in the weld pool, tracking included), m; the contact
-#: tip and nozzle never touch.
-WIRE_ARC_DEPTH_M = 1e-3
-#: Depth a part may sink into what it rests on, is lifted off or set down on, or into the cup's
-#: lip, m: the soft contacts of the simulation sink by a fraction of this.
-PART_CONTACT_DEPTH_M = 1e-3
 #: Dips of the coarse clearance refined per phase and group (tool, arm), the deepest first.
 MAX_DIPS = 50
-#: Suction picks the part whose bounding sphere holds the tool point, with this to spare, m.
-PICK_REACH_M = 0.005
-
-#: Roles of the checked geoms.
-LINK, TOOL, CELL, PART = "link", "tool", "cell", "part"
-_BITS = {LINK: 1, TOOL: 2, CELL: 4, PART: 8}
-_AFFINITY = {LINK: 1 | 2 | 4 | 8, TOOL: 1 | 4 | 8, CELL: 1 | 2 | 8, PART: 1 | 2 | 4 | 8}
-_ROLE_CODE = {LINK: 0, TOOL: 1, CELL: 2, PART: 3}
-
-
-@dataclass(frozen=True)
-class CheckGeom:
-    """One checked geom.
-
-    Attributes:
-        id: Geom id in the compiled cell.
-        name: Geom name (``robot/link4/...``; unnamed robot geoms get ``<body>#<k>``).
-        role: ``link``, ``tool``, ``cell`` or ``part``.
-        owner: What a report names: the robot body, the tool body, the cell object or the part.
-        work: A tool work geom (wire, cup lip).
-        base: A geom of the robot's fixed base (left out of the arm's clearance).
-    """
-
-    id: int
-    name: str
-    role: str
-    owner: str
-    work: bool = False
-    base: bool = False
-
-
-@dataclass
-class MotionSamples:
-    """A motion sampled for checking, N samples.
-
-    Attributes:
-        t: Times, s, (N,).
-        qpos: Full MuJoCo qpos of the cell, (N, nq).
-        phase: Phase index of each sample, (N,).
-        arc_on: Arc on, (N,).
-        suction: Suction on, (N,).
-    """
-
-    t: NDArray[np.float64]
-    qpos: NDArray[np.float64]
-    phase: NDArray[np.int64]
-    arc_on: NDArray[np.bool_]
-    suction: NDArray[np.bool_]
-
-    @property
-    def dt(self) -> float:
-        return float(np.median(np.diff(self.t))) if self.t.size > 1 else 1.0
-
-
-@dataclass(frozen=True)
-class AllowedContact:
-    """Contacts between geoms ``a`` and ``b`` are allowed on the samples where ``when`` is set,
-    up to a penetration of ``max_depth_m``."""
-
-    a: frozenset[int]
-    b: frozenset[int]
-    when: NDArray[np.bool_]
-    reason: str
-    max_depth_m: float = np.inf
-
-    def mask(self, s: NDArray[np.int64], g1: NDArray[np.int64], g2: NDArray[np.int64],
-             dist: NDArray[np.float64] | None = None) -> NDArray[np.bool_]:
-        """Which contacts (sample ``s``, geoms ``g1``, ``g2``, distance ``dist``, m; arrays)
-        this declaration allows."""
-        a, b = np.fromiter(self.a, int), np.fromiter(self.b, int)
-        pair = (np.isin(g1, a) & np.isin(g2, b)) | (np.isin(g1, b) & np.isin(g2, a))
-        ok = pair & self.when[s]
-        if dist is not None and np.isfinite(self.max_depth_m):
-            ok &= -dist <= self.max_depth_m
-        return ok
-
-
-@dataclass
-class Contacts:
-    """Contacts found on a set of samples (one row per geom pair and sample, closest only)."""
-
-    s: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
-    g1: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
-    g2: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
-    dist: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
-
-    def select(self, keep: NDArray[np.bool_]) -> Contacts:
-        return Contacts(self.s[keep], self.g1[keep], self.g2[keep], self.dist[keep])
-
-    @staticmethod
-    def concat(parts: Sequence[Contacts]) -> Contacts:
-        if not parts:
-            return Contacts()
-        return Contacts(*(np.concatenate([getattr(p, k) for p in parts])
-                          for k in ("s", "g1", "g2", "dist")))
-
-
-class CollisionModel:
-    """The check model of a compiled cell: which geoms are checked, as what, against what.
-
-    Args:
-        built: The compiled cell.
-
-    Attributes:
-        geoms: Checked geoms by id.
-        model: Check model for collisions (geom margins :data:`DETECTION_MARGIN_M`).
-        range_model: Check model for clearance (cell and part geoms with margin
-            :data:`CLEARANCE_RANGE_M`).
-    """
-
-    def __init__(self, built: BuiltCell) -> None:
-        import mujoco
-
-        self.built = built
-        src = built.model
-        cell = built.cell
-        tool_prefix = "robot/tool/"
-        work = {f"{tool_prefix}{g}" for g in (cell.tool.work_geoms if cell.tool else ())}
-        object_of = {g: obj for obj, geoms in cell.objects.items() for g in geoms}
-        parts = set(cell.parts)
-        geoms: dict[int, CheckGeom] = {}
-        unnamed: dict[int, int] = {}
-        for g in range(src.ngeom):
-            body = int(src.geom_bodyid[g])
-            bname = src.body(body).name
-            gname = src.geom(g).name
-            if not gname:
-                unnamed[body] = unnamed.get(body, 0) + 1
-                gname = f"{bname}#{unnamed[body] - 1}"
-            if gname.startswith(tool_prefix) or bname.startswith(tool_prefix):
-                geoms[g] = CheckGeom(g, gname, TOOL, bname, work=gname in work)
-            elif bname.startswith("robot/"):
-                if src.geom_group[g] == 3:
-                    geoms[g] = CheckGeom(g, gname, LINK, bname,
-                                         base=bool(src.body_weldid[body] == 0))
-            elif bname in parts:
-                geoms[g] = CheckGeom(g, gname, PART, bname)
-            elif src.geom_contype[g] | src.geom_conaffinity[g]:
-                if src.body_weldid[body] != 0:
-                    raise InternalError(f"cell body {bname!r} moves but is neither the robot nor "
-                                        "a part: collision checks do not cover it")
-                geoms[g] = CheckGeom(g, gname, CELL, object_of.get(gname, gname))
-        missing = work - {cg.name for cg in geoms.values() if cg.work}
-        if missing:
-            raise InternalError(f"tool {cell.tool.name!r} declares work geoms it does not have: "
-                                f"{', '.join(sorted(missing))}")
-        self.geoms = geoms
-        self.model = self._masked(src, DETECTION_MARGIN_M, every=True)
-        self.range_model = self._masked(src, CLEARANCE_RANGE_M)
-        self._data = mujoco.MjData(self.model)
-        self._range_data = mujoco.MjData(self.range_model)
-        n = src.ngeom
-        self.role = np.full(n, -1)
-        self.is_work = np.zeros(n, bool)
-        self.is_base = np.zeros(n, bool)
-        for g, cg in geoms.items():
-            self.role[g] = _ROLE_CODE[cg.role]
-            self.is_work[g] = cg.work
-            self.is_base[g] = cg.base
-
-    def _masked(self, src: Any, margin: float, every: bool = False) -> Any:
-        """The cell recompiled with the check masks and ``margin`` on the cell and part geoms
-        (on every checked geom when ``every``).
-
-        The masks are set before compiling, not on a compiled copy: MuJoCo's compiler leaves
-        geoms that collide with nothing out of their body's bounding-volume tree, so a geom
-        enabled after compiling would be skipped by the broad phase. MuJoCo's parent filter is
-        replaced by explicit exclusions of each robot link with its parent: the filter works on
-        bodies welded together, so it would also skip the tool (welded to the last link) against
-        the link before it.
-        """
-        mujoco = _mujoco()
-        spec = mujoco.MjSpec.from_string(self.built.xml, assets=self.built.cell.mjcf.get_assets())
-        geoms = spec.geoms
-        if len(geoms) != src.ngeom or any(
-                g.name != src.geom(i).name for i, g in enumerate(geoms) if g.name):
-            raise InternalError("the check model's geoms do not match the compiled cell's")
-        for i, g in enumerate(geoms):
-            cg = self.geoms.get(i)
-            g.contype = _BITS[cg.role] if cg else 0
-            g.conaffinity = _AFFINITY[cg.role] if cg else 0
-            g.margin = margin if cg and (every or cg.role in (CELL, PART)) else 0.0
-            g.gap = 0.0
-        spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
-        for body in spec.bodies:
-            if body.name.startswith("robot/") and body.joints and body.parent is not None:
-                ex = spec.add_exclude()
-                ex.bodyname1, ex.bodyname2 = body.parent.name, body.name
-        try:
-            m = spec.compile()
-        except ValueError as exc:
-            raise InternalError(f"the check model does not compile: {exc}") from exc
-        m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
-        return m
-
-    def reach_from_joint(self, joint: int) -> float:
-        """Upper bound of the distance from a joint's anchor to any point of a checked geom it
-        moves, whatever the configuration, m: the chain of body offsets from the anchor to the
-        geom's body, the geom's offset and its bounding radius."""
-        m = self.built.model
-        jbody = int(m.jnt_bodyid[joint])
-        best = 0.0
-        for g in self.geoms:
-            b = int(m.geom_bodyid[g])
-            chain = 0.0
-            while b != jbody and b != 0:
-                chain += float(np.linalg.norm(m.body_pos[b]))
-                b = int(m.body_parentid[b])
-            if b != jbody:
-                continue  # not moved by this joint
-            r = (float(np.linalg.norm(m.jnt_pos[joint])) + chain
-                 + float(np.linalg.norm(m.geom_pos[g])) + float(m.geom_rbound[g]))
-            best = max(best, r)
-        return best
-
-    def ids(self, role: str | None = None, owner: str | None = None) -> frozenset[int]:
-        """Ids of the checked geoms with that role and/or owner."""
-        return frozenset(g for g, cg in self.geoms.items()
-                         if (role is None or cg.role == role) and (owner is None or cg.owner == owner))
-
-    def scan(self, qpos: NDArray[np.float64], samples: NDArray[np.int64], *,
-             ranged: bool = False) -> Contacts:
-        """Contacts at the given samples of ``qpos`` (N, nq): penetrations deeper than the
-        tolerance, or every pair closer than :data:`CLEARANCE_RANGE_M` when ``ranged``.
-
-        Penetration depths come from ``mj_geomDistance`` (GJK/EPA) for every pair the broad and
-        narrow phases report within :data:`DETECTION_MARGIN_M`: the depth of a contact point
-        of ``mj_collision`` can be far from the geoms' penetration (a cylinder against a box,
-        measured: 0.09 mm reported where the geoms overlap by 2.2 mm).
-        """
-        mujoco = _mujoco()
-        m, d = (self.range_model, self._range_data) if ranged else (self.model, self._data)
-        fromto = np.zeros(6)
-        out_s, out_g1, out_g2, out_d = [], [], [], []
-        for i in samples:
-            d.qpos[:] = qpos[i]
-            mujoco.mj_kinematics(m, d)
-            mujoco.mj_collision(m, d)
-            n = d.ncon
-            if not n:
-                continue
-            geom = d.contact.geom[:n]
-            if ranged:
-                keep = d.contact.dist[:n] < CLEARANCE_RANGE_M
-                if keep.any():
-                    out_s.append(np.full(int(keep.sum()), i))
-                    out_g1.append(geom[keep, 0].copy())
-                    out_g2.append(geom[keep, 1].copy())
-                    out_d.append(d.contact.dist[:n][keep].copy())
-                continue
-            for a, b in {(int(x), int(y)) for x, y in geom}:
-                dist = mujoco.mj_geomDistance(m, d, a, b, 2.0 * DETECTION_MARGIN_M, fromto)
-                if dist < -PENETRATION_TOLERANCE_M:
-                    out_s.append(np.array([i]))
-                    out_g1.append(np.array([a]))
-                    out_g2.append(np.array([b]))
-                    out_d.append(np.array([dist]))
-        if not out_s:
-            return Contacts()
-        a, b = np.concatenate(out_g1), np.concatenate(out_g2)
-        g1, g2 = np.minimum(a, b), np.maximum(a, b)
-        s, dist = np.concatenate(out_s), np.concatenate(out_d)
-        # one row per (sample, pair): the closest of the pair's contact points
-        order = np.lexsort((dist, g2, g1, s))
-        s, g1, g2, dist = s[order], g1[order], g2[order], dist[order]
-        first = np.ones(s.size, bool)
-        first[1:] = (s[1:] != s[:-1]) | (g1[1:] != g1[:-1]) | (g2[1:] != g2[:-1])
-        return Contacts(s[first], g1[first], g2[first], dist[first])
-
-
-def coarse_scan(cm: CollisionModel, qpos: NDArray[np.float64], samples: NDArray[np.int64]
-                ) -> Contacts:
-    """Every pair closer than :data:`CLEARANCE_RANGE_M` at the given samples, with exact
-    penetration depths: a geom margin makes MuJoCo's distances exact when positive but its
-    penetration depths approximate, so pairs in contact are measured again without margin
-    (a contact within the tolerance counts as touching, distance 0)."""
-    ranged = cm.scan(qpos, samples, ranged=True)
-    exact = cm.scan(qpos, samples)
-    n = max(1, cm.model.ngeom)
-    key = lambda c: (c.s.astype(np.int64) * n + c.g1) * n + c.g2  # noqa: E731
-    keep = ranged.dist >= 0.0
-    touching = ~keep & ~np.isin(key(ranged), key(exact))
-    ranged.dist[touching] = 0.0
-    return Contacts.concat([ranged.select(keep | touching), exact])
-
-
-def _mujoco() -> Any:
-    import mujoco
-
-    return mujoco
-
-
-# --------------------------------------------------------------------------------------------
-# Allowed contacts
-# --------------------------------------------------------------------------------------------
-
-
-def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
-    from sim.core.intervals import true_runs
-
-    return true_runs(mask)
-
-
-def weave_reach(weave: Any) -> float:
-    """How far a weave (:class:`planners.weave.Weave`, or None) takes the tool point from its
-    path, m: the largest ``|(lateral, longitudinal)|`` offset of its pattern over a cycle (its
-    fade envelope is at most 1): the amplitude ``A`` for a sine, zigzag or circle,
-    ``sqrt(5) / 2 A`` for the triangle (``A`` across, ``A / 2`` behind); 0 without a weave."""
-    if weave is None:
-        return 0.0
-    lateral, longitudinal = weave.shape(np.linspace(0.0, 1.0, 401))  # the extremes at 1/4, 3/4
-    return float(np.max(np.hypot(lateral, longitudinal)))
-
-
-def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
-                     phase_seams: Sequence[str | None],
-                     weaves: Sequence[float] | None = None) -> list[AllowedContact]:
-    """The contacts the work makes on purpose (module docstring), as declarations.
-
-    Args:
-        cm: The check model.
-        samples: The sampled motion.
-        phase_seams: The seam each phase follows (None when it follows none), by phase index.
-        weaves: Each phase's weave reach, m (:func:`phase_weaves`); None: no phase weaves.
-    """
-    built = cm.built
-    cell = built.cell
-    n = samples.t.size
-    out: list[AllowedContact] = []
-    work = frozenset(g for g, cg in cm.geoms.items() if cg.work)
-    torch = cell.tool is not None and cell.tool.kind == "torch"
-    if work and torch and cell.seam_objects:
-        all_work = frozenset().union(*(cm.ids(CELL, obj) for objs in cell.seam_objects.values()
-                                       for obj in objs))
-        radius = max(float(built.model.geom_size[g, 0]) for g in work)
-        # the wire in the joint of the seam it welds, weaving included, while the arc is on
-        for k, seam in enumerate(phase_seams):
-            when = samples.arc_on & (samples.phase == k)
-            if not when.any():
-                continue
-            objs = cell.seam_objects.get(seam, ()) if seam is not None else ()
-            pieces = (frozenset().union(*(cm.ids(CELL, o) for o in objs)) if objs else all_work)
-            reach = 0.0 if weaves is None else float(weaves[k])
-            depth = radius + reach + WIRE_ARC_DEPTH_M
-            weaving = f" + weave {reach * 1e3:.1f} mm" if reach > 0 else ""
-            out.append(AllowedContact(
-                work, pieces, when, f"wire in the joint of seam {seam!r}, arc on (up to "
-                f"{depth * 1e3:.1f} mm: radius{weaving} + {WIRE_ARC_DEPTH_M * 1e3:g} mm)",
-                max_depth_m=depth))
-        # the wire tip set on a workpiece, arc off included (touch sensing, the tip on the
-        # root at a seam's start or end); deeper is a collision
-        touch = cell.tool.touch_depth_m
-        out.append(AllowedContact(work, all_work, np.ones(n, bool),
-                                  f"wire touching a workpiece (up to {(radius + touch) * 1e3:.1f} "
-                                  f"mm: radius + touch depth {touch * 1e3:g} mm)",
-                                  max_depth_m=radius + touch))
-    # parts: at rest, lifted off, set down; the cup lip with the part it picks
-    part_ids = {p: cm.ids(PART, p) for p in cell.parts}
-    if not part_ids:
-        return out
-    cell_ids = cm.ids(CELL)
-    depth = PART_CONTACT_DEPTH_M
-    held = {p: np.zeros(n, bool) for p in part_ids}
-    for i_on, stop in _runs(samples.suction):
-        p = _picked_part(cm, samples, i_on)
-        if p is None:
-            continue
-        held[p][i_on:stop] = True
-        k_on, k_off = int(samples.phase[i_on]), int(samples.phase[stop - 1])
-        if stop < n:
-            k_off = int(samples.phase[stop])
-        window = (samples.phase >= k_on - 1) & (samples.phase <= k_off + 1)
-        if work:
-            out.append(AllowedContact(work, part_ids[p], window,
-                                      f"cup lip on {p}, picking it", max_depth_m=depth))
-        settle = held[p] & np.isin(samples.phase, (k_on, k_on + 1, k_off - 1, k_off))
-        rest = frozenset().union(*(ids for q, ids in part_ids.items() if q != p))
-        out.append(AllowedContact(part_ids[p], cell_ids | rest, settle,
-                                  f"{p} lifted off or set down", max_depth_m=depth))
-    names = list(part_ids)
-    for i, p in enumerate(names):
-        out.append(AllowedContact(part_ids[p], cell_ids, ~held[p], f"{p} at rest",
-                                  max_depth_m=depth))
-        for q in names[i + 1:]:
-            out.append(AllowedContact(part_ids[p], part_ids[q], ~held[p] & ~held[q],
-                                      f"{p} and {q} at rest", max_depth_m=depth))
-    return out
-
-
-def _picked_part(cm: CollisionModel, samples: MotionSamples, i: int) -> str | None:
-    """The part the cup's lip is on when suction comes on at sample ``i``: the nearest part
-    whose bounding sphere holds the tool point (with :data:`PICK_REACH_M` to spare); None when
-    suction comes on with no part at the cup."""
-    mujoco = _mujoco()
-    built = cm.built
-    m, d = cm.model, cm._data
-    d.qpos[:] = samples.qpos[i]
-    mujoco.mj_kinematics(m, d)
-    tcp = d.site_xpos[built.tcp_site]
-    best, best_d = None, np.inf
-    for p in built.cell.parts:
-        body = m.body(p).id
-        geoms = np.flatnonzero(m.geom_bodyid == body)
-        reach = float(np.max(np.linalg.norm(m.geom_pos[geoms], axis=1) + m.geom_rbound[geoms]))
-        dist = float(np.linalg.norm(d.xpos[body] - tcp))
-        if dist <= reach + PICK_REACH_M and dist < best_d:
-            best, best_d = p, dist
-    return best
-
-
-def _allowed_mask(c: Contacts, allowed: Sequence[AllowedContact]) -> NDArray[np.bool_]:
-    ok = np.zeros(c.s.size, bool)
-    for rule in allowed:
-        if c.s.size:
-            ok |= rule.mask(c.s, c.g1, c.g2, c.dist)
-    return ok
 
 
 # --------------------------------------------------------------------------------------------
@@ -653,7 +256,7 @@ def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Seq
     fine = np.concatenate([np.arange(a, b + 1) for a, b in _intervals_to_check(
         cm, samples, coarse, scanned, allowed)] or [np.zeros(0, int)])
     c = cm.scan(samples.qpos, np.unique(fine).astype(int))
-    c = c.select(~_allowed_mask(c, allowed))
+    c = c.select(~allowed_mask(c, allowed))
     groups: dict[tuple[str, str], list[int]] = {}
     for r in range(c.s.size):
         a, b = _ordered(cm, int(c.g1[r]), int(c.g2[r]))
@@ -761,12 +364,12 @@ def _clearance_rows(cm: CollisionModel, c: Contacts, allowed: Sequence[AllowedCo
     """Pairs of the robot (tool but its work geoms, links but the base) with the cell or a part,
     leaving out allowed pairs and the tool near a part it may touch."""
     r1, r2 = cm.role[c.g1], cm.role[c.g2]
-    robot = _ROLE_CODE[LINK], _ROLE_CODE[TOOL]
-    world = _ROLE_CODE[CELL], _ROLE_CODE[PART]
+    robot = ROLE_CODE[LINK], ROLE_CODE[TOOL]
+    world = ROLE_CODE[CELL], ROLE_CODE[PART]
     keep = ((np.isin(r1, robot) & np.isin(r2, world)) | (np.isin(r2, robot) & np.isin(r1, world)))
     keep &= ~(cm.is_work[c.g1] | cm.is_work[c.g2] | cm.is_base[c.g1] | cm.is_base[c.g2])
     c = c.select(keep)
-    ok = _allowed_mask(c, allowed)
+    ok = allowed_mask(c, allowed)
     # the whole tool near a part its lip may touch: picking, not a clearance
     tool, parts = cm.ids(TOOL), cm.ids(PART)
     for rule in allowed:
@@ -776,8 +379,8 @@ def _clearance_rows(cm: CollisionModel, c: Contacts, allowed: Sequence[AllowedCo
 
 
 def _group_rows(cm: CollisionModel, c: Contacts) -> dict[str, NDArray[np.bool_]]:
-    tool = (cm.role[c.g1] == _ROLE_CODE[TOOL]) | (cm.role[c.g2] == _ROLE_CODE[TOOL])
-    link = (cm.role[c.g1] == _ROLE_CODE[LINK]) | (cm.role[c.g2] == _ROLE_CODE[LINK])
+    tool = (cm.role[c.g1] == ROLE_CODE[TOOL]) | (cm.role[c.g2] == ROLE_CODE[TOOL])
+    link = (cm.role[c.g1] == ROLE_CODE[LINK]) | (cm.role[c.g2] == ROLE_CODE[LINK])
     return {"tool": tool, "arm": link}
 
 
@@ -828,7 +431,7 @@ def samples_from_motion(built: BuiltCell, motion: Any, dt: float) -> MotionSampl
     t = motion.t0 + dt * np.arange(n)
     if t[-1] < motion.t1 - 1e-12:
         t = np.append(t, motion.t1)
-    mujoco = _mujoco()
+    mujoco = mujoco_module()
     model = built.model
     key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
     base = model.key_qpos[key] if key >= 0 else model.qpos0

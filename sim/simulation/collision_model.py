@@ -1,0 +1,319 @@
+"""The check model of a cell: a copy of the compiled cell whose contact masks select the pairs
+collisions are checked for (robot links, tool, cell objects, parts), the geoms' roles, and the
+scan that measures the pairs' distances at given samples of a motion.
+
+Owns what is checked and how a sample is measured (:class:`CollisionModel`,
+:class:`Contacts`, :func:`coarse_scan`); what may touch is
+:mod:`sim.simulation.allowed_contacts`', the search for collisions and clearance along a motion
+:mod:`sim.simulation.collisions`'.
+May import: :mod:`sim.errors` and the compiled cell.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.errors import InternalError
+from sim.simulation.compile import BuiltCell
+
+#: Penetration a contact may have without being a collision, m.
+PENETRATION_TOLERANCE_M = 1e-4
+#: Pairs closer than this are measured for penetration (``mj_geomDistance``), m.
+DETECTION_MARGIN_M = 1e-3
+#: Distances are measured up to this range, m (the check model's geom margin).
+CLEARANCE_RANGE_M = 0.1
+
+
+#: Roles of the checked geoms.
+LINK, TOOL, CELL, PART = "link", "tool", "cell", "part"
+_BITS = {LINK: 1, TOOL: 2, CELL: 4, PART: 8}
+_AFFINITY = {LINK: 1 | 2 | 4 | 8, TOOL: 1 | 4 | 8, CELL: 1 | 2 | 8, PART: 1 | 2 | 4 | 8}
+ROLE_CODE = {LINK: 0, TOOL: 1, CELL: 2, PART: 3}
+
+
+@dataclass(frozen=True)
+class CheckGeom:
+    """One checked geom.
+
+    Attributes:
+        id: Geom id in the compiled cell.
+        name: Geom name (``robot/link4/...``; unnamed robot geoms get ``<body>#<k>``).
+        role: ``link``, ``tool``, ``cell`` or ``part``.
+        owner: What a report names: the robot body, the tool body, the cell object or the part.
+        work: A tool work geom (wire, cup lip).
+        base: A geom of the robot's fixed base (left out of the arm's clearance).
+    """
+
+    id: int
+    name: str
+    role: str
+    owner: str
+    work: bool = False
+    base: bool = False
+
+
+@dataclass
+class MotionSamples:
+    """A motion sampled for checking, N samples.
+
+    Attributes:
+        t: Times, s, (N,).
+        qpos: Full MuJoCo qpos of the cell, (N, nq).
+        phase: Phase index of each sample, (N,).
+        arc_on: Arc on, (N,).
+        suction: Suction on, (N,).
+    """
+
+    t: NDArray[np.float64]
+    qpos: NDArray[np.float64]
+    phase: NDArray[np.int64]
+    arc_on: NDArray[np.bool_]
+    suction: NDArray[np.bool_]
+
+    @property
+    def dt(self) -> float:
+        return float(np.median(np.diff(self.t))) if self.t.size > 1 else 1.0
+
+
+@dataclass(frozen=True)
+class AllowedContact:
+    """Contacts between geoms ``a`` and ``b`` are allowed on the samples where ``when`` is set,
+    up to a penetration of ``max_depth_m``."""
+
+    a: frozenset[int]
+    b: frozenset[int]
+    when: NDArray[np.bool_]
+    reason: str
+    max_depth_m: float = np.inf
+
+    def mask(self, s: NDArray[np.int64], g1: NDArray[np.int64], g2: NDArray[np.int64],
+             dist: NDArray[np.float64] | None = None) -> NDArray[np.bool_]:
+        """Which contacts (sample ``s``, geoms ``g1``, ``g2``, distance ``dist``, m; arrays)
+        this declaration allows."""
+        a, b = np.fromiter(self.a, int), np.fromiter(self.b, int)
+        pair = (np.isin(g1, a) & np.isin(g2, b)) | (np.isin(g1, b) & np.isin(g2, a))
+        ok = pair & self.when[s]
+        if dist is not None and np.isfinite(self.max_depth_m):
+            ok &= -dist <= self.max_depth_m
+        return ok
+
+
+@dataclass
+class Contacts:
+    """Contacts found on a set of samples (one row per geom pair and sample, closest only)."""
+
+    s: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
+    g1: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
+    g2: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, int))
+    dist: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    def select(self, keep: NDArray[np.bool_]) -> Contacts:
+        return Contacts(self.s[keep], self.g1[keep], self.g2[keep], self.dist[keep])
+
+    @staticmethod
+    def concat(parts: Sequence[Contacts]) -> Contacts:
+        if not parts:
+            return Contacts()
+        return Contacts(*(np.concatenate([getattr(p, k) for p in parts])
+                          for k in ("s", "g1", "g2", "dist")))
+
+
+class CollisionModel:
+    """The check model of a compiled cell: which geoms are checked, as what, against what.
+
+    Args:
+        built: The compiled cell.
+
+    Attributes:
+        geoms: Checked geoms by id.
+        model: Check model for collisions (geom margins :data:`DETECTION_MARGIN_M`).
+        range_model: Check model for clearance (cell and part geoms with margin
+            :data:`CLEARANCE_RANGE_M`).
+    """
+
+    def __init__(self, built: BuiltCell) -> None:
+        import mujoco
+
+        self.built = built
+        src = built.model
+        cell = built.cell
+        tool_prefix = "robot/tool/"
+        work = {f"{tool_prefix}{g}" for g in (cell.tool.work_geoms if cell.tool else ())}
+        object_of = {g: obj for obj, geoms in cell.objects.items() for g in geoms}
+        parts = set(cell.parts)
+        geoms: dict[int, CheckGeom] = {}
+        unnamed: dict[int, int] = {}
+        for g in range(src.ngeom):
+            body = int(src.geom_bodyid[g])
+            bname = src.body(body).name
+            gname = src.geom(g).name
+            if not gname:
+                unnamed[body] = unnamed.get(body, 0) + 1
+                gname = f"{bname}#{unnamed[body] - 1}"
+            if gname.startswith(tool_prefix) or bname.startswith(tool_prefix):
+                geoms[g] = CheckGeom(g, gname, TOOL, bname, work=gname in work)
+            elif bname.startswith("robot/"):
+                if src.geom_group[g] == 3:
+                    geoms[g] = CheckGeom(g, gname, LINK, bname,
+                                         base=bool(src.body_weldid[body] == 0))
+            elif bname in parts:
+                geoms[g] = CheckGeom(g, gname, PART, bname)
+            elif src.geom_contype[g] | src.geom_conaffinity[g]:
+                if src.body_weldid[body] != 0:
+                    raise InternalError(f"cell body {bname!r} moves but is neither the robot nor "
+                                        "a part: collision checks do not cover it")
+                geoms[g] = CheckGeom(g, gname, CELL, object_of.get(gname, gname))
+        missing = work - {cg.name for cg in geoms.values() if cg.work}
+        if missing:
+            raise InternalError(f"tool {cell.tool.name!r} declares work geoms it does not have: "
+                                f"{', '.join(sorted(missing))}")
+        self.geoms = geoms
+        self.model = self._masked(src, DETECTION_MARGIN_M, every=True)
+        self.range_model = self._masked(src, CLEARANCE_RANGE_M)
+        self._data = mujoco.MjData(self.model)
+        self._range_data = mujoco.MjData(self.range_model)
+        n = src.ngeom
+        self.role = np.full(n, -1)
+        self.is_work = np.zeros(n, bool)
+        self.is_base = np.zeros(n, bool)
+        for g, cg in geoms.items():
+            self.role[g] = ROLE_CODE[cg.role]
+            self.is_work[g] = cg.work
+            self.is_base[g] = cg.base
+
+    def _masked(self, src: Any, margin: float, every: bool = False) -> Any:
+        """The cell recompiled with the check masks and ``margin`` on the cell and part geoms
+        (on every checked geom when ``every``).
+
+        The masks are set before compiling, not on a compiled copy: MuJoCo's compiler leaves
+        geoms that collide with nothing out of their body's bounding-volume tree, so a geom
+        enabled after compiling would be skipped by the broad phase. MuJoCo's parent filter is
+        replaced by explicit exclusions of each robot link with its parent: the filter works on
+        bodies welded together, so it would also skip the tool (welded to the last link) against
+        the link before it.
+        """
+        mujoco = mujoco_module()
+        spec = mujoco.MjSpec.from_string(self.built.xml, assets=self.built.cell.mjcf.get_assets())
+        geoms = spec.geoms
+        if len(geoms) != src.ngeom or any(
+                g.name != src.geom(i).name for i, g in enumerate(geoms) if g.name):
+            raise InternalError("the check model's geoms do not match the compiled cell's")
+        for i, g in enumerate(geoms):
+            cg = self.geoms.get(i)
+            g.contype = _BITS[cg.role] if cg else 0
+            g.conaffinity = _AFFINITY[cg.role] if cg else 0
+            g.margin = margin if cg and (every or cg.role in (CELL, PART)) else 0.0
+            g.gap = 0.0
+        spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
+        for body in spec.bodies:
+            if body.name.startswith("robot/") and body.joints and body.parent is not None:
+                ex = spec.add_exclude()
+                ex.bodyname1, ex.bodyname2 = body.parent.name, body.name
+        try:
+            m = spec.compile()
+        except ValueError as exc:
+            raise InternalError(f"the check model does not compile: {exc}") from exc
+        m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        return m
+
+    def reach_from_joint(self, joint: int) -> float:
+        """Upper bound of the distance from a joint's anchor to any point of a checked geom it
+        moves, whatever the configuration, m: the chain of body offsets from the anchor to the
+        geom's body, the geom's offset and its bounding radius."""
+        m = self.built.model
+        jbody = int(m.jnt_bodyid[joint])
+        best = 0.0
+        for g in self.geoms:
+            b = int(m.geom_bodyid[g])
+            chain = 0.0
+            while b != jbody and b != 0:
+                chain += float(np.linalg.norm(m.body_pos[b]))
+                b = int(m.body_parentid[b])
+            if b != jbody:
+                continue  # not moved by this joint
+            r = (float(np.linalg.norm(m.jnt_pos[joint])) + chain
+                 + float(np.linalg.norm(m.geom_pos[g])) + float(m.geom_rbound[g]))
+            best = max(best, r)
+        return best
+
+    def ids(self, role: str | None = None, owner: str | None = None) -> frozenset[int]:
+        """Ids of the checked geoms with that role and/or owner."""
+        return frozenset(g for g, cg in self.geoms.items()
+                         if (role is None or cg.role == role) and (owner is None or cg.owner == owner))
+
+    def scan(self, qpos: NDArray[np.float64], samples: NDArray[np.int64], *,
+             ranged: bool = False) -> Contacts:
+        """Contacts at the given samples of ``qpos`` (N, nq): penetrations deeper than the
+        tolerance, or every pair closer than :data:`CLEARANCE_RANGE_M` when ``ranged``.
+
+        Penetration depths come from ``mj_geomDistance`` (GJK/EPA) for every pair the broad and
+        narrow phases report within :data:`DETECTION_MARGIN_M`: the depth of a contact point
+        of ``mj_collision`` can be far from the geoms' penetration (a cylinder against a box,
+        measured: 0.09 mm reported where the geoms overlap by 2.2 mm).
+        """
+        mujoco = mujoco_module()
+        m, d = (self.range_model, self._range_data) if ranged else (self.model, self._data)
+        fromto = np.zeros(6)
+        out_s, out_g1, out_g2, out_d = [], [], [], []
+        for i in samples:
+            d.qpos[:] = qpos[i]
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_collision(m, d)
+            n = d.ncon
+            if not n:
+                continue
+            geom = d.contact.geom[:n]
+            if ranged:
+                keep = d.contact.dist[:n] < CLEARANCE_RANGE_M
+                if keep.any():
+                    out_s.append(np.full(int(keep.sum()), i))
+                    out_g1.append(geom[keep, 0].copy())
+                    out_g2.append(geom[keep, 1].copy())
+                    out_d.append(d.contact.dist[:n][keep].copy())
+                continue
+            for a, b in {(int(x), int(y)) for x, y in geom}:
+                dist = mujoco.mj_geomDistance(m, d, a, b, 2.0 * DETECTION_MARGIN_M, fromto)
+                if dist < -PENETRATION_TOLERANCE_M:
+                    out_s.append(np.array([i]))
+                    out_g1.append(np.array([a]))
+                    out_g2.append(np.array([b]))
+                    out_d.append(np.array([dist]))
+        if not out_s:
+            return Contacts()
+        a, b = np.concatenate(out_g1), np.concatenate(out_g2)
+        g1, g2 = np.minimum(a, b), np.maximum(a, b)
+        s, dist = np.concatenate(out_s), np.concatenate(out_d)
+        # one row per (sample, pair): the closest of the pair's contact points
+        order = np.lexsort((dist, g2, g1, s))
+        s, g1, g2, dist = s[order], g1[order], g2[order], dist[order]
+        first = np.ones(s.size, bool)
+        first[1:] = (s[1:] != s[:-1]) | (g1[1:] != g1[:-1]) | (g2[1:] != g2[:-1])
+        return Contacts(s[first], g1[first], g2[first], dist[first])
+
+
+def coarse_scan(cm: CollisionModel, qpos: NDArray[np.float64], samples: NDArray[np.int64]
+                ) -> Contacts:
+    """Every pair closer than :data:`CLEARANCE_RANGE_M` at the given samples, with exact
+    penetration depths: a geom margin makes MuJoCo's distances exact when positive but its
+    penetration depths approximate, so pairs in contact are measured again without margin
+    (a contact within the tolerance counts as touching, distance 0)."""
+    ranged = cm.scan(qpos, samples, ranged=True)
+    exact = cm.scan(qpos, samples)
+    n = max(1, cm.model.ngeom)
+    key = lambda c: (c.s.astype(np.int64) * n + c.g1) * n + c.g2  # noqa: E731
+    keep = ranged.dist >= 0.0
+    touching = ~keep & ~np.isin(key(ranged), key(exact))
+    ranged.dist[touching] = 0.0
+    return Contacts.concat([ranged.select(keep | touching), exact])
+
+
+def mujoco_module() -> Any:
+    """The ``mujoco`` module, imported when a check first needs it."""
+    import mujoco
+
+    return mujoco
