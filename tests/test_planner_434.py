@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from planners import (
-    PLANNERS,
     InvalidBoundaryError,
     InvalidKnotsError,
     PlannerError,
@@ -210,14 +209,57 @@ def test_errors_are_planner_errors_and_value_errors():
         plan_434([0.0, 1.0], [0.0, 1.0])
 
 
-def test_registry():
-    assert PLANNERS == {"434": plan_434, "546": plan_546}
-    assert get_planner("434") is plan_434 and get_planner("546") is plan_546
+def test_planner_names_are_normalized_and_unknown_ones_listed():
+    """Spaces and dashes are not part of a planner's name; an unknown name gets the nearest
+    known one and the list."""
     assert get_planner("4-3-4") is plan_434 and get_planner(" 5-4-6 ") is plan_546
     with pytest.raises(UnknownPlannerError, match=r"unknown planner '436'.*did you mean.*known: 434, 546"):
         get_planner("436")
     with pytest.raises(UnknownPlannerError, match=r"known: 434, 546$"):
         get_planner("cubic")
+
+
+#: Finite-difference weights on 5 equally spaced samples from a point into one side, exact for
+#: polynomials up to degree 4: first derivative (forward; negate for backward), second
+#: (either side), third (forward; negate for backward).
+_FD1 = np.array([-25.0, 48.0, -36.0, 16.0, -3.0]) / 12.0
+_FD2 = np.array([35.0, -104.0, 114.0, -56.0, 11.0]) / 12.0
+_FD3 = np.array([-5.0, 18.0, -24.0, 14.0, -3.0]) / 2.0
+
+
+def test_434_boundary_conditions_by_finite_differences_of_the_positions():
+    """Seed 001's conditions (eq. 12-17) on Table 1, checked from sampled positions alone (not
+    the planner's own derivatives or coefficients): one-sided difference quotients from the
+    left and from the right of each interior knot agree in velocity and acceleration (C2), the
+    motion starts and ends at rest, and the jerk jumps at each interior knot (three pieces,
+    not one polynomial); the pieces are a quartic, a cubic and a quartic (the fifth
+    differences of equally spaced samples vanish on each, the fourth on the middle one only).
+    """
+    tr = plan_434(TABLE1_TAU, TABLE1_Q * DEG)
+    h = 0.05
+    k = np.arange(5)
+
+    def one_side(t0: float, side: int) -> tuple[np.ndarray, ...]:
+        q = tr.at(t0 + side * h * k).q
+        return side * (_FD1 @ q) / h, (_FD2 @ q) / h**2, side * (_FD3 @ q) / h**3
+
+    v0, a0, _ = one_side(TABLE1_TAU[0], +1)
+    vf, af, _ = one_side(TABLE1_TAU[-1], -1)
+    for x in (v0, a0, vf, af):
+        np.testing.assert_allclose(x, 0.0, atol=1e-9)
+    np.testing.assert_allclose(tr.at(TABLE1_TAU).q, TABLE1_Q * DEG, atol=1e-12)
+    for tk in TABLE1_TAU[1:-1]:
+        vl, al, jl = one_side(tk, -1)
+        vr, ar, jr = one_side(tk, +1)
+        np.testing.assert_allclose(vl, vr, atol=1e-9, err_msg=f"velocity at {tk} s")
+        np.testing.assert_allclose(al, ar, atol=1e-9, err_msg=f"acceleration at {tk} s")
+        assert np.abs(jl - jr).max() > 1e-3, f"no jerk jump at {tk} s"
+    fourth = []
+    for i in range(3):
+        q = tr.at(np.linspace(TABLE1_TAU[i], TABLE1_TAU[i + 1], 9)).q
+        assert np.abs(np.diff(q, 5, axis=0)).max() < 1e-12, f"segment {i + 1} beyond quartic"
+        fourth.append(np.abs(np.diff(q, 4, axis=0)).max())
+    assert fourth[0] > 1e-4 and fourth[1] < 1e-12 and fourth[2] > 1e-4, fourth
 
 
 def test_one_dimensional_q_is_one_joint():
