@@ -30,7 +30,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from planners.errors import InvalidMoveError
-from planners.profiles import quintic_smoothstep
+from planners.profiles import ConstantSpeedShare, quintic_smoothstep
+from planners.rotations import GeodesicOrientation, axis_angle_matrix
 
 
 class SubPath:
@@ -215,8 +216,6 @@ class CornerOrientation:
 
     def __init__(self, start: ArrayLike, end: ArrayLike, rate_start: ArrayLike | None = None,
                  rate_end: ArrayLike | None = None, length: float = 0.0) -> None:
-        from planners.rotations import GeodesicOrientation
-
         self._geo = GeodesicOrientation(start, end)
         self.start, self.end, self.angle = self._geo.start, self._geo.end, self._geo.angle
         wa = np.zeros(3) if rate_start is None else np.asarray(rate_start, dtype=float)
@@ -228,8 +227,6 @@ class CornerOrientation:
         self._turning = bool(max(np.linalg.norm(self._wa), np.linalg.norm(self._wb)) > 1e-9)
 
     def _blended(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
-        from planners.rotations import axis_angle_matrix
-
         def carried(R0: NDArray[np.float64], w: NDArray[np.float64],
                     x: NDArray[np.float64]) -> NDArray[np.float64]:
             n = float(np.linalg.norm(w))
@@ -343,8 +340,6 @@ class PiecewiseProfile:
 
     @property
     def constant_speed_fraction(self):
-        from planners.profiles import ConstantSpeedShare
-
         tc = sum(p.T for p in self.pieces if p.va == p.vb)
         return ConstantSpeedShare(time=tc / self.duration if self.duration else 0.0,
                                   length=self.constant_speed_length / self.length
@@ -397,8 +392,6 @@ class TimeWindow:
 
     @property
     def constant_speed_fraction(self):
-        from planners.profiles import ConstantSpeedShare
-
         tc = max(self.steady[1] - self.steady[0], 0.0)
         return ConstantSpeedShare(time=tc / self.duration if self.duration else 0.0,
                                   length=min(1.0, tc * self._speed / self.length)

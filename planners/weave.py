@@ -36,6 +36,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from planners.base import sample_times
 from planners.errors import InvalidMoveError
 
 #: The patterns, in the order the docs list them.
@@ -240,8 +241,6 @@ class WeavingTrajectory:
         return t[t > 0.0]
 
     def sample(self, dt: float):
-        from planners.base import sample_times
-
         times = sample_times(0.0, self.duration, dt)
         return times, self.at(times)
 
