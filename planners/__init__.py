@@ -4,6 +4,12 @@ Joint-space piecewise polynomials through via points (4-3-4 after seed 001, 5-4-
 seed 000) and Cartesian ADNIA interpolation of the tool point (seed 003). Every planner
 returns a trajectory with ``duration``, ``at(t)`` and ``sample(dt)``.
 
+Cartesian moves are built from separate parts: geometric paths by arc length
+(:mod:`planners.paths`), time laws (:mod:`planners.profiles`), tool-frame laws
+(:mod:`planners.rotations`), their trajectories and move builders (:mod:`planners.cartesian`),
+corner blends and weaves on top (:mod:`planners.blend`, :mod:`planners.weave`); seed 003's
+algorithm itself is :mod:`planners.adnia` (which re-exports the moves).
+
 Planners work in SI units: seconds, radians (joints) and metres (Cartesian).
 """
 
