@@ -34,10 +34,9 @@ import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
-from dm_control import mjcf
 from numpy.typing import NDArray
 
 from sim.cells.tools import (
@@ -52,6 +51,10 @@ from sim.errors import CellsimError
 from sim.robots.model import KinematicModel, kinematic_model
 from sim.robots.registry import COULOMB_SPEED, RobotSpec
 
+if TYPE_CHECKING:  # MuJoCo and dm_control are imported where a model is made or compiled
+    import mujoco
+    from dm_control import mjcf
+
 ROBOT_PREFIX = "robot"
 #: Name prefix of the robot's friction actuators (``robot/friction_j1``, ...).
 FRICTION_PREFIX = "friction_"
@@ -64,6 +67,8 @@ OFFSCREEN = (1920, 1080)
 # ---------------------------------------------------------------------------- small helpers
 def quat_from_matrix(R: NDArray[np.float64]) -> NDArray[np.float64]:
     """Unit quaternion (w, x, y, z) of a rotation matrix (3, 3)."""
+    import mujoco
+
     q = np.zeros(4)
     mujoco.mju_mat2Quat(q, np.asarray(R, dtype=float).reshape(9))
     return q
@@ -71,6 +76,8 @@ def quat_from_matrix(R: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def matrix_from_quat(q: NDArray[np.float64]) -> NDArray[np.float64]:
     """Rotation matrix (3, 3) of a quaternion (w, x, y, z)."""
+    import mujoco
+
     R = np.zeros(9)
     mujoco.mju_quat2Mat(R, np.asarray(q, dtype=float) / np.linalg.norm(q))
     return R.reshape(3, 3)
@@ -149,6 +156,8 @@ class RobotStatics:
 
 
 def _site_pose(m: mujoco.MjModel, d: mujoco.MjData, name: str) -> NDArray[np.float64]:
+    import mujoco
+
     i = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
     if i < 0:
         raise CellsimError(f"robot model has no site {name!r}")
@@ -166,6 +175,8 @@ def robot_statics(spec: RobotSpec) -> RobotStatics:
 
 @lru_cache(maxsize=None)
 def _robot_statics(spec: RobotSpec) -> RobotStatics:
+    import mujoco
+
     if not spec.robot_path.is_file():
         raise CellsimError(f"robot {spec.name!r}: model file {spec.robot_path} is missing")
     m = mujoco.MjModel.from_xml_path(str(spec.robot_path))
@@ -279,6 +290,8 @@ def payload_radius(mass_kg: float) -> float:
 
 def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.0) -> RobotRig:
     """Load the robot, attach the tool at its flange, move its tcp, add the payload."""
+    from dm_control import mjcf
+
     st = robot_statics(spec)
     robot = mjcf.from_path(str(spec.robot_path))
     for key in robot.find_all("key"):
@@ -353,6 +366,8 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
 # ---------------------------------------------------------------------------- world
 def new_world(name: str, center=(0.0, 0.0, 0.8), extent: float = 3.0) -> mjcf.RootElement:
     """Empty world: floor (contacts parts only), sky, lights, offscreen buffer, visual quality."""
+    from dm_control import mjcf
+
     w = mjcf.RootElement(model=name)
     g = getattr(w.visual, "global")
     g.offwidth, g.offheight = OFFSCREEN
@@ -508,6 +523,8 @@ class Layout:
 
 def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
     """Compile a ``dm_control`` model with MuJoCo (raises CellsimError on compiler errors)."""
+    import mujoco
+
     try:
         return mujoco.MjModel.from_xml_string(world.to_xml_string(), world.get_assets())
     except ValueError as exc:  # mujoco reports XML/compile errors as ValueError
@@ -519,6 +536,8 @@ def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
 def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np.float64]
                       ) -> mujoco.MjModel:
     """Add keyframe ``home``: robot at ``home_q``, free bodies where built, suction off."""
+    import mujoco
+
     m = compile_model(world)
     qpos = m.qpos0.copy()
     ctrl = np.zeros(m.nu)

@@ -7,10 +7,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
-from dm_control import mjcf
 from numpy.typing import NDArray
 
 from sim.cells.compose import Layout, RobotRig, compile_model
@@ -18,6 +17,10 @@ from sim.cells.seam import Seam
 from sim.cells.tools import ToolSpec
 from sim.robots.model import KinematicModel
 from sim.robots.registry import RobotSpec
+
+if TYPE_CHECKING:  # for the annotations only: compose imports them where a model is made
+    import mujoco
+    from dm_control import mjcf
 
 #: ``tool="none"`` asks for no tool even where the cell has a default one.
 NO_TOOL = "none"

@@ -31,10 +31,9 @@ mass (MuJoCo computes the centre of mass and inertia from their volumes).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
-from dm_control import mjcf
 from pydantic import Field
 
 from sim.cells.tools import TIP_SITE, ToolSpec
@@ -42,6 +41,9 @@ from sim.core.rotations import euler_zyx_to_matrix
 from sim.core.text import PlainText
 from sim.core.tomlschema import Strict, load_toml
 from sim.errors import CellError
+
+if TYPE_CHECKING:  # dm_control is imported where a tool model is built
+    from dm_control import mjcf
 
 #: A length or coordinate in mm, bounded (10 m: a tool is not bigger).
 Mm = Annotated[float, Field(ge=-1e4, le=1e4)]
@@ -129,6 +131,8 @@ class _ToolBuilder:
             spec, mesh_path, X, wire_from, geoms)
 
     def __call__(self) -> mjcf.RootElement:
+        from dm_control import mjcf
+
         spec, mesh_path, X, wire_from, geoms = (self.spec, self.mesh_path, self.X,
                                                 self.wire_from, self.geoms)
         mass = spec.mass_kg

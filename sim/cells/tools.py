@@ -77,12 +77,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from dm_control import mjcf
 
 from planners.registry import Registry
 from sim.errors import CellsimError
+
+if TYPE_CHECKING:  # dm_control is imported where a tool model is built
+    from dm_control import mjcf
 
 #: Contact bit masks used across cellsim's cells (MuJoCo ``contype``/``conaffinity``): a contact
 #: is generated when ``(contype1 & conaffinity2) | (contype2 & conaffinity1)`` is non-zero.
@@ -280,6 +283,8 @@ _TORCHES: dict[str, tuple[tuple[str, float, float, float, float, tuple], ...]] =
 
 
 def _build_torch(spec: ToolSpec) -> mjcf.RootElement:
+    from dm_control import mjcf
+
     model = mjcf.RootElement(model=spec.name)
     body = model.worldbody.add("body", name="torch")
     for name, r, z0, z1, rho, rgba in _TORCHES[spec.name]:
@@ -290,6 +295,8 @@ def _build_torch(spec: ToolSpec) -> mjcf.RootElement:
 
 
 def _build_vacuum_gripper(spec: ToolSpec) -> mjcf.RootElement:
+    from dm_control import mjcf
+
     model = mjcf.RootElement(model=spec.name)
     body = model.worldbody.add("body", name="gripper")
     # adapter plate, vacuum ejector block, stem (tube), cup holder; the cup is a separate body.

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, ValidationError
 
+from sim.cells import BARE, resolve_cell, resolve_tool
 from sim.core.resources import shipped_scenarios
 from sim.errors import CellsimError, ScenarioError
 from sim.robots.registry import resolve_robot
@@ -130,10 +131,6 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         else:
             phase = HoldPhase(index=i, name=pspec.name, duration=pspec.duration_s)
         phases.append(phase)
-
-    # imported here: sim.cells imports mujoco, and the command line must be able to choose the
-    # OpenGL backend (MUJOCO_GL) after loading a scenario
-    from sim.cells import BARE, resolve_cell, resolve_tool
 
     base = Path(source).parent if str(source) != "<scenario>" else Path.cwd()
     try:
