@@ -25,15 +25,23 @@ import numpy as np
 from pydantic import BaseModel, ValidationError
 
 from sim.cells import BARE, resolve_cell, resolve_tool
+from sim.core.files import read_input_text
 from sim.core.resources import shipped_scenarios
+from sim.core.tomlschema import describe
 from sim.errors import CellsimError, ScenarioError
 from sim.robots.registry import resolve_robot
+from sim.scenario.fanuc_ls import read_ls
 from sim.scenario.model import Action, HoldPhase, JointPhase, Phase, Scenario
 from sim.scenario.phases import (
     build_cartesian_phase,
     build_joint_phase,
     check_continuity,
     with_ctwd,
+)
+from sim.scenario.program import (
+    frames_from_scenario,
+    program_phases,
+    registers_from_scenario,
 )
 from sim.scenario.schema import (
     PHASE_KINDS,
@@ -71,8 +79,6 @@ def load_scenario(ref: str | Path) -> Scenario:
             the file and the key.
         UnknownNameError: Unknown scenario name or robot.
     """
-    from sim.core.files import read_input_text
-
     path = resolve_scenario(ref)
     return parse_scenario(read_input_text(path, ScenarioError, "scenario file"), source=path)
 
@@ -167,13 +173,6 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         if spec.actions:
             raise ScenarioError(f"{where}: actions: not with program (the program's Arc "
                                 "Start/End are its actions)")
-        from sim.scenario.fanuc_ls import read_ls
-        from sim.scenario.program import (
-            frames_from_scenario,
-            program_phases,
-            registers_from_scenario,
-        )
-
         try:
             prog = read_ls(base / spec.program)
         except ScenarioError as exc:  # names the program file and line
@@ -224,8 +223,6 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
 def _describe_validation_error(exc: ValidationError, raw: Any) -> str:
     """One line for the first pydantic error: dotted key path and what is wrong
     (:func:`sim.core.tomlschema.describe`, with the phases' tagged union)."""
-    from sim.core.tomlschema import describe
-
     return describe(exc, ScenarioSpec, locate=lambda loc: _model_at(loc, raw), strip=_strip_tags,
                     union_hint=f"kind: must be one of {', '.join(repr(k) for k in PHASE_KINDS)}")
 

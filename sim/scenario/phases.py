@@ -5,6 +5,7 @@ distance)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -12,7 +13,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planners.errors import PlannerError
+from planners.weave import Weave
+from sim.core.rotations import euler_zyx_to_matrix
 from sim.errors import CellsimError, ScenarioError
+from sim.robots.maker import from_maker
 from sim.robots.registry import RobotSpec
 from sim.scenario.model import CartesianPhase, JointPhase, Phase, PoseTarget
 from sim.scenario.schema import (
@@ -117,8 +121,6 @@ def build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where:
                     f"({', '.join(robot.joints)})")
         rows_q = np.asarray(rows, dtype=float).reshape(-1, n) * scale
         if key == "joints_maker_deg":  # the controller's joint values -> the seed's
-            from sim.robots.maker import from_maker
-
             rows_q = from_maker(robot, rows_q)
     if target is None and rows_q.shape[0] == 0:
         raise ScenarioError(f"{where}: no knots")
@@ -180,8 +182,6 @@ def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
         return None
     rot = None
     if spec.euler_zyx_deg is not None:
-        from sim.core.rotations import euler_zyx_to_matrix
-
         rot = euler_zyx_to_matrix(*np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)))
     return PoseTarget(position=np.asarray(spec.to_mm, dtype=float) * 1e-3, rotation=rot,
                       frame=spec.frame)
@@ -206,8 +206,6 @@ def with_ctwd(phases: list[Phase], spec: ScenarioSpec, tool: Any, where: str) ->
         ScenarioError: ``ctwd_mm`` without a seam, without a torch, or shorter than the torch's
             nominal stick-out (its modelled wire would reach into the work).
     """
-    import dataclasses
-
     out = list(phases)
     for i, pspec in enumerate(spec.phases):
         ctwd = getattr(pspec, "ctwd_mm", None)
@@ -233,8 +231,6 @@ def _weave(spec: LinearPhaseSpec | CircularPhaseSpec, where: str):
     w = spec.weave
     if w is None:
         return None
-    from planners.weave import Weave
-
     if (w.frequency_hz is None) == (w.wavelength_mm is None):
         raise ScenarioError(f"{where}.weave: give exactly one of frequency_hz or wavelength_mm")
     freq = w.frequency_hz if w.frequency_hz is not None else spec.speed_mm_s / w.wavelength_mm

@@ -15,6 +15,7 @@ from sim.cells.cellfile.solids import Solid
 from sim.cells.compose import (
     Layout,
     RobotRig,
+    add_ring,
     look_at_xyaxes,
     matrix_from_quat,
     new_world,
@@ -23,6 +24,7 @@ from sim.cells.compose import (
 from sim.cells.seam import Seam
 from sim.cells.tools import CONTACT_FIXTURE, CONTACT_PART_AFFINITY, CONTACT_PART_TYPE
 from sim.errors import CellError, CellsimError
+from sim.robots.ik import solve_ik
 
 
 def _friction(b: ObjectBlock) -> dict:
@@ -55,8 +57,6 @@ def _add_static(world, b: ObjectBlock, solid: Solid, material: str) -> list:
         return [wb.add("geom", name=b.name, type="sphere", pos=t, size=[b.radius_mm * 1e-3],
                        **look, **common)]
     if b.shape == "ring":
-        from sim.cells.compose import add_ring
-
         half = b.length_mm * 0.5e-3
         a0, a1 = np.deg2rad(b.arc_deg) if b.arc_deg is not None else (0.0, 2 * np.pi)
         mat = b.material or material
@@ -229,8 +229,6 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
                                 f"{gap * 1e3:.3f} mm from the start of seam "
                                 f"{first.name!r} (at most 0.05 mm)")
     elif first is not None:
-        from sim.robots.ik import solve_ik
-
         km = rig.kinematics()
         T_inv = np.linalg.inv(T0)
         with warnings.catch_warnings():

@@ -20,7 +20,7 @@ from sim.cells.cellfile.schema import (
 from sim.cells.cellfile.seams import ctwd_key, seam_in_world, seam_points
 from sim.cells.cellfile.solids import Solid, geom_names, object_pose, read_solid
 from sim.core.tomlschema import load_toml
-from sim.errors import CellError, CellsimError
+from sim.errors import CellError, CellsimError, UnknownNameError
 
 
 @dataclass
@@ -74,8 +74,6 @@ def read_cell_file(path: str | Path) -> CellFile:
 
     def known(name: str, key: str, static: bool = False) -> Solid:
         if name not in solids:
-            from sim.errors import UnknownNameError
-
             valid = [n for n, s in solids.items() if not static or s.block.role != "part"]
             raise CellError(f"{where}: {key}: {UnknownNameError('object', name, valid)}")
         return solids[name]

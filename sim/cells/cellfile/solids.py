@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from sim.cells import meshes
 from sim.cells.cellfile.schema import ObjectBlock
 from sim.core.rotations import euler_zyx_to_matrix
 from sim.errors import CellError
@@ -60,10 +61,8 @@ class Solid:
             return float(np.linalg.norm(p) - b.radius_mm * 1e-3)
         if b.shape == "ring":
             return ring_distance(p, b)
-        from sim.cells.meshes import point_mesh_distance
-
         assert self.verts is not None and self.faces is not None
-        surf = point_mesh_distance(p, self.verts, self.faces)
+        surf = meshes.point_mesh_distance(p, self.verts, self.faces)
         inside = any(np.all(H[:, :3] @ p + H[:, 3] <= 1e-9) for H in self._halfspaces)
         return -surf if inside else surf
 
@@ -163,11 +162,9 @@ def read_solid(block: ObjectBlock, index: int, base: Path, where: str) -> Solid:
     else:
         from scipy.spatial import ConvexHull
 
-        from sim.cells.meshes import convex_pieces, read_mesh
-
         path = (base / str(block.file)).resolve()
-        s.verts, s.faces = read_mesh(path, block.mesh_unit, where=f"{key}.file")
-        pieces = convex_pieces(path, block.mesh_unit, where=f"{key}.file")
+        s.verts, s.faces = meshes.read_mesh(path, block.mesh_unit, where=f"{key}.file")
+        pieces = meshes.convex_pieces(path, block.mesh_unit, where=f"{key}.file")
         s.pieces = [pc for pc in pieces if _volume(pc) >= MIN_PIECE_VOLUME]
         if not s.pieces:
             raise CellError(f"{key}.file: {path.name}: the mesh encloses less than 1 mm^3 "

@@ -5,8 +5,10 @@ reported as that variant's error while the others go on."""
 
 from __future__ import annotations
 
+import logging
 import math
 import multiprocessing
+import socket
 import time
 import traceback
 from collections.abc import Callable, Sequence
@@ -87,8 +89,6 @@ def _run_batch(batch: Callable[[Sequence[Variant]], Sequence[Any]],
 
 def check_reachable(address: str, timeout_s: float = 5.0) -> None:
     """Refuse a cluster address nobody answers at (Ray itself would retry for minutes)."""
-    import socket
-
     where = address.split("://", 1)[-1]
     host, _, port = where.rpartition(":")
     if not host or not port.isdigit() or not 0 < int(port) < 65536:
@@ -113,8 +113,6 @@ def _run_on_ray(runner: Callable[[Variant], Any], variants: Sequence[Variant],
     installed on every node) and leaves it running. A task that dies (a worker killed, a node
     lost) becomes that variant's error; the others go on.
     """
-    import logging
-
     ray = import_ray()
     started = not ray.is_initialized()
     if started:

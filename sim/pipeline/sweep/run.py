@@ -22,6 +22,7 @@ from sim.pipeline.sweep.engines import (
 )
 from sim.pipeline.sweep.report import write_sweep
 from sim.pipeline.sweep.variants import SweepResult, Variant, make_variants
+from sim.simulation import runfolder
 
 
 def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Sequence[float],
@@ -76,8 +77,6 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
         import_ray()
         if address not in (None, "auto"):
             check_reachable(address)
-    from sim.simulation import runfolder
-
     # the sweep folder is cellsim's, like a run folder: never the working directory, a file,
     # a symbolic link or a user's folder (its marker lets a later sweep reuse it)
     out_dir = runfolder.check_out_dir(out_dir)

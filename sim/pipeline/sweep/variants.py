@@ -26,6 +26,7 @@ from sim.analysis.sizing import (
     sustained,
 )
 from sim.errors import CellsimError, SweepError
+from sim.scenario.schema import MAX_PAYLOAD_KG
 from sim.simulation.runfolder import SIZING_JSON
 
 #: Most variants of a sweep.
@@ -42,8 +43,6 @@ def validate_payloads(payloads: Sequence[float], field: str = "payload") -> list
     values = [float(p) for p in payloads]
     if not values:
         raise SweepError(f"{field}: no payload given (expected kg values like 0,2.5,5)")
-    from sim.scenario.schema import MAX_PAYLOAD_KG
-
     for p in values:
         if not math.isfinite(p) or p < 0 or p > MAX_PAYLOAD_KG:
             raise SweepError(f"{field}: payload must be a mass of 0 to {MAX_PAYLOAD_KG:g} kg, "
