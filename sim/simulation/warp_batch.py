@@ -326,7 +326,8 @@ WARP_SETTLE_TOL = 1e-4
 
 
 class _MotorBounds:
-    """The drives' motor limit of every world of a batch, as the CPU path's :class:`~sim.simulation.motor_limit.MotorLimit`.
+    """The drives' motor limit of every world of a batch, as the CPU path's
+    :class:`~sim.simulation.motor_limit.MotorLimit`.
 
     Per world and joint, at joint speed ``qd`` (the step's start: the motor's own speed) and
     the step's acceleration ``qdd``, a drive's force range is where its motor torque
