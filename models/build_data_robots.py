@@ -2,7 +2,7 @@
 table (``models/*/robot.toml`` with ``[kinematics] convention`` and ``mjcf``).
 
 cellsim generates such a model from the chain, the drives and the mass
-(:mod:`sim.robots.generate`); a user's robot folder gets it in cellsim's cache, a shipped one
+(:mod:`sim.robots.mjcf.generate`); a user's robot folder gets it in cellsim's cache, a shipped one
 keeps it in its folder so that it can be read and opened in MuJoCo's viewer like the others.
 
     python models/build_data_robots.py          # rewrite the files
@@ -50,7 +50,7 @@ def readme_block(folder: Path) -> str:
     import numpy as np
 
     from sim.robots.accel_limits import derive_accel_limits
-    from sim.robots.generate import max_gravity_torque
+    from sim.robots.mjcf.generate import max_gravity_torque
     from sim.robots.robotfile import load_robot_folder
 
     spec = load_robot_folder(folder)
@@ -71,14 +71,14 @@ def readme_block(folder: Path) -> str:
     L += ["", f"Flange (`tool0`) from j{n}: {' '.join(_g(v) for v in f)} mm.", ""]
     if arm.opw is not None:
         p = arm.opw
-        L += ["## OPW parameters derived from the chain (`sim/robots/opw.py`)", "",
+        L += ["## OPW parameters derived from the chain (`sim/robots/kinematics/opw.py`)", "",
               "| a1 | a2 | b | c1 | c2 | c3 | c4 (mm) | offsets (deg) | signs |",
               "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
               "| " + " | ".join(_g(v * 1e3, 6) for v in p.lengths().values()) + " | "
               + " ".join(_g(math.degrees(v) + 0.0) for v in p.offsets) + " | "
               + " ".join(f"{s:+d}" for s in p.signs) + " |", ""]
     est = spec.estimated_links or (False,) * n
-    L += ["## Mass model (`sim/robots/generate.py`)", "",
+    L += ["## Mass model (`sim/robots/mjcf/generate.py`)", "",
           "| link | mass (kg) | centre of mass in its joint frame (mm) | principal moments "
           "(kg m^2) | inertial | capsule radius (mm) |", "| --- | --- | --- | --- | --- | --- |"]
     for i in range(n):

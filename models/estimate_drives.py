@@ -74,7 +74,7 @@ def drives_toml(folder: Path) -> str:
     import mujoco
     import numpy as np
 
-    from sim.robots.generate import mass_matrix, max_gravity_torque
+    from sim.robots.mjcf.generate import mass_matrix, max_gravity_torque
     from sim.robots.robotfile import generated_files, load_robot_folder
 
     spec = load_robot_folder(folder)

@@ -8,14 +8,14 @@ import pytest
 
 from sim.core.resources import models_dir
 from sim.errors import KinematicsError
-from sim.robots.builder import (
+from sim.robots.kinematics.closed_form import fk_5r, fk_fanuc6, mdh_transform
+from sim.robots.kinematics.dh import DHRow, MDHRow, ScrewAxis
+from sim.robots.kinematics.mujoco_fk import MujocoKinematics
+from sim.robots.mjcf.builder import (
     RRRT_DIMS,
     RRRT_Q4,
     RTT_L1,
-    DHRow,
     KinematicChain,
-    MDHRow,
-    ScrewAxis,
     example_chains,
     fanuc6_chain,
     five_r_chain,
@@ -23,8 +23,6 @@ from sim.robots.builder import (
     rrrt_exercise_q,
     rtt_chain,
 )
-from sim.robots.closed_form import fk_5r, fk_fanuc6, mdh_transform
-from sim.robots.mujoco_fk import MujocoKinematics
 from sim.robots.registry import get_robot
 
 
@@ -157,7 +155,7 @@ def test_screw_chain_with_tilted_axes_and_rotated_home():
 
 
 def test_shipped_examples_are_up_to_date():
-    """models/examples/*.xml are what `python -m sim.robots.builder` generates."""
+    """models/examples/*.xml are what `python -m sim.robots.mjcf.builder` generates."""
     for name, chain in example_chains().items():
         text = (models_dir() / "examples" / f"{name}.xml").read_text()
         assert chain.to_mjcf() in text

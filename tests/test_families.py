@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.robots.closed_form import fk_5r, fk_fanuc6
 from sim.robots.families import Fanuc6, FiveR, KinematicFamily
+from sim.robots.kinematics.closed_form import fk_5r, fk_fanuc6
 from sim.robots.registry import ROBOTS, joint_ranges
 
 ALL_ROBOTS = sorted(ROBOTS)

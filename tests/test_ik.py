@@ -7,10 +7,14 @@ import pytest
 
 from sim.core.rotations import euler_zyx_to_matrix, make_transform, wrap_to_pi
 from sim.errors import KinematicsError, UnreachableError
-from sim.robots.closed_form import fk_5r, fk_fanuc6
 from sim.robots.families import Fanuc6, FiveR
-from sim.robots.ik import SingularityWarning, ik_5r_seed, ik_path, solve_ik
-from sim.robots.model import KinematicModel, closed_form_model, kinematic_model
+from sim.robots.kinematics.closed_form import fk_5r, fk_fanuc6
+from sim.robots.kinematics.ik import SingularityWarning, ik_5r_seed, ik_path, solve_ik
+from sim.robots.kinematics.model import (
+    KinematicModel,
+    closed_form_model,
+    kinematic_model,
+)
 from sim.robots.registry import ROBOTS, get_robot
 
 ALL_ROBOTS = sorted(ROBOTS)
@@ -290,8 +294,8 @@ def test_5axis_orientation_tolerance_for_typed_angles():
 
     from sim.core.rotations import rot_z
     from sim.errors import UnreachableError
-    from sim.robots.ik import PLANE_TOL, solve_ik
-    from sim.robots.model import closed_form_model
+    from sim.robots.kinematics.ik import PLANE_TOL, solve_ik
+    from sim.robots.kinematics.model import closed_form_model
 
     kin = closed_form_model(ROBOTS["lrmate100ib"])
     q = np.deg2rad([20.0, 30.0, -10.0, 15.0, 5.0])
@@ -334,7 +338,7 @@ def test_a_chains_batched_forward_kinematics_is_the_dh_product():
     """``Chain.fk_many`` (the path IK's check of the closed form's branches) against the
     standard DH product ``Rz(theta) Tz(d) Tx(a) Rx(alpha)`` written here, on random tables and
     configurations; and row by row equal to ``Chain.fk``."""
-    from sim.robots.chain import chain_from_dh
+    from sim.robots.kinematics.chain import chain_from_dh
 
     def rz(t):
         c, s = np.cos(t), np.sin(t)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.robots.jacobian import (
+from sim.robots.kinematics.jacobian import (
     geometric_jacobian,
     manipulability,
     numeric_jacobian,
@@ -13,8 +13,8 @@ from sim.robots.jacobian import (
     task_jacobian,
     task_jacobian_5r,
 )
-from sim.robots.model import closed_form_model, kinematic_model
-from sim.robots.mujoco_fk import MujocoKinematics
+from sim.robots.kinematics.model import closed_form_model, kinematic_model
+from sim.robots.kinematics.mujoco_fk import MujocoKinematics
 from sim.robots.registry import ROBOTS
 
 ALL_ROBOTS = sorted(ROBOTS)
@@ -88,7 +88,7 @@ def test_seed004_singular_conditions_give_zero_det():
         assert singularity_measures(m, np.array([0.3, 0.4, t, 0.7, 0.6, -0.2]))["sigma_min"] < 1e-12
     # eq. 25 (as printed): d2 + d3 S2 + C2 (R4 C3 - d4 S3) + S2 (R4 S3 + d4 C3) = 0. Solve it
     # for theta2 at a few theta3 (brentq) and evaluate det J at theta2 -> -theta2 (the seed's
-    # sign of theta2 in eq. 25 is opposite to eq. 6's; see sim.robots.jacobian).
+    # sign of theta2 in eq. 25 is opposite to eq. 6's; see sim.robots.kinematics.jacobian).
     from scipy.optimize import brentq
 
     def eq25(t2, t3):

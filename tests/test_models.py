@@ -11,8 +11,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from sim.robots.closed_form import fk_5r, fk_fanuc6
 from sim.robots.families import Fanuc6, FiveR
+from sim.robots.kinematics.closed_form import fk_5r, fk_fanuc6
 from sim.robots.registry import ROBOTS, RobotSpec, joint_ranges
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -19,11 +19,11 @@ import numpy as np
 import pytest
 
 from sim.errors import KinematicsError
-from sim.robots import opw
 from sim.robots.arm import load_arm
-from sim.robots.chain import chain_from_dh, chain_from_urdf
-from sim.robots.numeric_ik import pose_error
-from sim.robots.numeric_ik import solve_ik as numeric_ik
+from sim.robots.kinematics import opw
+from sim.robots.kinematics.chain import chain_from_dh, chain_from_urdf
+from sim.robots.kinematics.numeric_ik import pose_error
+from sim.robots.kinematics.numeric_ik import solve_ik as numeric_ik
 
 DATA = Path(__file__).resolve().parent / "data"
 
@@ -57,7 +57,7 @@ UR5_DH = np.array([[0.0, np.pi / 2, 0.089159, 0.0], [-0.425, 0.0, 0.0, 0.0],
 
 def dh_product(rows: np.ndarray, q: np.ndarray, convention: str = "dh") -> np.ndarray:
     """The textbook DH (or Craig MDH) product for joint values ``q``: the explicit matrix
-    entries of each row, independent of sim.robots.chain and sim.robots.builder."""
+    entries of each row, independent of sim.robots.kinematics.chain and sim.robots.mjcf.builder."""
     T = np.eye(4)
     for (a, alpha, d, off), qi in zip(np.asarray(rows, dtype=float), np.asarray(q, float),
                                       strict=True):
@@ -446,8 +446,8 @@ def test_fanuc_j3_is_measured_from_the_horizontal(robot):
     """The J2/J3 interaction, checked on the arm itself: with the maker's J3 fixed, the
     forearm's elevation (J3 axis to the wrist, in the arm plane) does not change with J2, and a
     change of the maker's J3 turns it by that much; maps both ways are inverse."""
+    from sim.robots.kinematics.model import closed_form_model
     from sim.robots.maker import from_maker, to_maker
-    from sim.robots.model import closed_form_model
     from sim.robots.registry import ROBOTS
 
     spec = ROBOTS[robot]
@@ -951,7 +951,7 @@ def test_a_5_axis_dh_arm_gets_the_seeds_5r_closed_form(tmp_path):
     configurations the one the pose came from is among at most 4 branches (front/back x
     up/down) modulo whole turns, every solution within 1e-9 of the pose (the textbook DH
     product), and the tool point equals seed 000's eq. 5 with the derived dimensions."""
-    from sim.robots.closed_form import fk_5r
+    from sim.robots.kinematics.closed_form import fk_5r
 
     (tmp_path / "five").mkdir()
     (tmp_path / "five" / "robot.toml").write_text(robot_toml(FIVE_DH, "five"))
@@ -1061,8 +1061,8 @@ def test_a_numeric_arms_path_ik_continues_its_branch_as_the_global_search_would(
     and each point's joints are those the global search (every seed, the nearest taken)
     gives from the point before."""
     from sim.robots.families.chain_family import ChainFamily
-    from sim.robots.ik import ik_path
-    from sim.robots.model import KinematicModel
+    from sim.robots.kinematics.ik import ik_path
+    from sim.robots.kinematics.model import KinematicModel
 
     (tmp_path / "robot.toml").write_text(robot_toml(UR5_DH, "ur5"))
     arm = load_arm(tmp_path)

@@ -54,7 +54,7 @@ def same_arm(a, b, samples: int = 200) -> float:
 
 def links() -> list[tuple[float, np.ndarray, np.ndarray]]:
     """``(mass kg, centre of mass mm, [ixx, iyy, izz, ixy, ixz, iyz] kg m^2)`` per link."""
-    from sim.robots.chain import chain_from_urdf
+    from sim.robots.kinematics.chain import chain_from_urdf
 
     a = chain_from_urdf(HERE / "kr6r900_2.urdf")
     b = chain_from_urdf(HERE / "kr6_r900_2_kroshu.urdf", tip="flange")

@@ -2,10 +2,10 @@
 
 :func:`load_arm` reads ``*.urdf`` files and ``robot.toml`` files (or the folder holding one);
 :class:`Arm` solves inverse kinematics with the closed form when the arm is ortho-parallel with
-a spherical wrist (:mod:`sim.robots.opw`: all 8 branches, plus the whole-turn variants of
+a spherical wrist (:mod:`sim.robots.kinematics.opw`: all 8 branches, plus the whole-turn variants of
 joints whose range exceeds 360 deg), with seed 000's 5R closed form when a 5-axis arm has its
-structure (:mod:`sim.robots.five_axis`: 4 branches), and numerically otherwise
-(:mod:`sim.robots.numeric_ik`).
+structure (:mod:`sim.robots.kinematics.five_axis`: 4 branches), and numerically otherwise
+(:mod:`sim.robots.kinematics.numeric_ik`).
 
 ``robot.toml`` (this slice reads its kinematics and joint tables)::
 
@@ -36,16 +36,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from sim.core.tomlschema import load_toml
 from sim.errors import KinematicsError
-from sim.robots import opw
-from sim.robots.chain import (
+from sim.robots.kinematics import opw
+from sim.robots.kinematics.chain import (
     Chain,
     chain_from_dh,
     chain_from_urdf,
     range_problem,
     turns_problem,
 )
-from sim.robots.five_axis import FiveAxisMap, five_axis_from_chain
-from sim.robots.numeric_ik import solve_ik as numeric_solve
+from sim.robots.kinematics.five_axis import FiveAxisMap, five_axis_from_chain
+from sim.robots.kinematics.numeric_ik import solve_ik as numeric_solve
 from sim.robots.schema import DH_COLUMNS, RobotFolderSpec
 
 

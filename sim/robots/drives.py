@@ -4,7 +4,8 @@
 One place decides it, and everything uses its result: the compiled model's actuator
 ``forcerange`` (peak motor torque x ratio x efficiency at the joint) and joint ``armature``
 (the rotor's reflected inertia, ``J_r N^2``), the simulation's torque-speed limit, sizing and
-the report (:attr:`sim.scenario.model.Scenario.drive_train`).
+the report (:attr:`sim.scenario.model.Scenario.drive_train`). The physics of a drive (its
+torque-speed curve, the motor torque of a joint torque) is :mod:`sim.robots.drive`.
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ README deriving each number. The registry (:data:`sim.robots.registry.ROBOTS`) s
 A robot may instead be given by a DH table or a URDF (``[kinematics] convention = "dh" | "mdh"
 | "urdf"``, with ``[[drives]]`` and ``[mass] total_kg``): its family is
 :class:`sim.robots.families.chain_family.ChainFamily` (OPW closed form or numeric IK) and
-cellsim writes its MJCF (:mod:`sim.robots.generate`). Every key: ``docs/robot-format.md``.
+cellsim writes its MJCF (:mod:`sim.robots.mjcf.generate`). Every key: ``docs/robot-format.md``.
 
 Every problem is one line naming the file and the key (:class:`sim.errors.KinematicsError`).
 """
@@ -53,11 +53,11 @@ from sim.core.tomlschema import load_toml
 from sim.errors import HoldError, KinematicsError
 from sim.robots.accel_limits import derive_accel_limits
 from sim.robots.arm import arm_from_chain, chain_from_robot_file
-from sim.robots.chain import Chain, chain_from_urdf, inertia_problem
 from sim.robots.drive import Drive
 from sim.robots.families import Fanuc6, FiveR
 from sim.robots.families.chain_family import ChainFamily
-from sim.robots.generate import generated_model_path, model_text, scene_text
+from sim.robots.kinematics.chain import Chain, chain_from_urdf, inertia_problem
+from sim.robots.mjcf.generate import generated_model_path, model_text, scene_text
 from sim.robots.schema import RobotFolderSpec
 from sim.robots.spec import RobotSpec
 
@@ -128,7 +128,7 @@ def _drives(spec: RobotFolderSpec) -> tuple[Drive, ...]:
 
 
 def _mass_model(spec: RobotFolderSpec, chain: Chain, where: str) -> tuple[object, tuple[bool, ...]]:
-    """The links' mass model for :mod:`sim.robots.generate` (``[[links]]``, a URDF's inertials
+    """The links' mass model for :mod:`sim.robots.mjcf.generate` (``[[links]]``, a URDF's inertials
     or ``[mass] total_kg``) and which links' inertials are estimates: every capsule of a total
     mass; a ``[[links]]`` entry marked ``estimate`` or without its centre of mass and inertia
     (a capsule of its mass); every link where ``[mass] estimated = true``."""
@@ -186,7 +186,7 @@ def _maker(spec: RobotFolderSpec, n: int, where: str
 
 def _data_robot(spec: RobotFolderSpec, path: Path) -> RobotSpec:
     """A robot given by a DH table or a URDF: its chain, the :class:`ChainFamily`, a generated
-    MJCF (:mod:`sim.robots.generate`) and acceleration limits derived from the drives."""
+    MJCF (:mod:`sim.robots.mjcf.generate`) and acceleration limits derived from the drives."""
     where = str(path)
     chain = chain_from_robot_file(spec, path)
     n = chain.n

@@ -96,7 +96,7 @@ class RobotSpec:
 
 @cache
 def _mjcf_ranges(path: str, joints: tuple[str, ...]) -> tuple[tuple[float, float], ...]:
-    import mujoco
+    import mujoco  # only when ranges are read: loading the registry must not import mujoco
 
     model = mujoco.MjModel.from_xml_path(path)
     out = []
