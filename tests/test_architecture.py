@@ -56,10 +56,13 @@ def _imports(module: str, path: Path) -> list[tuple[int, str]]:
                 name = ".".join(base + ([node.module] if node.module else []))
             else:
                 name = node.module or ""
-            found.append((node.lineno, name))
-            # "from sim.render import gl" imports the module sim.render.gl
-            found += [(node.lineno, f"{name}.{a.name}") for a in node.names
-                      if f"{name}.{a.name}" in MODULE_NAMES]
+            # "from sim.render import gl" imports the module sim.render.gl (the package's
+            # __init__ runs first as for any submodule, no arrow of its own); a name that is
+            # no module ("from sim.render.gl import configure_gl") is the module's
+            subs = [f"{name}.{a.name}" for a in node.names if f"{name}.{a.name}" in MODULE_NAMES]
+            if len(subs) < len(node.names):
+                found.append((node.lineno, name))
+            found += [(node.lineno, sub) for sub in subs]
     return [(ln, n) for ln, n in found if n.split(".")[0] in ("sim", "planners")]
 
 
