@@ -490,3 +490,100 @@ def test_held_part_set_down_into_the_tray_floor_is_a_collision():
     assert hits and {c["phase"] for c in hits} == {"release0"}, found
     assert hits[0]["bodies"][1] == "tray_floor"
     assert hits[0]["depth_mm"] == pytest.approx(10.0, abs=0.6)
+
+
+# ------------------------------------------------------- where the tool meets the last link
+MOUNT_JOB = """
+name = "mount_{robot}"
+description = "a joint move of {robot} with {tool}, the wrist straight then bent"
+robot = "{robot}"
+tool = "{tool}"
+
+[[phases]]
+name = "move"
+planner = "434"
+time_s = [0.0, 1.0, 2.0]
+joints_deg = [[0, 0, 0, 0, {q5}, 0], [10, 5, -5, 0, {q5}, 30], [20, 10, -10, 0, {q5}, 60]]
+"""
+
+MOUNT_ARMS = ("m10ia", "m20ia", "ar2010", "irb1600", "kr10r1420", "kr6r900_2", "irb2400")
+
+
+def _mount_case(tmp_path: Path, robot: str, tool: str = "mig_torch", q5: float = -60.0):
+    path = tmp_path / f"{robot}.toml"
+    path.write_text(MOUNT_JOB.format(robot=robot, tool=tool, q5=q5))
+    return path
+
+
+@pytest.mark.parametrize("robot", MOUNT_ARMS)
+def test_the_shapes_meeting_at_a_tool_mount_are_declared_not_reported(robot, tmp_path, capsys):
+    """The generated arms' last-but-one link is a capsule whose cap reaches past the flange
+    into the torch's adapter at every angle of J6: ``cellsim check`` found a collision there
+    for the whole cycle of any scenario. Each declared pair is measured here on the compiled
+    cell itself (MuJoCo's distance, J6 swept over its range, the other joints anywhere): it
+    overlaps at every angle; and the check finds nothing else on a plain joint move."""
+    import mujoco
+
+    from sim.simulation.allowed_contacts import mount_overlaps
+    from sim.simulation.collision_model import CollisionModel
+    from sim.simulation.compile import build
+
+    path = _mount_case(tmp_path, robot)
+    built = build(load_scenario(path))
+    pairs = mount_overlaps(CollisionModel(built))
+    m = built.model
+    d = mujoco.MjData(m)
+    j6 = m.joint("robot/j6").id
+    rng = np.random.default_rng(6)
+    for a, b, reason in pairs:
+        assert m.geom(a).name.startswith("robot/tool/") and "every angle of j6" in reason
+        assert m.body(m.geom_bodyid[b]).name == "robot/link5"
+        lo, hi = m.jnt_range[j6]
+        for angle in np.linspace(lo, hi, 25):
+            d.qpos[:] = rng.uniform(m.jnt_range[:, 0], m.jnt_range[:, 1])
+            d.qpos[m.jnt_qposadr[j6]] = angle
+            mujoco.mj_kinematics(m, d)
+            assert mujoco.mj_geomDistance(m, d, a, b, 1.0, None) < -1e-4
+    assert main(["check", str(path)]) == 0, capsys.readouterr().out
+
+
+def test_a_tool_clear_of_the_wrist_declares_nothing(tmp_path):
+    from sim.simulation.allowed_contacts import mount_overlaps
+    from sim.simulation.collision_model import CollisionModel
+    from sim.simulation.compile import build
+
+    built = build(load_scenario(_mount_case(tmp_path, "lrmate200ic5l")))
+    assert mount_overlaps(CollisionModel(built)) == []
+
+
+ROD_TORCH = """
+name = "rod_torch"
+description = "a torch with a rod reaching back along the wrist (a planted fault)"
+kind = "torch"
+mass_kg = 1.0
+tcp_mm = [0, 0, 300]
+
+[[shapes]]
+name = "body"
+shape = "cylinder"
+radius_mm = 20
+from_mm = [0, 0, 0]
+to_mm = [0, 0, 285]
+
+[[shapes]]
+name = "rod"
+shape = "box"
+size_mm = [20, 20, 40]
+pos_mm = [0, 0, -200]
+"""
+
+
+def test_a_tool_reaching_back_past_the_mount_still_collides(tmp_path, capsys):
+    """Planted fault: a rod 200 mm behind the flange sits in the forearm (link4) while the
+    wrist is straight: the declaration of the mount's own overlap does not hide it."""
+    (tmp_path / "rod_torch.toml").write_text(ROD_TORCH)
+    path = _mount_case(tmp_path, "m10ia", tool="rod_torch.toml", q5=0.0)
+    assert main(["check", str(path)]) == 1
+    out = capsys.readouterr().out
+    hits = [line for line in out.splitlines() if line.startswith("collision:")]
+    assert hits and all("robot/link4" in h and "robot/tool/rod" in h for h in hits), out

@@ -19,7 +19,10 @@ from numpy.typing import NDArray
 from sim.core.intervals import true_runs
 from sim.simulation.collision_model import (
     CELL,
+    LINK,
     PART,
+    PENETRATION_TOLERANCE_M,
+    TOOL,
     AllowedContact,
     CollisionModel,
     Contacts,
@@ -36,6 +39,9 @@ WIRE_ARC_DEPTH_M = 1e-3
 PART_CONTACT_DEPTH_M = 1e-3
 #: Suction picks the part whose bounding sphere holds the tool point, with this to spare, m.
 PICK_REACH_M = 0.005
+#: Step of the sweep of the tool's own joint that finds the tool's geoms overlapping the link
+#: before it at every angle (:func:`mount_overlaps`), deg.
+MOUNT_SWEEP_STEP_DEG = 0.5
 
 
 def weave_reach(weave: Any) -> float:
@@ -63,7 +69,9 @@ def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
     built = cm.built
     cell = built.cell
     n = samples.t.size
-    out: list[AllowedContact] = []
+    out: list[AllowedContact] = [
+        AllowedContact(frozenset({a}), frozenset({b}), np.ones(n, bool), reason)
+        for a, b, reason in mount_overlaps(cm)]
     work = frozenset(g for g, cg in cm.geoms.items() if cg.work)
     torch = cell.tool is not None and cell.tool.kind == "torch"
     if work and torch and cell.seam_objects:
@@ -151,3 +159,58 @@ def allowed_mask(c: Contacts, allowed: Sequence[AllowedContact]) -> NDArray[np.b
         if c.s.size:
             ok |= rule.mask(c.s, c.g1, c.g2, c.dist)
     return ok
+
+
+def mount_overlaps(cm: CollisionModel) -> list[tuple[int, int, str]]:
+    """The tool's geoms that overlap a geom of the link before the one the tool is mounted on at
+    every angle of the joint between them: ``(tool geom, link geom, reason)``.
+
+    The tool is welded to the last link, so its pose relative to the link before depends on
+    that one joint only; a pair that overlaps at every angle of its range (swept every
+    :data:`MOUNT_SWEEP_STEP_DEG`, deeper than the collision tolerance each time) is the model's
+    shapes meeting at the mount (a link capsule's cap reaching past the flange face into the
+    tool's adapter), no place a motion can reach or avoid: MoveIt's "always in collision" pair.
+    A pair that overlaps at some angles only stays a collision. Computed once per check model.
+    """
+    cached = getattr(cm, "_mount_overlaps", None)
+    if cached is not None:
+        return list(cached)
+    mujoco = mujoco_module()
+    m = cm.model
+    tool = sorted(g for g, cg in cm.geoms.items() if cg.role == TOOL)
+    found: list[tuple[int, int, str]] = []
+    if tool:
+        body = int(m.geom_bodyid[tool[0]])
+        while body != 0 and m.body_jntnum[body] == 0:  # up to the link the tool is welded to
+            body = int(m.body_parentid[body])
+        before = int(m.body_parentid[body])
+        link = sorted(g for g, cg in cm.geoms.items()
+                      if cg.role == LINK and int(m.geom_bodyid[g]) == before)
+        if body != 0 and m.body_jntnum[body] == 1 and link:
+            joint = int(m.body_jntadr[body])
+            lo, hi = ((float(m.jnt_range[joint, 0]), float(m.jnt_range[joint, 1]))
+                      if m.jnt_limited[joint] else (-np.pi, np.pi))
+            hi = min(hi, lo + 2 * np.pi)  # the pose repeats after a turn
+            angles = np.linspace(lo, hi, max(2, int(np.ceil(
+                np.degrees(hi - lo) / MOUNT_SWEEP_STEP_DEG)) + 1))
+            d = mujoco.MjData(m)
+            adr = int(m.jnt_qposadr[joint])
+            worst = {(a, b): -np.inf for a in tool for b in link}
+            fromto = np.zeros(6)
+            for angle in angles:
+                d.qpos[:] = m.qpos0
+                d.qpos[adr] = angle
+                mujoco.mj_kinematics(m, d)
+                for (a, b), w in worst.items():
+                    if w > -PENETRATION_TOLERANCE_M:
+                        continue  # already clear at some angle
+                    dist = mujoco.mj_geomDistance(m, d, a, b, 1.0, fromto)
+                    worst[(a, b)] = max(w, float(dist))
+            joint_name = m.joint(joint).name.removeprefix("robot/")
+            for (a, b), w in worst.items():
+                if w <= -PENETRATION_TOLERANCE_M:
+                    found.append((a, b, f"{cm.geoms[a].name} overlaps {cm.geoms[b].name} at "
+                                  f"every angle of {joint_name} (at least {-w * 1e3:.1f} mm): "
+                                  "the model's shapes meeting at the tool mount"))
+    cm._mount_overlaps = tuple(found)  # type: ignore[attr-defined]
+    return found

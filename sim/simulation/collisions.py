@@ -41,6 +41,11 @@ Allowed contacts are declared (:func:`allowed_contacts`), not guessed:
   held, and while held in the phase where suction comes on and the next one (lift-off) and in
   the phase where suction goes off and the one before (set-down); parts and the lip up to
   :data:`PART_CONTACT_DEPTH_M` deep;
+* a tool geom with a geom of the link before the one the tool is mounted on, when the two
+  overlap at every angle of the joint between them (:func:`~sim.simulation.allowed_contacts.
+  mount_overlaps`: the model's shapes meeting at the mount, e.g. a generated arm's wrist capsule
+  whose cap reaches past the flange face into the torch's adapter; MoveIt's "always in
+  collision" pair); a pair that overlaps at some angles only is a collision;
 * everything else (nozzle, contact tip, torch body, arm, a held part in transfer) never.
 
 A contact is a collision when its penetration exceeds :data:`PENETRATION_TOLERANCE_M` (0.1 mm,
