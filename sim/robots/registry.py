@@ -35,7 +35,8 @@ from sim.robots.spec import RobotSpec, joint_ranges
 
 
 def _shipped_robots() -> Registry[RobotSpec]:
-    """The robot folders of ``models/`` (each with a ``robot.toml``, :mod:`sim.robots.robotfile`)."""
+    """The robot folders of ``models/``, each with a ``robot.toml``
+    (:mod:`sim.robots.robotfile`)."""
     reg: Registry[RobotSpec] = Registry("robot")
     for path in sorted(models_dir().glob("*/robot.toml")):
         spec = load_robot_folder(path.parent)

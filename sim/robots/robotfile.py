@@ -239,7 +239,8 @@ def _data_robot(spec: RobotFolderSpec, path: Path) -> RobotSpec:
     return dataclasses.replace(robot, max_accel=tuple(float(v) for v in accel))
 
 
-def _derived_accel(robot: RobotSpec, payload_kg: float, cache: Path | None, where: str) -> np.ndarray:
+def _derived_accel(robot: RobotSpec, payload_kg: float, cache: Path | None,
+                   where: str) -> np.ndarray:
     """Acceleration limits derived from the drives (:mod:`sim.robots.accel_limits`), rad/s^2,
     kept beside a generated model in cellsim's cache (whose key covers the drives, the
     masses and the payload): a second load neither recomputes them nor imports mujoco."""

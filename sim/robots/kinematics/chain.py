@@ -227,8 +227,8 @@ def chain_from_dh(rows: ArrayLike, convention: str = "dh", *, name: str = "arm",
     rows_a = np.asarray(R, dtype=float).reshape(-1, 4)
     if convention not in ("dh", "mdh"):
         raise KinematicsError(f"{name}: convention must be 'dh' or 'mdh', got {convention!r}")
-    # the table rows of sim.robots.kinematics.dh (also the MJCF chain builder's) give each row's constant
-    # transform; the joint turns about the z axis before (dh) or after (mdh) it
+    # the table rows of sim.robots.kinematics.dh (also the MJCF chain builder's) give each
+    # row's constant transform; the joint turns about the z axis before (dh) or after (mdh) it
     n = len(rows_a)
     z = np.array([0.0, 0.0, 1.0])
     if convention == "dh":

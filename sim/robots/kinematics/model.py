@@ -136,12 +136,12 @@ def kinematic_model(spec: RobotSpec) -> KinematicModel:
     """Model of a robot whose tool frame is the MJCF site ``tcp``.
 
     The constant ``tcp_offset`` is measured from the MJCF at q = 0 (site ``tcp`` in site
-    ``frame0``); :mod:`sim.robots.kinematics.mujoco_fk` checks it holds at every q (tests). An offset the
-    family's analytic IK cannot handle falls back to the seed's tool frame with a warning.
+    ``frame0``); :mod:`sim.robots.kinematics.mujoco_fk` checks it holds at every q (tests). An
+    offset the family's analytic IK cannot handle falls back to the seed's tool frame with a
+    warning.
     """
-    from sim.robots.kinematics.mujoco_fk import (
-        MujocoKinematics,  # imports mujoco: only when used
-    )
+    # imports mujoco, so only when used (not a cycle: mujoco_fk imports spec, not this module)
+    from sim.robots.kinematics.mujoco_fk import MujocoKinematics
 
     model = closed_form_model(spec)
     mj = MujocoKinematics.for_robot(spec)

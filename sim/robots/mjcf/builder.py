@@ -184,7 +184,8 @@ def fanuc6_chain(dims: dict[str, float], tool_length: float = 0.0) -> KinematicC
     rows = [MDHRow(0.0, 0.0, 0.0, 0.0), MDHRow(h, dims["d2"], h, 0.0),
             MDHRow(0.0, dims["d3"], 0.0, 0.0), MDHRow(h, dims["d4"], 0.0, dims["R4"]),
             MDHRow(-h, 0.0, 0.0, 0.0), MDHRow(h, 0.0, 0.0, 0.0)]
-    return KinematicChain("mdh", rows, tool=make_transform(np.eye(3), [0.0, 0.0, dims["R6"] + tool_length]), name="fanuc6_mdh")
+    tool = make_transform(np.eye(3), [0.0, 0.0, dims["R6"] + tool_length])
+    return KinematicChain("mdh", rows, tool=tool, name="fanuc6_mdh")
 
 
 def five_r_chain(dims: dict[str, float]) -> KinematicChain:
@@ -222,7 +223,8 @@ def rtt_chain(L1: float = RTT_L1, convention: str = "screw") -> KinematicChain:
     if convention == "dh":
         rows = [DHRow(0.0, 0.0, 0.0, 0.0), DHRow(0.0, 0.0, 0.0, -np.pi / 2, "P", (0.0, 1.0)),
                 DHRow(0.0, L1, 0.0, 0.0, "P", lim)]
-        return KinematicChain("dh", rows, tool=make_transform(rot_x(np.pi / 2), np.zeros(3)), name="rtt_dh")
+        return KinematicChain("dh", rows, tool=make_transform(rot_x(np.pi / 2), np.zeros(3)),
+                              name="rtt_dh")
     raise KinematicsError(
         f"unknown convention {convention!r} for the RTT example; known: dh, screw")
 
