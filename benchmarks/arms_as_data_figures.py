@@ -39,9 +39,9 @@ from test_robots_as_data import (  # noqa: E402
     ur5_urdf_with_inertials,
 )
 
-from sim.robots import opw  # noqa: E402
 from sim.robots.arm import load_arm  # noqa: E402
-from sim.robots.chain import chain_from_urdf  # noqa: E402
+from sim.robots.kinematics import opw  # noqa: E402
+from sim.robots.kinematics.chain import chain_from_urdf  # noqa: E402
 from sim.robots.registry import ROBOTS, resolve_robot  # noqa: E402
 
 print("shipped arms: generated model vs MuJoCo's compile of the public URDF (1000 configs)")

@@ -2,7 +2,7 @@
 
 Numeric: 1000 random reachable poses of a UR5 (offset wrist, no closed form; standard DH from
 Universal Robots' table), each solved from the zero configuration then random seeds until one
-solution reaches a pose error under 1e-9 (``sim.robots.numeric_ik.solve_ik(first=True)``). The
+solution reaches a pose error under 1e-9 (``sim.robots.kinematics.numeric_ik.solve_ik(first=True)``). The
 issue's goal: 99 % solved within 20 ms each. Closed form: the same count of poses of the KUKA
 KR 6 R700 sixx (its URDF, tests/data), every branch (``Arm.ik``), for the ratio of the two.
 
@@ -22,8 +22,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from sim.robots.arm import load_arm  # noqa: E402
-from sim.robots.chain import chain_from_dh  # noqa: E402
-from sim.robots.numeric_ik import pose_error, solve_ik  # noqa: E402
+from sim.robots.kinematics.chain import chain_from_dh  # noqa: E402
+from sim.robots.kinematics.numeric_ik import pose_error, solve_ik  # noqa: E402
 
 UR5_DH = np.array([[0.0, np.pi / 2, 0.089159, 0.0], [-0.425, 0.0, 0.0, 0.0],
                    [-0.39225, 0.0, 0.0, 0.0], [0.0, np.pi / 2, 0.10915, 0.0],

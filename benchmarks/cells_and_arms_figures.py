@@ -22,9 +22,9 @@ sys.path.insert(0, str(ROOT))
 from test_cell_files import BRACKET_POS_MM, BRACKET_YAW_DEG, SEAM_MM, make_cell, rz  # noqa: E402
 
 from sim.pipeline.run import evaluate_scenario  # noqa: E402
-from sim.robots import opw  # noqa: E402
 from sim.robots.arm import load_arm  # noqa: E402
-from sim.robots.numeric_ik import pose_error  # noqa: E402
+from sim.robots.kinematics import opw  # noqa: E402
+from sim.robots.kinematics.numeric_ik import pose_error  # noqa: E402
 from sim.scenario import load_scenario  # noqa: E402
 
 with tempfile.TemporaryDirectory() as tmp:

@@ -14,9 +14,9 @@ import pytest
 from sim.cells import BARE, CELLS, MOUNTS, Seam, build_cell, resolve_tool
 from sim.cells.tools import TOOLS
 from sim.errors import CellsimError, UnknownNameError
-from sim.robots.closed_form import fk_5r
 from sim.robots.families import Fanuc6, FiveR
-from sim.robots.ik import solve_ik
+from sim.robots.kinematics.closed_form import fk_5r
+from sim.robots.kinematics.ik import solve_ik
 from sim.robots.registry import ROBOTS
 
 COMBOS = [(c, r, mt) for c, s in CELLS.items() for r in s.robots for mt in s.mounts] + \

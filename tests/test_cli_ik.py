@@ -13,7 +13,7 @@ import pytest
 
 from sim.cli import main
 from sim.core.rotations import euler_zyx_to_matrix, matrix_to_euler_zyx
-from sim.robots.model import closed_form_model, kinematic_model
+from sim.robots.kinematics.model import closed_form_model, kinematic_model
 from sim.robots.registry import ROBOTS
 
 ALL_ROBOTS = sorted(ROBOTS)
@@ -157,7 +157,7 @@ def test_workspace_png_and_reach(capsys, tmp_path):
 
 
 def test_reach_definition_against_closed_form():
-    from sim.robots.workspace import compute_reach
+    from sim.robots.kinematics.workspace import compute_reach
 
     m = closed_form_model(ROBOTS["lrmate200ic5l"])
     m.lower = m.upper = None

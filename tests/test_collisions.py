@@ -158,7 +158,7 @@ def test_fold_strict_exits_1(fold_run, tmp_path):
 
 def _torch_samples(built, poses):
     """Samples of a static torch at each pose (frame 0, (4, 4)), one phase each."""
-    from sim.robots.ik import solve_ik
+    from sim.robots.kinematics.ik import solve_ik
     from sim.simulation.collisions import MotionSamples
 
     qs = []

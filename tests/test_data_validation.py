@@ -6,7 +6,7 @@ a robot folder (``robot.toml``: a DH table, a seeds' family, a URDF with ``[[lin
 URDF (origins, axes, limits, inertials), a motor and reducer catalogue, and a cell file's
 solids. The keys are taken from a valid file (so a key added to it is covered), each key's
 range from its reader (:func:`sim.core.tomlschema.quantity_at` for the TOML files,
-:data:`sim.robots.chain.URDF_QUANTITIES` for URDFs): a number without a declared range fails
+:data:`sim.robots.kinematics.chain.URDF_QUANTITIES` for URDFs): a number without a declared range fails
 :func:`test_every_numeric_key_of_the_valid_files_has_a_range`.
 
 1. A value that is no number (a TOML boolean, a string), not finite (``nan``, ``inf``, an
@@ -56,7 +56,7 @@ from sim.cells.cellfile import CellFileSpec, ObjectBlock, RobotBlock
 from sim.cli import main
 from sim.core.tomlschema import Quantity, format_loc, quantity_at
 from sim.errors import CatalogError
-from sim.robots.chain import URDF_QUANTITIES, URDF_ZERO_IS_NONE
+from sim.robots.kinematics.chain import URDF_QUANTITIES, URDF_ZERO_IS_NONE
 from sim.robots.robotfile import RobotFolderSpec
 
 MODELS = Path(__file__).resolve().parents[1] / "models"

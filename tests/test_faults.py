@@ -517,7 +517,7 @@ def _readers():
     from sim.cells import load_cell
     from sim.cells.meshes import read_mesh
     from sim.cells.toolfile import load_tool_file
-    from sim.robots.chain import chain_from_urdf
+    from sim.robots.kinematics.chain import chain_from_urdf
     from sim.robots.robotfile import load_robot_folder
     from sim.scenario import load_scenario
     from sim.scenario.fanuc_ls import read_ls

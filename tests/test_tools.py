@@ -18,8 +18,8 @@ from sim.cells.tools import (
     get_tool,
 )
 from sim.errors import UnknownNameError
-from sim.robots.closed_form import fk_5r, fk_fanuc6
 from sim.robots.families import Fanuc6, FiveR
+from sim.robots.kinematics.closed_form import fk_5r, fk_fanuc6
 from sim.robots.registry import ROBOTS, get_robot
 
 RNG = np.random.default_rng(7)

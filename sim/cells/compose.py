@@ -48,7 +48,7 @@ from sim.cells.tools import (
     build_tool,
 )
 from sim.errors import CellsimError
-from sim.robots.model import KinematicModel, kinematic_model
+from sim.robots.kinematics.model import KinematicModel, kinematic_model
 from sim.robots.registry import COULOMB_SPEED, RobotSpec
 
 if TYPE_CHECKING:  # MuJoCo and dm_control are imported where a model is made or compiled

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 from sim.cells.compose import Layout, RobotRig, compile_model
 from sim.cells.seam import Seam
 from sim.cells.tools import ToolSpec
-from sim.robots.model import KinematicModel
+from sim.robots.kinematics.model import KinematicModel
 from sim.robots.registry import RobotSpec
 
 if TYPE_CHECKING:  # for the annotations only: compose imports them where a model is made

@@ -31,7 +31,7 @@ on the floor; the robot hangs upside-down (turned 180 deg about the world x axis
 beam with its base plane at ``part height + D + h0``, J2 again ``D`` above the seam. Hanging,
 the seed's phase-I joint values would fold the arm *up* towards the beam, so they cannot end on
 the seam; the cell's ``start_q`` is then the analytic IK (seed 000 eq. 13-17,
-:func:`sim.robots.ik.solve_ik`) of the seam start with the same torch posture. The seam is
+:func:`sim.robots.kinematics.ik.solve_ik`) of the seam start with the same torch posture. The seam is
 laid out in frame 0 exactly as on the floor (start at q1 = -15.2 deg, running towards
 increasing q1); in world it therefore starts at +15.2 deg azimuth and runs clockwise.
 """
@@ -53,9 +53,9 @@ from sim.cells.compose import (
 )
 from sim.cells.seam import Seam
 from sim.errors import CellsimError
-from sim.robots.closed_form import fk_5r
-from sim.robots.ik import solve_ik
-from sim.robots.model import joint_limits
+from sim.robots.kinematics.closed_form import fk_5r
+from sim.robots.kinematics.ik import solve_ik
+from sim.robots.kinematics.model import joint_limits
 
 #: Seed 001 Table 1 / eq. (4): end of phase I, deg.
 PHASE1_END_DEG = (-15.2, 116.82, -1.3, 1.4, -0.206)

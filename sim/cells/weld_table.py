@@ -44,7 +44,7 @@ from sim.cells.compose import (
     new_world,
 )
 from sim.cells.seam import Seam
-from sim.robots.ik import solve_ik
+from sim.robots.kinematics.ik import solve_ik
 
 RISER = 0.6  #: robot riser height, m
 PLATE_TOP = -0.15  #: base plate top in frame 0, m

@@ -4,7 +4,7 @@ kinematics.
 Position in mm in the robot's ``frame0``; orientation of its ``tcp`` frame as Z-Y-X Euler
 angles in degrees, ``R = Rz(A) Ry(B) Rx(G)`` (seed 000 eq. 6); default: the tcp orientation at
 the home configuration (q = 0). Solutions are printed best first (inside the joint ranges,
-then closest to home; see :mod:`sim.robots.ik`), in degrees, only the best unless
+then closest to home; see :mod:`sim.robots.kinematics.ik`), in degrees, only the best unless
 ``--all``. For the 5-axis robots A is implied by the position: a disagreeing A is replaced
 (one note on stderr). A pose with no solution is one line on stderr and exit code 2, for every
 kind of robot (shipped, a robot folder, an arm as data with a closed form or the numeric
@@ -27,8 +27,8 @@ import numpy as np
 
 from sim.core.rotations import euler_zyx_to_matrix, make_transform
 from sim.errors import KinematicsError, UnreachableError
-from sim.robots.ik import solve_ik
-from sim.robots.model import kinematic_model
+from sim.robots.kinematics.ik import solve_ik
+from sim.robots.kinematics.model import kinematic_model
 from sim.robots.registry import resolve_robot
 
 

@@ -2,7 +2,7 @@
 
 Draws seed 004's (theta2, theta3) map with the singular curves of eq. (24)-(25) and the x-z
 section of the reachable wrist centre (5-axis robots: the equivalent map and the x-z section of
-wrist point and tcp), and prints the reach as defined in :mod:`sim.robots.workspace`:
+wrist point and tcp), and prints the reach as defined in :mod:`sim.robots.kinematics.workspace`:
 the largest distance from the J1 axis of the wrist centre, and of the tcp, within the ranges.
 """
 
@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 
 from sim.errors import CellsimError
-from sim.robots.model import kinematic_model
+from sim.robots.kinematics.model import kinematic_model
+from sim.robots.kinematics.workspace import plot_workspace
 from sim.robots.registry import get_robot
-from sim.robots.workspace import plot_workspace
 
 
 def register(sub: argparse._SubParsersAction) -> None:

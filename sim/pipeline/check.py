@@ -7,7 +7,7 @@ the Cartesian paths) and checks the reference motion for:
   planning stops there: nothing after it can be checked);
 * ``limit``: a joint past its range, speed or acceleration limit (:func:`limit_violations`);
 * ``singular``: a Cartesian phase passing near a singularity of the arm (the family's explicit
-  factors of ``det J``, :func:`sim.robots.jacobian.singularity_measures`, below
+  factors of ``det J``, :func:`sim.robots.kinematics.jacobian.singularity_measures`, below
   :data:`SINGULAR_LIMITS`), where the joint speeds a straight or circular tool path asks for
   grow without bound (a joint move through ``theta5 = 0`` is harmless and not reported);
 * ``collision``: a collision of the robot with itself, of the tool or the arm with the cell
@@ -97,7 +97,7 @@ def check_scenario(scenario: Scenario, *, dt: float = CHECK_DT_S) -> CheckResult
 
 def _singular_passes(built, motion: Motion, dt: float) -> list[Finding]:
     from sim.core.intervals import true_runs
-    from sim.robots.jacobian import singularity_measures
+    from sim.robots.kinematics.jacobian import singularity_measures
 
     t = np.arange(motion.t0, motion.t1 + 1e-12, dt)
     m = singularity_measures(built.context.kinematics, motion.at(t).q)

@@ -53,7 +53,7 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
         ScenarioError: A motion the TP form cannot hold (one line).
     """
     from sim.core.rotations import matrix_to_euler_zyx
-    from sim.robots.ik import solve_ik
+    from sim.robots.kinematics.ik import solve_ik
     from sim.robots.maker import to_maker
     from sim.scenario.program import CNT_SHARE, TP_WEAVE_PATTERNS, config_of
     from sim.simulation.compile import build

@@ -21,8 +21,5 @@ Owns (no module imports one that imports it back, directly or around a circle):
 * :mod:`~sim.robots.drives`: a scenario's ``[drives.jN]`` overrides applied to the defaults;
 * :mod:`~sim.robots.maker`: the maker's joint convention.
 
-The old flat paths (``sim.robots.chain``, ``sim.robots.ik``, ``sim.robots.generate``, ...) are
-the moved modules themselves (a three-line alias each) for the callers outside this layer.
-
 May import: planners, :mod:`sim.errors`, :mod:`sim.core`.
 """

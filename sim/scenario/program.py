@@ -45,7 +45,7 @@
 
 CONFIG: ``N``/``F`` the sign of the controller's J5 (``F``: J5 < 0), ``U``/``D`` the elbow up
 or down, ``T``/``B`` the wrist centre in front of J1 or behind (the branch labels of
-:mod:`sim.robots.ik`), and the turn numbers of J4, J5, J6 (the controller's joint value is its
+:mod:`sim.robots.kinematics.ik`), and the turn numbers of J4, J5, J6 (the controller's joint value is its
 value in (-180, 180] deg plus 360 deg times the turn number).
 """
 

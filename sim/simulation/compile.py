@@ -22,7 +22,7 @@ from sim.simulation.motion import CartesianContext
 
 if TYPE_CHECKING:  # sim.cells imports mujoco: the command line picks MUJOCO_GL first
     from sim.cells import Cell
-    from sim.robots.model import KinematicModel
+    from sim.robots.kinematics.model import KinematicModel
     from sim.robots.registry import Drive
 
 
@@ -77,7 +77,7 @@ def build(scenario: Scenario) -> BuiltCell:
 
     from sim.cells import build_cell
     from sim.cells.compose import FRICTION_PREFIX
-    from sim.robots.model import closed_form_model
+    from sim.robots.kinematics.model import closed_form_model
 
     cell = build_cell(scenario.cell, scenario.robot, tool=scenario.tool,
                       mount=scenario.mount, payload_kg=scenario.payload_kg)

@@ -417,12 +417,12 @@ def singularity_summary(arrays: dict[str, NDArray[Any]], motion: Motion, built: 
     """Closest approach of the reference to a singularity (sampled every 10 ms).
 
     ``min_sigma`` is the smallest singular value of the task Jacobian (0 at a singularity,
-    mixed units; :func:`sim.robots.jacobian.singularity_measures`), with its time and
+    mixed units; :func:`sim.robots.kinematics.jacobian.singularity_measures`), with its time and
     phase; ``min_abs_<factor>`` are the explicit factors of det J (200iC: ``wrist`` = sin
     theta5, ``elbow``, ``shoulder`` = wrist-centre distance from the J1 axis in m; 5R:
     ``elbow`` = cos q3, ``shoulder`` = reach in m).
     """
-    from sim.robots.jacobian import singularity_measures
+    from sim.robots.kinematics.jacobian import singularity_measures
 
     step = max(1, int(round(0.01 / dt)))
     t = arrays["t"][::step]

@@ -24,7 +24,7 @@ from sim.cells.compose import (
 from sim.cells.seam import Seam
 from sim.cells.tools import CONTACT_FIXTURE, CONTACT_PART_AFFINITY, CONTACT_PART_TYPE
 from sim.errors import CellError, CellsimError
-from sim.robots.ik import solve_ik
+from sim.robots.kinematics.ik import solve_ik
 
 
 def _friction(b: ObjectBlock) -> dict:

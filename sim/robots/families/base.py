@@ -207,7 +207,7 @@ class KinematicFamily(ABC):
     def reach(self) -> float:
         """Upper bound of the wrist's distance from frame 0: the sum of the link lengths, m.
 
-        (:func:`sim.robots.workspace.compute_reach` finds the reach inside the joint ranges.)
+        (:func:`sim.robots.kinematics.workspace.compute_reach` finds the reach inside the joint ranges.)
         """
 
     # ------------------------------------------------------------------ tcp frame

@@ -90,7 +90,7 @@ class ChainFamily(KinematicFamily):
         otherwise None (the global search decides)."""
         if self.arm.solver != "numeric":
             return None
-        from sim.robots.numeric_ik import solve_one
+        from sim.robots.kinematics.numeric_ik import solve_one
 
         cur = np.asarray(current, dtype=float)
         q, err = solve_one(self.arm.chain, self._flange(T), cur)

@@ -2,7 +2,7 @@
 
 Seed 004 Table 1 modified DH (Khalil-Dombre) with dimensions ``d2, d3, d4, R4, R6``; the tool
 frame E is frame 6 moved ``R6 + r`` along z6 (``r`` the tool length), identical to seed 004
-eq. (6)-(7) (:func:`sim.robots.closed_form.fk_fanuc6`). The approach axis is ``a = z6``.
+eq. (6)-(7) (:func:`sim.robots.kinematics.closed_form.fk_fanuc6`). The approach axis is ``a = z6``.
 
 Inverse kinematics: Pieper's method (seed 004 eq. 9-18) on the wrist centre
 ``w = p - (R6 + r) a`` (the seed's eq. 9-10 mix R6 into the position equations; we subtract it
@@ -18,7 +18,7 @@ Singularities (seed 004 eq. 22-25): ``det J = -d3 * (R4 c3 - d4 s3) * rho_w * s5
 ``rho_w = d2 - d3 s2 + R4 c23 - d4 s23`` is the signed distance of the wrist centre from the J1
 axis. Wrist: ``s5`` (eq. 23), elbow: ``R4 c3 - d4 s3`` (eq. 24, zero at
 ``theta3 = atan2(R4, d4)`` and that +pi), shoulder: ``rho_w`` (eq. 25; as printed, eq. 25 has
-theta2 of the opposite sign, see :mod:`sim.robots.jacobian`).
+theta2 of the opposite sign, see :mod:`sim.robots.kinematics.jacobian`).
 """
 
 from __future__ import annotations
@@ -32,8 +32,8 @@ from numpy.typing import NDArray
 
 from sim.core.rotations import rot_x, rot_y, rot_z
 from sim.errors import SingularityWarning, UnreachableError
-from sim.robots.closed_form import fk_fanuc6
 from sim.robots.families.base import KinematicFamily, annulus_gap
+from sim.robots.kinematics.closed_form import fk_fanuc6
 
 #: |sin theta5| or distance of the wrist centre from the J1 axis (m) below which the pose is
 #: singular.
@@ -41,7 +41,7 @@ SINGULAR_TOL = 1e-9
 
 
 def _mdh_batch(alpha: float, d: float, theta: NDArray[np.float64], r: float) -> NDArray[np.float64]:
-    """Vectorized :func:`sim.robots.closed_form.mdh_transform` over ``theta`` (N,): (N, 4, 4)."""
+    """Vectorized :func:`sim.robots.kinematics.closed_form.mdh_transform` over ``theta`` (N,): (N, 4, 4)."""
     T = np.zeros(theta.shape + (4, 4))
     ca, sa = np.cos(alpha), np.sin(alpha)
     ct, st = np.cos(theta), np.sin(theta)

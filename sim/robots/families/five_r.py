@@ -1,7 +1,7 @@
 """The 5R family (FANUC LR Mate 100iB, the 5R welding robot): seed 000.
 
 Seed 000 Table 1 screw axes, product of exponentials (identical to seed 000 eq. 5,
-:func:`sim.robots.closed_form.fk_5r`); dimensions ``l1, d1, l2, l3`` (l3 = J4 axis to the tool
+:func:`sim.robots.kinematics.closed_form.fk_5r`); dimensions ``l1, d1, l2, l3`` (l3 = J4 axis to the tool
 point). The seed tool frame's x axis is the approach axis (the torch axis).
 
 Inverse kinematics: seed 000 eq. (13)-(17), with eq. (14) derived again (it is garbled as
@@ -45,8 +45,8 @@ from sim.core.rotations import (
     wrap_to_pi,
 )
 from sim.errors import KinematicsError, SingularityWarning, UnreachableError
-from sim.robots.closed_form import fk_5r
 from sim.robots.families.base import KinematicFamily, annulus_gap
+from sim.robots.kinematics.closed_form import fk_5r
 
 #: Distance from the J1 axis (m) below which the pose is singular.
 SINGULAR_TOL = 1e-9

@@ -339,8 +339,8 @@ def _wrist_roll(plan: _BlendedPlan, geo: _BlendGeometry, of: list[int], t0: floa
     joint out of its range). Returns the first such leg's new roll (move index -> rad), or
     nothing."""
     from planners.blend import CornerOrientation
-    from sim.robots.ik import ik_path
-    from sim.robots.jacobian import singularity_measures
+    from sim.robots.kinematics.ik import ik_path
+    from sim.robots.kinematics.jacobian import singularity_measures
     from sim.simulation.seam_orientation import SeamOrientation
 
     kin = ctx.kinematics

@@ -137,7 +137,7 @@ def _check_end_config(pm: PhaseMotion, ctx: CartesianContext, label: str) -> Non
     phase = pm.phase
     if not isinstance(phase, CartesianPhase) or phase.config is None:
         return
-    from sim.robots.ik import solve_ik
+    from sim.robots.kinematics.ik import solve_ik
     from sim.scenario.program import config_of
 
     q_end = np.asarray(pm.trajectory.at(pm.t1).q, dtype=float)

@@ -20,7 +20,7 @@ class CartesianContext:
     """What Cartesian phases need from the cell and the robot.
 
     Attributes:
-        kinematics: A :class:`sim.robots.model.KinematicModel` of the robot with its tool
+        kinematics: A :class:`sim.robots.kinematics.model.KinematicModel` of the robot with its tool
             (``fk(q)`` gives the tcp pose in frame 0; used by ``ik_path``).
         seams: Cell seams by name (world frame).
         world_from_frame0: Pose of frame 0 in the world, (4, 4).

@@ -101,8 +101,8 @@ def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | 
 def _solve_target(phase: JointPhase, q0: NDArray[np.float64], ctx: CartesianContext,
                   label: str) -> NDArray[np.float64]:
     """Joint values of a joint phase's pose target: the in-limits IK solution closest to
-    the phase's start (weighted by joint speed limits, see ``sim.robots.ik``)."""
-    from sim.robots.ik import solve_ik
+    the phase's start (weighted by joint speed limits, see ``sim.robots.kinematics.ik``)."""
+    from sim.robots.kinematics.ik import solve_ik
 
     tgt = phase.target
     assert tgt is not None

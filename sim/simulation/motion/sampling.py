@@ -112,7 +112,7 @@ def _ik_knots(kin: Any, ts: NDArray[np.float64], poses: NDArray[np.float64],
             runs into a joint's range, and another takes over): the error names the joint,
             the time and the jump.
     """
-    from sim.robots.ik import ik_path
+    from sim.robots.kinematics.ik import ik_path
 
     try:
         q_via = np.asarray(ik_path(kin, poses, q_start=q0), dtype=float)

@@ -1,8 +1,0 @@
-"""Old import path of :mod:`sim.robots.kinematics.closed_form`, kept for the callers outside
-:mod:`sim.robots`: this name is that very module (new code imports it from its package)."""
-
-import sys
-
-from sim.robots.kinematics import closed_form
-
-sys.modules[__name__] = closed_form
