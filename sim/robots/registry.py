@@ -3,7 +3,7 @@
 A robot is a folder under ``models/``: its MJCF, ``scene.xml``, a README deriving each number
 and a ``robot.toml`` with what the code needs (:mod:`sim.robots.robotfile`: kinematic family and
 dimensions, speed and acceleration limits, drive trains, payload, the maker's joint convention);
-:data:`ROBOTS` is built by scanning those folders, and :func:`resolve_robot` also takes a folder
+:data:`ROBOTS` is built by scanning those folders on first use, and :func:`resolve_robot` also takes a folder
 of one's own. Joint position ranges live in the MJCF files (single source of truth, read back
 with :func:`joint_ranges`). Sources of every number: the README of each model folder and
 ``../shared/reference/robots.md``.
@@ -18,9 +18,11 @@ drive constants under their old path.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 from planners.registry import Registry
+from sim.core.registry import LazyRegistry
 from sim.core.resources import models_dir
 from sim.errors import KinematicsError
 from sim.robots.drive import (
@@ -34,14 +36,12 @@ from sim.robots.robotfile import load_robot_folder, load_urdf_robot
 from sim.robots.spec import RobotSpec, joint_ranges
 
 
-def _shipped_robots() -> Registry[RobotSpec]:
+def _shipped_robots() -> Iterator[tuple[str, RobotSpec]]:
     """The robot folders of ``models/``, each with a ``robot.toml``
     (:mod:`sim.robots.robotfile`)."""
-    reg: Registry[RobotSpec] = Registry("robot")
     for path in sorted(models_dir().glob("*/robot.toml")):
         spec = load_robot_folder(path.parent)
-        reg.add(spec.name, spec)
-    return reg
+        yield spec.name, spec
 
 
 def get_robot(name: str) -> RobotSpec:
@@ -74,8 +74,9 @@ def resolve_robot(ref: str, base: Path | None = None) -> RobotSpec:
     return ROBOTS.get(ref)
 
 
-#: The shipped robots by name, read from ``models/*/robot.toml``.
-ROBOTS: Registry[RobotSpec] = _shipped_robots()
+#: The shipped robots by name, read from ``models/*/robot.toml`` the first time it is looked
+#: into (importing this module reads no file).
+ROBOTS: Registry[RobotSpec] = LazyRegistry("robot", _shipped_robots)
 
 
 __all__ = ["COULOMB_SPEED", "PEAK_KNEE_FRACTION", "ROBOTS", "RPM_PER_RAD_S", "Drive", "RobotSpec",
