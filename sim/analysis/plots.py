@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from sim.core.intervals import true_runs
-from sim.errors import UsageError
+from sim.errors import RunFolderError, UsageError
 from sim.simulation.runfolder import PLOTS_DIR, REQUIRED_FOR_PLOTS, RunRecord, as_record
 
 #: Resolution of the PNG files, dots per inch.
@@ -277,8 +277,6 @@ def check_plots_dir(out: Path) -> None:
         RunFolderError: One line naming it.
     """
     if Path(out).is_symlink():
-        from sim.errors import RunFolderError
-
         raise RunFolderError(f"{out}: is a symbolic link; cellsim writes plots only into a real "
                              "folder (remove the link)")
 
