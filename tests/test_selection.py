@@ -365,16 +365,44 @@ def test_starter_catalogue_cites_sources_and_has_plausible_units():
         else:
             assert "http" in e.spec.source and re.search(r"\b(p\.|page|table)", e.spec.source), e.id
     # the makers' selection procedures: strain-wave gears with their limits for average torque
-    # (between the rated and the repeated peak torque) and average input speed, life exponent
-    # 3; RV reducers with Nabtesco's 10/3
+    # (between the rated and the repeated peak torque) and average input speed (the life
+    # exponents: test_reducer_life_is_the_makers_formula_for_every_catalogue_reducer)
     for r in cat.reducers:
         s = r.spec
         if r.id.startswith("hd-"):
             assert s.rated_torque_nm <= s.average_torque_limit_nm <= s.repeated_peak_torque_nm
             assert 1000 <= s.max_average_input_speed_rpm <= s.max_input_speed_rpm, r.id
-            assert s.life_exponent == 3.0, r.id
-        else:
-            assert s.life_exponent == pytest.approx(10 / 3), r.id
+
+
+#: The torque exponent of each maker's L10 life formula: Harmonic Drive (strain-wave gears) 3,
+#: Nabtesco (RV) 10/3.
+MAKER_LIFE_EXPONENT = {"hd-": 3.0, "nabtesco-": 10.0 / 3.0}
+
+
+def test_reducer_life_is_the_makers_formula_for_every_catalogue_reducer():
+    """The reducer life of a constant duty (output torque T, output speed w, no dwell) against
+    the maker's formula written here, ``L10 = L_rated (T_rated / T)^k (n_rated / n)`` with
+    ``n = N w`` the input speed and ``k`` the maker's exponent: a reducer whose exponent were
+    left at a default that is not its maker's (the strain-wave default 3 on an RV reducer),
+    or a life formula with the ratio missing, fails. (It replaces a check that the strain-wave
+    entries' exponent equals 3.0, which is the schema's default for every entry that gives
+    none: it restated the code.)"""
+    from sim.analysis.selection import _source, check_pair
+
+    cat = load_catalog(starter_catalog())
+    t = np.linspace(0.0, 2.0, 201)
+    w = 0.5  # rad/s at the output
+    for reducer in cat.reducers:
+        r = reducer.spec
+        k = next(e for prefix, e in MAKER_LIFE_EXPONENT.items() if reducer.id.startswith(prefix))
+        T = 0.5 * r.rated_torque_nm
+        src = _source("id", t, np.full(t.size, T), np.full(t.size, w), np.zeros(t.size), 0.0)
+        pair = check_pair([src], cat.motors[0], reducer, SelectionOptions(catalog=cat), 2.0, 0.0)
+        life = next(c.value for c in pair.checks if c.name == "reducer_life")
+        n_in_rpm = r.ratio * w * 60.0 / (2.0 * math.pi)
+        expected = r.rated_life_h * (r.rated_torque_nm / T) ** k * (r.rated_input_speed_rpm
+                                                                      / n_in_rpm)
+        assert life == pytest.approx(expected, rel=1e-9), reducer.id
 
 
 @pytest.mark.parametrize("shape", ["full", "never_brakes", "only_torque", "at_rest"])
