@@ -38,6 +38,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from planners.base import sample_times
 from planners.errors import InvalidMoveError
+from planners.profiles import quintic_smoothstep
 
 #: The patterns, in the order the docs list them.
 PATTERNS = ("sine", "zigzag", "triangle", "circle")
@@ -115,11 +116,6 @@ class Weave:
         return np.unique(t[(t > 0.0) & (t < duration)])
 
 
-def _smoothstep(x: NDArray[np.float64]) -> NDArray[np.float64]:
-    x = np.clip(x, 0.0, 1.0)
-    return x * x * x * (10.0 - 15.0 * x + 6.0 * x * x)
-
-
 class WeavingTrajectory:
     """A Cartesian move with a weave on top (module docstring).
 
@@ -189,8 +185,8 @@ class WeavingTrajectory:
         on through)."""
         t = np.asarray(t, dtype=float)
         T = self.duration
-        e = _smoothstep(t / self.fade_in) if self.fade_in > 0 else np.ones_like(t)
-        return e * (_smoothstep((T - t) / self.fade_out) if self.fade_out > 0 else 1.0)
+        e = quintic_smoothstep(t / self.fade_in)[0] if self.fade_in > 0 else np.ones_like(t)
+        return e * (quintic_smoothstep((T - t) / self.fade_out)[0] if self.fade_out > 0 else 1.0)
 
     def travel_direction(self, t: ArrayLike) -> NDArray[np.float64]:
         """The unit tangent of the base path at times ``t``, (..., 3): the direction of travel
