@@ -2,8 +2,8 @@
 
 Owns :class:`ProgrammedMove` (end pose, via pose, speed, blend), a planned move as its
 programmed moves (:func:`_programmed`: an arc of more than 170 deg in pieces), a blended
-polyline's legs and corner-zone points (:func:`_programmed_legs`), and the TP blend share
-:data:`CNT_SHARE`.
+polyline's legs and corner-zone points (:func:`_programmed_legs`); the TP blend share
+:data:`~sim.scenario.program.CNT_SHARE` is the program reader's.
 """
 
 from __future__ import annotations
@@ -13,6 +13,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from sim.scenario.program import CNT_SHARE
 
 
 @dataclass(frozen=True)
@@ -55,8 +57,6 @@ def _programmed(cart: Any, kind: str, speed: float, blend: float = 0.0,
     return out
 
 
-#: A TP program's CNT100 blends over this share of the shorter of the two moves.
-CNT_SHARE = 0.45
 #: An exported polyline's points where its corner zones begin and end blend over this share
 #: of the shorter adjacent move (CNT20: the rounding stays near the zone's ends).
 ZONE_POINT_CNT = 0.2
