@@ -139,12 +139,10 @@ def _independent(traj, model, k: int, motor: dict, reducer: dict) -> dict[str, b
                             (traj["tau"][:, k], traj["qd"][:, k], traj["qdd"][:, k],
                              PEAK_WINDOW_S)):
         tau_l = tau - arm * qdd
-        tau_m = np.empty_like(tau_l)
-        for i in range(t.size):  # per sample, as the issue writes it
-            if tau_l[i] * qd[i] >= 0 or abs(qd[i]) < 1e-3:  # standstill: the motor drives
-                tau_m[i] = tau_l[i] / (N * eta) + J * N * qdd[i]
-            else:
-                tau_m[i] = tau_l[i] * eta / N + J * N * qdd[i]
+        # per sample, as the issue writes it: motoring (or standstill, where the motor
+        # drives) divides by the efficiency, power flowing back multiplies by it
+        motoring = (tau_l * qd >= 0) | (np.abs(qd) < 1e-3)
+        tau_m = np.where(motoring, tau_l / (N * eta), tau_l * eta / N) + J * N * qdd
         hold = tau_l[-1] / (N * eta)
         cycle = t[-1] - t[0]
         duty = cycle + DWELL_S
