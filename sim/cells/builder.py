@@ -69,7 +69,7 @@ def _check_tool(cell: CellSpec, tool: ToolSpec | None) -> None:
         return
     if cell.any_tool or cell is BARE:
         return
-    if tool.source is not None:  # a tool file: any tool of the kind the cell works with
+    if not tool.shipped:  # a tool file of its own: any tool of the kind the cell works with
         kinds = sorted({t.kind for t in cell.tools})
         if tool.kind not in kinds:
             raise CellError(f"cell {cell.name!r} works with a {' or '.join(kinds)}; tool "

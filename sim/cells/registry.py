@@ -24,25 +24,29 @@ from sim.core.resources import models_dir
 from sim.errors import CellError, CellsimError, UnknownNameError
 from sim.robots.registry import ROBOTS
 
-_TORCHES = (TOOLS["mig_torch"], TOOLS["mig_torch_long"])
-
 #: The Python derivations of the shipped cells: each module (``weld_cylinder``, ``weld_table``,
 #: ``pick``) derives its cell's numbers; ``models/cells/generate.py`` writes them as the cell
-#: files cellsim reads (:data:`CELLS`), and a test keeps the two in step.
-DERIVED: Registry[CellSpec] = Registry("cell")
-for _spec in (
-    CellSpec("weld_cylinder",
-             "5R welding of a large cylinder coaxial with J1 (seed 001); floor or ceiling",
-             ("robot_5r",), TOOLS["mig_torch_long"], (TOOLS["mig_torch_long"],),
-             ("floor", "ceiling"), weld_cylinder.build),
-    CellSpec("weld_table", "welding table: a 1F fillet line and a 2F fillet arc",
-             ("lrmate100ib", "lrmate200ic5l"), TOOLS["mig_torch"], _TORCHES, ("floor",),
-             weld_table.build),
-    CellSpec("pick", "vacuum pick-and-place of 4 boxes from an infeed table to a tray",
-             ("lrmate200ic5l",), TOOLS["vacuum_gripper"], (TOOLS["vacuum_gripper"],), ("floor",),
-             pick.build),
-):
-    DERIVED.add(_spec.name, _spec)
+#: files cellsim reads (:data:`CELLS`), and a test keeps the two in step (read on first use:
+#: they name the shipped tools, read from their files).
+def _derived() -> Iterator[tuple[str, CellSpec]]:
+    """The derived cells, in order."""
+    torches = (TOOLS["mig_torch"], TOOLS["mig_torch_long"])
+    for spec in (
+        CellSpec("weld_cylinder",
+                 "5R welding of a large cylinder coaxial with J1 (seed 001); floor or ceiling",
+                 ("robot_5r",), TOOLS["mig_torch_long"], (TOOLS["mig_torch_long"],),
+                 ("floor", "ceiling"), weld_cylinder.build),
+        CellSpec("weld_table", "welding table: a 1F fillet line and a 2F fillet arc",
+                 ("lrmate100ib", "lrmate200ic5l"), TOOLS["mig_torch"], torches, ("floor",),
+                 weld_table.build),
+        CellSpec("pick", "vacuum pick-and-place of 4 boxes from an infeed table to a tray",
+                 ("lrmate200ic5l",), TOOLS["vacuum_gripper"], (TOOLS["vacuum_gripper"],),
+                 ("floor",), pick.build),
+    ):
+        yield spec.name, spec
+
+
+DERIVED: Registry[CellSpec] = LazyRegistry("cell", _derived)
 
 
 def cells_dir() -> Path:
