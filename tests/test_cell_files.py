@@ -554,13 +554,13 @@ def test_format_reference_documents_every_key():
         SeamBlock,
         SlotBlock,
     )
-    from sim.cells.toolfile import ShapeSpec, ToolFileSpec
+    from sim.cells.toolfile import ShapeSpec, SuctionSpec, ToolFileSpec
 
     doc = (Path(__file__).resolve().parents[1] / "docs" / "cell-format.md").read_text()
     table_keys = set(re.findall(r"^\| `([a-z][a-z0-9_]*)`", doc, flags=re.M))
     declared = set()
     for model in (CellFileSpec, RobotBlock, ObjectBlock, SeamBlock, SlotBlock, CameraBlock,
-                  ToolFileSpec, ShapeSpec):
+                  ToolFileSpec, ShapeSpec, SuctionSpec):
         for key in model.model_fields:
             assert key in table_keys, f"{model.__name__}.{key} is not documented"
             declared.add(key)

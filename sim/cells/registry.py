@@ -24,12 +24,10 @@ from sim.core.resources import models_dir
 from sim.errors import CellError, CellsimError, UnknownNameError
 from sim.robots.registry import ROBOTS
 
-#: The Python derivations of the shipped cells: each module (``weld_cylinder``, ``weld_table``,
-#: ``pick``) derives its cell's numbers; ``models/cells/generate.py`` writes them as the cell
-#: files cellsim reads (:data:`CELLS`), and a test keeps the two in step (read on first use:
-#: they name the shipped tools, read from their files).
+
 def _derived() -> Iterator[tuple[str, CellSpec]]:
-    """The derived cells, in order."""
+    """The derived cells, in order (read on first use: they name the shipped tools, read from
+    their files)."""
     torches = (TOOLS["mig_torch"], TOOLS["mig_torch_long"])
     for spec in (
         CellSpec("weld_cylinder",
@@ -46,6 +44,9 @@ def _derived() -> Iterator[tuple[str, CellSpec]]:
         yield spec.name, spec
 
 
+#: The Python derivations of the shipped cells: each module (``weld_cylinder``, ``weld_table``,
+#: ``pick``) derives its cell's numbers; ``models/cells/generate.py`` writes them as the cell
+#: files cellsim reads (:data:`CELLS`), and a test keeps the two in step.
 DERIVED: Registry[CellSpec] = LazyRegistry("cell", _derived)
 
 

@@ -35,7 +35,8 @@ that pulls a part at the lip's contacts (:mod:`sim.cells.toolspec` names them).
 Lengths: a value in mm is read as the metre value it names (``v / 1000``, correctly rounded), so
 a file in mm gives the same model as a builder writing metres. A cylinder or capsule along the
 tool axis (``from_mm`` and ``to_mm`` on it, ``to_mm`` further out) is written as MuJoCo's
-``pos`` and ``size`` (what MuJoCo makes of its ``fromto``, computed here).
+``pos`` and ``size``: the solid MuJoCo makes of its ``fromto``, in the tool's frame (MuJoCo's
+``fromto`` turns the geom half a turn about x).
 
 The shipped tools are tool files too (``models/tools``, :mod:`sim.cells.tools`).
 """
@@ -84,6 +85,11 @@ IMPEDANCE = Quantity("a contact impedance", "", 1e-4, 0.9999)
 WIDTH_M = Quantity("a contact impedance width", "m", 1e-6, 1.0)
 MIDPOINT = Quantity("a contact impedance midpoint", "", 1e-4, 0.9999)
 POWER = Quantity("a contact impedance power", "", 1.0, 100.0)
+ShapeMass = SHAPE_MASS_KG.type
+Adhesion = ADHESION_N.type
+LipRadius = LIP_RADIUS_MM.type
+RingRadius = RING_RADIUS_MM.type
+Gap = GAP_MM.type
 
 
 def _m(mm: float) -> float:
@@ -103,20 +109,20 @@ class ShapeSpec(Strict):
     pos_mm: list[Mm] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
     euler_zyx_deg: list[float] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
     color: list[float] | None = Field(None, min_length=3, max_length=4)
-    mass_kg: SHAPE_MASS_KG.type | None = None  # type: ignore[valid-type]
+    mass_kg: ShapeMass | None = None
     group: int | None = Field(None, ge=0, le=5)
 
 
 class SuctionSpec(Strict):
     """A gripper's suction cup: its body's shapes, the ring of lip spheres, the adhesion."""
 
-    gain_n: ADHESION_N.type  # type: ignore[valid-type]
+    gain_n: Adhesion
     lip_count: int = Field(8, ge=3, le=64)
-    lip_radius_mm: LIP_RADIUS_MM.type = 3.0  # type: ignore[valid-type]
-    lip_ring_radius_mm: RING_RADIUS_MM.type = 17.0  # type: ignore[valid-type]
-    lip_mass_kg: SHAPE_MASS_KG.type | None = None  # type: ignore[valid-type]
+    lip_radius_mm: LipRadius = 3.0
+    lip_ring_radius_mm: RingRadius = 17.0
+    lip_mass_kg: ShapeMass | None = None
     lip_color: list[float] = Field([0.1, 0.1, 0.1], min_length=3, max_length=4)
-    gap_mm: GAP_MM.type = 3.0  # type: ignore[valid-type]
+    gap_mm: Gap = 3.0
     friction: list[Real] = Field([1.0, 0.005, 0.0001], min_length=3, max_length=3)
     solref: list[Real] = Field([0.002, 1.0], min_length=2, max_length=2)
     solimp: list[Real] = Field([0.95, 0.99, 0.001, 0.5, 2.0], min_length=5, max_length=5)
@@ -385,6 +391,7 @@ def load_tool_file(path: str | Path, *, shipped: bool = False) -> ToolSpec:
     if straight and X[2, 3] <= 0:
         raise CellError(f"{where}: tcp_mm: the tool centre point must lie beyond the flange face")
     wire_from = X[:3, 3] - _m(spec.stickout_mm) * X[:3, 2]
+    payload: float | None
     if suction is not None:
         work: tuple[str, ...] = tuple(f"lip{k}" for k in range(suction.lip_count))
         payload = spec.max_payload_kg or suction.gain_n / (GRAVITY * SUCTION_SAFETY)
