@@ -94,9 +94,10 @@ def _shipped_cells() -> Iterator[tuple[str, CellSpec]]:
 #: The shipped cells by name, read from ``models/cells/*.toml`` on first use.
 CELLS: Registry[CellSpec] = LazyRegistry("cell", _shipped_cells)
 
-#: The bare scene's entry (``cell=None``): every robot, any tool or none, both mounts.
-BARE = CellSpec("bare", "the robot alone: floor, lights, cameras", tuple(ROBOTS), None,
-                tuple(TOOLS.values()), MOUNTS, bare.build, needs_tool=False, any_robot=True)
+#: The bare scene's entry (``cell=None``): any robot, any tool or none, both mounts (no list
+#: of them: naming the registries' entries here would read every robot and tool on import).
+BARE = CellSpec("bare", "the robot alone: floor, lights, cameras", (), None, (), MOUNTS,
+                bare.build, needs_tool=False, any_tool=True, any_robot=True)
 
 
 def is_file_ref(ref: str) -> bool:
