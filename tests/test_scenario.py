@@ -18,6 +18,7 @@ from sim.scenario import (
     ActionSpec,
     CircularPhaseSpec,
     DriveOverrideSpec,
+    ExpectSpec,
     HoldPhaseSpec,
     JointPhaseSpec,
     LinearPhaseSpec,
@@ -250,7 +251,8 @@ def test_format_reference_documents_every_key():
     doc = DOC.read_text()
     documented = set(re.findall(r"`([a-z][a-z0-9_]*)`", doc))
     models = (ScenarioSpec, JointPhaseSpec, LinearPhaseSpec, CircularPhaseSpec, HoldPhaseSpec,
-              ActionSpec, SimulationSpec, VideoSpec, DriveOverrideSpec, SizingSpec, WeaveSpec)
+              ActionSpec, SimulationSpec, VideoSpec, DriveOverrideSpec, SizingSpec, WeaveSpec,
+              ExpectSpec)
     declared = set()
     for model in models:
         for key in model.model_fields:
@@ -343,6 +345,32 @@ def test_action_errors(extra, fragment):
     text = CYCLE.replace("[drives.j2]", extra + "\n[drives.j2]")
     msg = _err(text)
     assert fragment in msg, msg
+
+
+@pytest.mark.parametrize("table, key, fragment", [
+    ('verdict = "fail"\nfailed_checks = ["speed j2"]', "expect.reason", "say why"),
+    ('verdict = "fail"\nreason = "r"', "expect.failed_checks", "name the checks"),
+    ('failed_checks = ["speed j2"]\nreason = "r"', "expect.verdict", 'verdict = "fail"'),
+    ('check_findings = ["limit"]', "expect.reason", "say why"),
+    ('check_findings = ["limits"]\nreason = "r"', "expect.check_findings[0]", "'limit'"),
+    ('failed_checks = ["speed"]\nverdict = "fail"\nreason = "r"', "expect.failed_checks[0]",
+     "pattern"),
+    ('verdict = "failed"', "expect.verdict", "'pass' or 'fail'"),
+    ('verdikt = "fail"', "expect.verdikt", "did you mean 'verdict'"),
+])
+def test_expect_errors_name_the_key(table, key, fragment):
+    """[expect] is consistent: a failure names its checks and its reason (one line, the key)."""
+    msg = _err(GOOD.replace("[[phases]]", f"[expect]\n{table}\n\n[[phases]]", 1))
+    assert f" {key}:" in msg, msg
+    assert fragment in msg, msg
+
+
+def test_expect_defaults_to_a_passing_run_and_is_carried_on_the_scenario():
+    assert parse_scenario(GOOD).expect == ExpectSpec(verdict="pass")
+    sc = parse_scenario(GOOD.replace("[[phases]]", '[expect]\nverdict = "fail"\nfailed_checks = '
+                                     '["speed j2"]\nreason = "as published"\n\n[[phases]]', 1))
+    assert (sc.expect.verdict, sc.expect.failed_checks, sc.expect.reason) == (
+        "fail", ["speed j2"], "as published")
 
 
 def test_action_unknown_phase_suggests():

@@ -231,16 +231,40 @@ def test_an_overloaded_robot_saturates_sags_and_fails(tmp_path, capsys):
 
 @pytest.mark.parametrize("name", SCENARIOS)
 def test_shipped_scenarios_pass_unless_they_document_an_excess(name, scenario_run):
-    """Every shipped scenario's verdict passes, except seed 000's sequence, which documents that
-    J2 goes past its speed (and acceleration) limit: its failed checks are exactly J2's."""
+    """Every shipped scenario's run gives the verdict its [expect] table declares: a pass,
+    unless it documents an excess with a reason (seed 000's sequence: J2 past its speed and
+    acceleration limits), and then its failed checks are exactly the ones it names."""
+    expect = load_scenario(name).expect
     _, summary = scenario_run(name)
-    failed = sorted((c["name"], c["joint"]) for c in summary["checks"] if not c["pass"])
-    if name == "kacso_lrmate100ib_sequence1":
-        assert summary["verdict"] == "fail"
-        assert failed == [("acceleration", "j2"), ("motor_speed", "j2"), ("speed", "j2")]
-    else:
-        assert summary["verdict"] == "pass", failed
+    failed = sorted(f"{c['name']} {c.get('subject') or c['joint']}" for c in summary["checks"]
+                    if not c["pass"] and c.get("severity", "error") == "error")
+    assert summary["verdict"] == expect.verdict, failed
+    assert failed == sorted(expect.failed_checks)
+    if expect.verdict == "pass":
         assert summary["saturation"] == []
+
+
+def test_a_declared_failure_is_one_line_after_the_verdict_and_changes_no_exit_code(tmp_path,
+                                                                                   capsys):
+    """[expect] changes nothing but one line: seed 000's sequence still fails its verdict and
+    `--strict` exits 1; `cellsim run` says after the verdict that the scenario declares it, and
+    why. The same file without its [expect] gets a line saying the verdict is not the declared
+    one."""
+    import re
+
+    args = ["--no-video", "--no-plots", "--quiet", "--strict"]
+    name = "kacso_lrmate100ib_sequence1"
+    assert main(["run", name, "--out", str(tmp_path / "a"), *args]) == 1
+    out = capsys.readouterr().out
+    assert re.search(r"verdict: FAIL.*\n(    .*\n)*  expected: the scenario declares this "
+                     r"failure \(\[expect\]\): Seed 000's sequence .* 7140 rpm", out), out
+    text = re.sub(r"\[expect\].*?\n(?=\[\[phases\]\])", "", load_scenario(name).text,
+                  count=1, flags=re.S)
+    assert "[expect]" not in text and "[[phases]]" in text
+    (tmp_path / "s.toml").write_text(text)
+    assert main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "b"), *args]) == 1
+    out = capsys.readouterr().out
+    assert "  unexpected: the scenario declares verdict 'pass' ([expect])\n" in out, out
 
 
 def test_simulated_friction_is_the_coulomb_law_of_tau_id():

@@ -14,13 +14,19 @@ or a sizing limit, or collides (the robot with itself, the tool or the arm with 
 part with the cell: :mod:`sim.simulation.collisions`); the failed checks and the collisions are
 printed, and a phase closer to the cell than ``simulation.clearance_mm`` is a warning. Exit codes: 0 when the run was simulated
 (whatever its verdict), 1 with ``--strict`` when the verdict is fail, 2 for a mistake in the
-input.
+input. A scenario whose ``[expect]`` table declares a failure (a published motion past the robot's
+limits, say) gets one line after the verdict saying so and why; its verdict and exit code are
+those of any failed run.
 """
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from sim.scenario.schema import ExpectSpec
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -142,6 +148,9 @@ def run(args: argparse.Namespace) -> int:
                   f"{c['unit']} against the limit {c['limit']:.4g} {c['unit']}")
     else:
         print(f"  verdict: pass ({len(checks)} checks, {len(warned)} warning(s))")
+    expected = _expectation(scenario.expect, summary.get("verdict"))
+    if expected:
+        print(f"  {expected}")
     timings = summary.get("timings_s", {})
     if timings:
         from sim.pipeline.stages import timings_line
@@ -149,3 +158,15 @@ def run(args: argparse.Namespace) -> int:
         print("  " + timings_line(timings, summary.get("total_wall_s", sum(timings.values()))))
     print(f"  results in {out}/")
     return 1 if args.strict and summary.get("verdict") == "fail" else 0
+
+
+def _expectation(expect: ExpectSpec, verdict: str | None) -> str | None:
+    """One line on the scenario's declared ``[expect]`` verdict when it expects a failure or
+    the run does not give the declared verdict (None otherwise); it changes nothing."""
+    reason = " ".join((expect.reason or "").split())
+    if expect.verdict == "fail" and verdict == "fail":
+        return f"expected: the scenario declares this failure ([expect]): {reason}"
+    if expect.verdict != verdict:
+        return (f"unexpected: the scenario declares verdict {expect.verdict!r} ([expect])"
+                + (f": {reason}" if reason else ""))
+    return None

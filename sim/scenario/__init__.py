@@ -25,6 +25,7 @@ from sim.scenario.schema import (
     ActionSpec,
     CircularPhaseSpec,
     DriveOverrideSpec,
+    ExpectSpec,
     HoldPhaseSpec,
     JointPhaseSpec,
     LinearPhaseSpec,
@@ -37,7 +38,8 @@ from sim.scenario.schema import (
 
 __all__ = [
     "Action", "ActionSpec", "CartesianPhase", "CircularPhaseSpec", "DriveOverrideSpec",
-    "HoldPhase", "HoldPhaseSpec", "JointPhase", "JointPhaseSpec", "LinearPhaseSpec", "Phase",
-    "PlannedPhase", "PoseTarget", "Scenario", "ScenarioSpec", "SimulationSpec", "SizingSpec", "VideoSpec",
-    "WeaveSpec", "load_scenario", "parse_scenario", "plan_phase", "plan_scenario", "resolve_scenario",
+    "ExpectSpec", "HoldPhase", "HoldPhaseSpec", "JointPhase", "JointPhaseSpec", "LinearPhaseSpec",
+    "Phase", "PlannedPhase", "PoseTarget", "Scenario", "ScenarioSpec", "SimulationSpec",
+    "SizingSpec", "VideoSpec", "WeaveSpec", "load_scenario", "parse_scenario", "plan_phase",
+    "plan_scenario", "resolve_scenario",
 ]

@@ -48,6 +48,7 @@ from sim.scenario.schema import (
     ActionSpec,
     CircularPhaseSpec,
     DriveOverrideSpec,
+    ExpectSpec,
     JointPhaseSpec,
     LinearPhaseSpec,
     ScenarioSpec,
@@ -200,6 +201,7 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
             raise ScenarioError(f"{where}: actions[{i}].action: {a.action} needs a {need} tool "
                                 f"(the tool is {'none' if tool is None else tool.name})")
         actions.append(Action(a.action, a.time_s, a.phase, a.at))
+    _check_expect(spec.expect, where)
     return Scenario(
         name=spec.name,
         description=spec.description,
@@ -217,7 +219,25 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         program_warnings=program_warnings,
         actions=tuple(actions),
         sizing=spec.sizing,
+        expect=spec.expect,
     )
+
+
+def _check_expect(expect: ExpectSpec, where: str) -> None:
+    """``[expect]`` is consistent: a failed verdict names its failed checks (and failed checks
+    fail the verdict), and whatever is expected to fail says why.
+
+    Raises:
+        ScenarioError: One line naming ``expect.<key>``.
+    """
+    if expect.failed_checks and expect.verdict == "pass":
+        raise ScenarioError(f"{where}: expect.verdict: a failed check fails the verdict; give "
+                            'verdict = "fail" with failed_checks')
+    if expect.verdict == "fail" and not expect.failed_checks:
+        raise ScenarioError(f"{where}: expect.failed_checks: name the checks that fail the "
+                            'verdict ("speed j2", ...)')
+    if (expect.verdict == "fail" or expect.check_findings) and not expect.reason:
+        raise ScenarioError(f"{where}: expect.reason: say why the scenario is expected to fail")
 
 
 def _describe_validation_error(exc: ValidationError, raw: Any) -> str:
@@ -255,7 +275,7 @@ def _model_at(loc: tuple[Any, ...], raw: Any) -> type[BaseModel] | None:
     if head == "drives" and len(loc) == 2:
         return DriveOverrideSpec
     if len(loc) == 1:
-        return {"simulation": SimulationSpec, "video": VideoSpec}.get(head)
+        return {"simulation": SimulationSpec, "video": VideoSpec, "expect": ExpectSpec}.get(head)
     return None
 
 

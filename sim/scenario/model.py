@@ -12,7 +12,13 @@ from numpy.typing import NDArray
 
 from sim.errors import ScenarioError, UsageError
 from sim.robots.registry import Drive, RobotSpec
-from sim.scenario.schema import MAX_PAYLOAD_KG, SimulationSpec, SizingSpec, VideoSpec
+from sim.scenario.schema import (
+    MAX_PAYLOAD_KG,
+    ExpectSpec,
+    SimulationSpec,
+    SizingSpec,
+    VideoSpec,
+)
 
 if TYPE_CHECKING:
     from sim.cells import CellSpec
@@ -238,6 +244,8 @@ class Scenario:
         actions: Tool actions in file order.
         program_warnings: For a scenario running a TP program: what the program holds that is
             not simulated, one line each with its line number.
+        expect: What a run is expected to give (``[expect]``: verdict, failed checks,
+            ``cellsim check`` findings, reason); it changes no verdict.
     """
 
     name: str
@@ -256,6 +264,7 @@ class Scenario:
     actions: tuple[Action, ...] = ()
     sizing: SizingSpec = SizingSpec()
     program_warnings: tuple[str, ...] = ()
+    expect: ExpectSpec = ExpectSpec()
 
     @property
     def sha256(self) -> str:

@@ -233,6 +233,25 @@ class SizingSpec(_Strict):
         "warning")
 
 
+#: The kinds of finding ``cellsim check`` reports (:mod:`sim.pipeline.check`).
+CheckFindingKind = Literal["reach", "limit", "singular", "collision"]
+
+
+class ExpectSpec(_Strict):
+    """What a run of the scenario is expected to give (``[expect]``): a scenario that documents
+    a known failure (a published motion past a robot's limits, say) declares it here, with the
+    reason; the tests read it. It changes no verdict and no exit code."""
+
+    verdict: Literal["pass", "fail"] = Field("pass", description="the run's verdict")
+    failed_checks: list[Annotated[str, Field(pattern=r"^[a-z_]+ \S+$")]] = Field(
+        [], description='the checks of severity error the run fails, "name subject" '
+        '(e.g. "speed j2")')
+    check_findings: list[CheckFindingKind] = Field(
+        [], description="the kinds of finding `cellsim check` reports")
+    reason: PlainText | None = Field(None, description="why; required when anything is "
+                                     "expected to fail")
+
+
 class ScenarioSpec(_Strict):
     """Top level of a scenario file."""
 
@@ -259,3 +278,5 @@ class ScenarioSpec(_Strict):
         {}, description="position register number -> [X, Y, Z, W, P, R] (mm, deg)")
     program_weld_speed_mm_s: float | None = Field(None, gt=0, description="the speed of the "
                                                   "program's WELD_SPEED moves, mm/s")
+    expect: ExpectSpec = Field(ExpectSpec(), description="what a run is expected to give "
+                               "(a documented failure, with its reason)")
