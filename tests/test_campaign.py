@@ -22,71 +22,12 @@ from typing import Any
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_cell_files import CELL, make_cell
-from test_robots_as_data import DH_ROBOT, DH_SCENARIO
-from test_weld_programs import DATA, TP_SCENARIO
+from support import DATA, ROOT
+from support.cell_files import CELL, make_cell
+from support.robots import DH_ROBOT, DH_SCENARIO
+from support.scenarios import CAMPAIGN_BASE, TP_SCENARIO
 
 from sim.cli import main
-
-BASE = """name = "campaign"
-description = "base scenario of the hostile-input campaign"
-robot = "lrmate200ic5l"
-cell = "weld_table"
-tool = "mig_torch"
-payload_kg = 0.5
-
-[simulation]
-timestep_s = 0.001
-settle_s = 0.1
-tracking_tolerance_deg = 0.1
-clearance_mm = 5.0
-
-[video]
-width = 160
-height = 120
-fps = 10.0
-
-[sizing]
-life_h = 20000.0
-dwell_s = 1.0
-
-[drives.j2]
-gear_ratio = 120.0
-efficiency = 0.8
-
-[[actions]]
-action = "arc_on"
-phase = "across"
-
-[[actions]]
-action = "arc_off"
-time_s = 3.5
-
-[[phases]]
-name = "start"
-planner = "434"
-time_s = [0.0, 0.5, 1.0]
-joints_deg = [[0.0, 0.0, 0.0, 0.0, -90.0, 0.0], [0.0, 5.0, -5.0, 0.0, -90.0, 0.0], [0.0, 10.0, -10.0, 0.0, -90.0, 0.0]]
-
-[[phases]]
-name = "above"
-planner = "546"
-durations_s = [1.0]
-to_mm = [330.0, 120.0, -60.0]
-euler_zyx_deg = [0.0, 0.0, 180.0]
-
-[[phases]]
-name = "across"
-kind = "linear"
-to_mm = [330.0, 180.0, -60.0]
-speed_mm_s = 50.0
-sample_period_s = 0.02
-
-[[phases]]
-name = "rest"
-kind = "hold"
-duration_s = 0.3
-"""
 
 #: CPU-time limit of one command, s, and the address-space limit of the campaign, bytes.
 LIMIT_S = 60
@@ -167,7 +108,7 @@ HOSTILE = st.one_of(
     st.text(max_size=20),
     st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=8),
 )
-LEAVES = _leaves(tomllib.loads(BASE))
+LEAVES = _leaves(tomllib.loads(CAMPAIGN_BASE))
 
 
 @contextmanager
@@ -214,7 +155,7 @@ def _answer(argv: list[str], capsys) -> int:
 def test_every_scenario_key_with_hostile_values(tmp_path, capsys, monkeypatch, path, value,
                                                 unknown):
     monkeypatch.chdir(tmp_path)
-    doc = tomllib.loads(BASE)
+    doc = tomllib.loads(CAMPAIGN_BASE)
     _set(doc, path, value)
     if unknown:  # a misspelt key beside it
         _set(doc, (*path[:-1], f"{path[-1]}_typo"), 1.0)
@@ -260,7 +201,7 @@ VALUES = st.sampled_from(["nan", "inf", "-inf", "1e308", "-1", "0", "1e-300", ""
 def test_every_command_with_hostile_arguments(tmp_path, capsys, monkeypatch, command, extra):
     monkeypatch.chdir(tmp_path)  # relative --out values land here, never in the checkout
     base = tmp_path / "s.toml"
-    base.write_text(BASE)
+    base.write_text(CAMPAIGN_BASE)
     values = [x for flag, value in extra for x in ((flag,) if flag in (
         "--select", "--strict", "--json", "--keep-runs", "--plots") else (flag, value))]
     with bounded():
@@ -271,7 +212,7 @@ def test_the_campaign_starts_from_a_valid_scenario(tmp_path, capsys):
     """The base passes `cellsim check` and runs: hostile values are the only reason a mutant
     is refused."""
     base = tmp_path / "s.toml"
-    base.write_text(BASE)
+    base.write_text(CAMPAIGN_BASE)
     assert _answer(["check", str(base)], capsys) == 0
     assert _answer(["run", str(base), "--out", str(tmp_path / "r"), "--no-video", "--no-plots",
                     "--quiet"], capsys) == 0
@@ -311,7 +252,7 @@ def robot_root(tmp_path_factory):
     (root / "robots" / "dh_arm").mkdir(parents=True)
     (root / "robots" / "dh_arm" / "robot.toml").write_text(DH_ROBOT)
     (root / "dh.toml").write_text(DH_SCENARIO)
-    src = Path(__file__).resolve().parents[1] / "models" / "kuka_kr6r900_2"
+    src = ROOT / "models" / "kuka_kr6r900_2"
     shutil.copytree(src, root / "robots" / "kr6", ignore=shutil.ignore_patterns("*.py"))
     (root / "urdf.toml").write_text(DH_SCENARIO.replace("robots/dh_arm", "robots/kr6").replace(
         "[[0, 0, 0, 0, 30, 0], [20, 10, -20, 10, 40, 20], [30, 20, -30, 0, 60, 0]]",
@@ -395,7 +336,7 @@ def _program_case(root: Path, data: st.DataObject) -> list[str] | None:
 
 def _small_catalog() -> str:
     """The starter catalogue's first two motors and two reducers, as TOML."""
-    doc = tomllib.loads((Path(__file__).resolve().parents[1] / "models" / "catalog" /
+    doc = tomllib.loads((ROOT / "models" / "catalog" /
                          "starter.toml").read_text())
     doc = {"catalog": doc["catalog"], "motors": doc["motors"][:2],
            "reducers": doc["reducers"][:2]}
@@ -412,7 +353,7 @@ def _catalog_case(root: Path, data: st.DataObject) -> list[str] | None:
     if text is None:
         return None
     (root / "cat.toml").write_text(text)
-    (root / "s.toml").write_text(BASE)
+    (root / "s.toml").write_text(CAMPAIGN_BASE)
     return ["run", str(root / "s.toml"), "--out", str(root / "run"), "--no-video", "--no-plots",
             "--quiet", "--select", "--catalog", str(root / "cat.toml")]
 
@@ -470,7 +411,7 @@ def test_the_new_inputs_start_valid(cell_root, robot_root, tmp_path, capsys, mon
     (tmp_path / "tp.toml").write_text(TP_SCENARIO)
     assert _answer(["check", str(tmp_path / "tp.toml")], capsys) == 0
     (tmp_path / "cat.toml").write_text(_small_catalog())
-    (tmp_path / "s.toml").write_text(BASE)
+    (tmp_path / "s.toml").write_text(CAMPAIGN_BASE)
     assert _answer(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "run"),
                     "--no-video", "--no-plots", "--quiet", "--select", "--catalog",
                     str(tmp_path / "cat.toml")], capsys) in (0, 1)

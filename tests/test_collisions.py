@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support.scenarios import joint_phase, write_scenario
 
 from sim.cli import main
 from sim.core.resources import shipped_scenarios
@@ -493,26 +494,16 @@ def test_held_part_set_down_into_the_tray_floor_is_a_collision():
 
 
 # ------------------------------------------------------- where the tool meets the last link
-MOUNT_JOB = """
-name = "mount_{robot}"
-description = "a joint move of {robot} with {tool}, the wrist straight then bent"
-robot = "{robot}"
-tool = "{tool}"
-
-[[phases]]
-name = "move"
-planner = "434"
-time_s = [0.0, 1.0, 2.0]
-joints_deg = [[0, 0, 0, 0, {q5}, 0], [10, 5, -5, 0, {q5}, 30], [20, 10, -10, 0, {q5}, 60]]
-"""
-
 MOUNT_ARMS = ("m10ia", "m20ia", "ar2010", "irb1600", "kr10r1420", "kr6r900_2", "irb2400")
 
 
 def _mount_case(tmp_path: Path, robot: str, tool: str = "mig_torch", q5: float = -60.0):
-    path = tmp_path / f"{robot}.toml"
-    path.write_text(MOUNT_JOB.format(robot=robot, tool=tool, q5=q5))
-    return path
+    """A joint move of ``robot`` with ``tool``, the wrist straight then bent."""
+    return write_scenario(
+        tmp_path, robot, [joint_phase([[0, 0, 0, 0, q5, 0], [10, 5, -5, 0, q5, 30],
+                                       [20, 10, -10, 0, q5, 60]])],
+        filename=f"{robot}.toml", name=f"mount_{robot}", tool=tool,
+        description=f"a joint move of {robot} with {tool}, the wrist straight then bent")
 
 
 @pytest.mark.parametrize("robot", MOUNT_ARMS)

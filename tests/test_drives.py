@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.scenarios import joint_phase, write_scenario
 
 from sim.pipeline.run import RunOptions, evaluate_scenario
 from sim.scenario import load_scenario
@@ -73,21 +74,13 @@ def five_r(tmp_path: Path, override: str = "") -> Path:
     return path
 
 
-def ur5(tmp_path: Path, override: str = "") -> Path:
+def ur5(tmp_path: Path) -> Path:
+    """A joint move of a robot folder's arm (:data:`UR5_TOML` as ``robots/ur5``)."""
     (tmp_path / "robots" / "ur5").mkdir(parents=True)
     (tmp_path / "robots" / "ur5" / "robot.toml").write_text(UR5_TOML)
-    path = tmp_path / "s.toml"
-    path.write_text(f"""name = "ur5_move"
-description = "a joint move of a robot folder's arm"
-robot = "robots/ur5"
-{override}
-[[phases]]
-name = "move"
-planner = "434"
-time_s = [0.0, 1.0, 2.0]
-joints_deg = [[0, -90, 90, -90, -90, 0], [20, -80, 80, -80, -80, 10], [40, -70, 70, -70, -70, 20]]
-""")
-    return path
+    return write_scenario(tmp_path, "robots/ur5", [joint_phase(
+        [[0, -90, 90, -90, -90, 0], [20, -80, 80, -80, -80, 10], [40, -70, 70, -70, -70, 20]])],
+        name="ur5_move", description="a joint move of a robot folder's arm")
 
 
 @pytest.mark.parametrize("source", ["robot defaults", "robot folder", "scenario override"])

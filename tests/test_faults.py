@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
+from support.scenarios import joint_phase, scenario_text
 
 from sim.cli import main
 from sim.errors import RunFolderError
@@ -587,12 +588,11 @@ def test_a_payload_over_the_robots_rating_fails_the_verdict(payload, passes, tmp
     from sim.robots.registry import ROBOTS
     from sim.scenario import parse_scenario
 
-    text = ('name = "heavy"\ndescription = "a joint move with a payload"\n'
-            'robot = "lrmate200ic5l"\ncell = "weld_table"\ntool = "mig_torch"\n'
-            f"payload_kg = {payload}\n[[phases]]\nname = \"move\"\nplanner = \"434\"\n"
-            "time_s = [0.0, 0.5, 1.0, 1.5, 2.0]\njoints_deg = [\n"
-            "  [0, 0, 0, 0, -90, 0], [2, 2, -2, 0, -88, 0], [4, 4, -4, 0, -86, 0],\n"
-            "  [6, 6, -6, 0, -84, 0], [8, 8, -8, 0, -82, 0]]\n")
+    text = scenario_text("lrmate200ic5l", [joint_phase(
+        [[0, 0, 0, 0, -90, 0], [2, 2, -2, 0, -88, 0], [4, 4, -4, 0, -86, 0],
+         [6, 6, -6, 0, -84, 0], [8, 8, -8, 0, -82, 0]], time_s=[0.0, 0.5, 1.0, 1.5, 2.0])],
+        name="heavy", description="a joint move with a payload", cell="weld_table",
+        tool="mig_torch", payload_kg=payload)
     ev = evaluate_scenario(parse_scenario(text), RunOptions(video=False, plots=False,
                                                             progress=False))
     check = next(c for c in ev.summary["checks"] if c["name"] == "payload")

@@ -19,7 +19,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
-from test_cell_files import make_cell, write_bracket
+from support.cell_files import make_cell, write_bracket
 
 import sim.cells.meshes as meshes
 from sim.cli import main

@@ -10,7 +10,7 @@ from html.parser import HTMLParser
 
 import numpy as np
 import pytest
-from window_oracle import sustained_peak
+from support.window_oracle import sustained_peak
 
 from sim.analysis.report import REQUIRED_COLUMNS, write_atomic, write_sizing
 from sim.analysis.sizing import PEAK_WINDOW_S, size_trajectory

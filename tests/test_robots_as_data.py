@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import DATA, ROOT
+from support.robots import DH_ROBOT, DH_SCENARIO, DRIVES_6
 
 from sim.errors import KinematicsError
 from sim.robots.arm import load_arm
@@ -25,9 +27,7 @@ from sim.robots.kinematics.chain import chain_from_dh, chain_from_urdf
 from sim.robots.kinematics.numeric_ik import pose_error
 from sim.robots.kinematics.numeric_ik import solve_ik as numeric_ik
 
-DATA = Path(__file__).resolve().parent / "data"
-
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = ROOT / "models"
 #: The URDF of each arm with published OPW parameters.
 URDFS = {"kuka_kr6r700sixx": DATA / "kuka_kr6r700sixx.urdf",
          "kuka_kr6r900_2": MODELS / "kuka_kr6r900_2" / "kr6r900_2.urdf",
@@ -597,7 +597,7 @@ def test_a_robot_folder_of_ones_own_runs_a_scenario(tmp_path):
     from sim.pipeline.run import evaluate_scenario
     from sim.scenario import load_scenario
 
-    src = Path(__file__).resolve().parents[1] / "models" / "fanuc_lrmate200ic"
+    src = MODELS / "fanuc_lrmate200ic"
     dst = tmp_path / "robots" / "my_arm"
     shutil.copytree(src, dst)
     toml = dst / "robot.toml"
@@ -616,47 +616,6 @@ def test_a_robot_folder_of_ones_own_runs_a_scenario(tmp_path):
 
 
 # ---------------------------------------------------------------------------- DH robots in cells
-DRIVES_6 = "".join(f"""
-[[drives]]
-gear_ratio = {r}
-efficiency = 0.75
-rotor_inertia_kg_m2 = {i}
-rated_torque_nm = {t}
-peak_torque_nm = {p}
-max_speed_rpm = 6000
-""" for r, i, t, p in [(120, 2e-5, 0.65, 2.4), (120, 4.5e-5, 1.3, 4.5), (120, 2e-5, 0.65, 2.4),
-                       (75, 5e-6, 0.32, 1.0), (75, 5e-6, 0.32, 1.0), (48, 3e-6, 0.25, 0.8)])
-
-DH_ROBOT = """name = "dh_arm"
-description = "an OPW arm from its DH table"
-[kinematics]
-convention = "dh"
-dh = [[75, -90, 330, 0], [300, 0, 0, -90], [75, -90, 0, 0], [0, 90, 320, 0], [0, -90, 0, 0],
-      [0, 0, 80, 0]]
-[joints]
-range_deg = [[-170, 170], [-100, 140], [-150, 150], [-190, 190], [-120, 120], [-360, 360]]
-max_speed_deg_s = [270, 270, 270, 450, 450, 720]
-[mass]
-total_kg = 25
-payload_kg = 2
-""" + DRIVES_6
-
-DH_SCENARIO = """name = "dh_moves"
-description = "a robot from a DH table: a joint move and a straight line"
-robot = "robots/dh_arm"
-[[phases]]
-name = "move"
-planner = "434"
-time_s = [0.0, 1.0, 2.0]
-joints_deg = [[0, 0, 0, 0, 30, 0], [20, 10, -20, 10, 40, 20], [30, 20, -30, 0, 60, 0]]
-[[phases]]
-name = "line"
-kind = "linear"
-to_mm = [450, 150, 300]
-speed_mm_s = 100
-"""
-
-
 @pytest.fixture
 def dh_robot(tmp_path, monkeypatch):
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
@@ -767,7 +726,7 @@ def test_robot_format_reference_documents_every_key():
         RobotMass,
     )
 
-    doc = (Path(__file__).resolve().parents[1] / "docs" / "robot-format.md").read_text()
+    doc = (ROOT / "docs" / "robot-format.md").read_text()
     table_keys = set(re.findall(r"^\| `([a-z][a-z0-9_]*)`", doc, flags=re.M))
     declared = set()
     for model in (RobotFolderSpec, FamilyKinematics, RobotJoints, RobotMass, DriveBlock,

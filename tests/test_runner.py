@@ -9,6 +9,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from support.scenarios import joint_phase, scenario_text
 
 from sim.cli import main
 from sim.errors import CellsimError, SimulationError
@@ -125,18 +126,11 @@ def test_feedforward_off_is_a_pure_position_servo(tmp_path):
     assert np.all(a["tau_ff"] == 0)
 
 
-UNSTABLE = """
-name = "unstable"
-description = "5R with a far too long time step"
-robot = "robot_5r"
-[simulation]
-timestep_s = 0.001
-[[phases]]
-name = "a"
-planner = "434"
-time_s = [0.0, 0.5, 1.0]
-joints_deg = [[0,0,0,0,0],[10,20,10,10,10],[20,40,20,20,20]]
-"""
+UNSTABLE = scenario_text(
+    "robot_5r", [joint_phase([[0, 0, 0, 0, 0], [10, 20, 10, 10, 10], [20, 40, 20, 20, 20]],
+                             name="a", time_s=[0.0, 0.5, 1.0])],
+    name="unstable", description="5R with a far too long time step",
+    simulation={"timestep_s": 0.001})
 
 
 def test_instability_stops_with_time_and_joint_and_keeps_failed_folder(tmp_path, monkeypatch):
@@ -244,21 +238,12 @@ def test_path_deviation_metric_against_the_line(tmp_path):
 def test_singularity_summary_sees_the_wrist_singularity(tmp_path):
     """A 200iC phase passing through theta5 = 0 (seed 004 eq. 23: det J = 0) is reported as the
     closest approach to a singularity, at that time; a phase far from it is not."""
-    text = """
-name = "wrist"
-description = "theta5 through zero"
-robot = "lrmate200ic5l"
-[[phases]]
-name = "through"
-planner = "434"
-time_s = [0.0, 0.5, 1.0]
-joints_deg = [[0,0,0,0,-30,0],[0,0,0,0,0,0],[0,0,0,0,30,0]]
-[[phases]]
-name = "away"
-planner = "434"
-durations_s = [0.5, 0.5]
-joints_deg = [[0,10,-20,0,45,0],[0,20,-40,0,60,0]]
-"""
+    text = scenario_text("lrmate200ic5l", [
+        joint_phase([[0, 0, 0, 0, -30, 0], [0, 0, 0, 0, 0, 0], [0, 0, 0, 0, 30, 0]],
+                    name="through", time_s=[0.0, 0.5, 1.0]),
+        joint_phase([[0, 10, -20, 0, 45, 0], [0, 20, -40, 0, 60, 0]], name="away",
+                    durations_s=[0.5, 0.5]),
+    ], name="wrist", description="theta5 through zero")
     s = _run(parse_scenario(text, source="w.toml"), tmp_path / "w")
     sing = s["singularity"]
     assert sing["phase"] == "through" and sing["t"] == pytest.approx(0.5, abs=0.011)

@@ -1,5 +1,5 @@
 """A seam campaign (issue 25): seams nobody wrote by hand, welded by every kind of arm, judged
-by an oracle written from the cell file's own numbers (:mod:`seam_oracle`).
+by an oracle written from the cell file's own numbers (:mod:`support.seam_oracle`).
 
 hypothesis draws a seam (a line; a polyline of 1-6 corners turning 30-150 deg; an arc of
 20-300 deg; a full circle) on a box, a cylinder (its end face, or a line along its side) or a
@@ -21,9 +21,9 @@ object the seam's workpiece.
 The tool frames the oracle judges are the robot's forward kinematics of the planned joints every
 5 ms: MuJoCo's compiled site ``tcp`` (``mj_kinematics``) for the shipped arms, a DH product
 written here for the UR5-like DH arm. The oracle's figures and limits (issue 25's acceptance)
-are in :func:`seam_oracle.judge_weld`; collisions must be reported exactly where the oracle puts
-a torch part (nozzle, contact tip, body) into a solid, never where it keeps them clear, and the
-wire only beyond its allowed depth (:func:`collision_failures`).
+are in :func:`support.seam_oracle.judge_weld`; collisions must be reported exactly where the
+oracle puts a torch part (nozzle, contact tip, body) into a solid, never where it keeps them
+clear, and the wire only beyond its allowed depth (:func:`collision_failures`).
 
 Arms: the shipped 6-axis arms (the welding-robot library's five among them); the 5-axis
 LR Mate 100iB on lines radial to J1 (work
@@ -48,9 +48,9 @@ from typing import Any
 
 import numpy as np
 import pytest
-import seam_oracle as so
 from hypothesis import HealthCheck, Phase, assume, given, settings
 from hypothesis import strategies as st
+from support import seam_oracle as so
 
 from sim.errors import CellsimError, ReachError, ScenarioError
 
@@ -862,7 +862,7 @@ def check_simulated_torques(case: Case, root: Path) -> Planned | None:
     on the run's own model (:mod:`rnea_oracle`): within 1e-5 of each joint's peak (the model
     goes to pinocchio as MJCF text, its numbers at the text's precision; a 1 % error in one
     joint's torque is caught: tests/test_torques.py)."""
-    from rnea_oracle import tau_id_error
+    from support.rnea_oracle import tau_id_error
 
     pl = check_simulated(case, root)
     if pl is None:

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from window_oracle import window_mean
+from support.window_oracle import window_mean
 
 from sim.analysis.catalog import load_catalog, starter_catalog
 from sim.analysis.selection import SelectionOptions, select_actuators

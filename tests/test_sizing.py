@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import integrate, optimize
-from window_oracle import window_mean
+from support.window_oracle import window_mean
 
 from sim.analysis.sizing import (
     PEAK_KNEE_FRACTION,

@@ -13,7 +13,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from window_oracle import sustained_peak
+from support.window_oracle import sustained_peak
 
 from sim.analysis.sizing import PEAK_WINDOW_S
 from sim.pipeline.run import RunOptions, run_scenario

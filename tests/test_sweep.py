@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from window_oracle import sustained_peak
+from support.window_oracle import sustained_peak
 
 from sim.analysis.sizing import PEAK_WINDOW_S
 from sim.cli.size import parse_float_list

@@ -14,7 +14,8 @@ import unicodedata
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_cell_files import CELL, make_cell
+from support.cell_files import CELL, make_cell
+from support.scenarios import CAMPAIGN_BASE
 
 from sim.cli import main
 
@@ -66,11 +67,9 @@ def test_a_cell_description_is_plain_text_or_refused(cell_root, capsys, text):
 
 @pytest.mark.parametrize("key", ["description", "note"])
 def test_a_scenario_s_free_text_is_plain(tmp_path, capsys, key):
-    from test_campaign import BASE
-
-    text = BASE.replace('description = "base scenario of the hostile-input campaign"',
-                        'description = "base"\nnote = "ok \\u001b]0;title\\u0007"'
-                        if key == "note" else 'description = "\\u001b[2Jcleared"')
+    text = CAMPAIGN_BASE.replace('description = "base scenario of the hostile-input campaign"',
+                                 'description = "base"\nnote = "ok \\u001b]0;title\\u0007"'
+                                 if key == "note" else 'description = "\\u001b[2Jcleared"')
     (tmp_path / "s.toml").write_text(text)
     assert main(["check", str(tmp_path / "s.toml")]) == 2
     err = capsys.readouterr().err

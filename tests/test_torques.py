@@ -9,7 +9,7 @@ import dataclasses
 import mujoco
 import numpy as np
 import pytest
-from rnea_oracle import tau_id_error
+from support.rnea_oracle import tau_id_error
 
 from sim.analysis.sizing import peak_abs, rms
 from sim.cli import main

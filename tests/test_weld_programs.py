@@ -15,6 +15,8 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support import DATA
+from support.scenarios import TP_SCENARIO
 
 from sim.pipeline.run import evaluate_scenario
 from sim.scenario import load_scenario
@@ -388,14 +390,6 @@ def test_a_polyline_seam_is_welded_in_one_pass_with_blended_corners(tmp_path):
 
 
 # ---------------------------------------------------------------------------- FANUC TP programs
-DATA = Path(__file__).resolve().parent / "data"
-TP_SCENARIO = """
-name = "tp_weld1"
-description = "a TP program"
-robot = "lrmate200ic5l"
-tool = "mig_torch"
-program = "weld1.ls"
-"""
 
 
 @pytest.fixture(scope="module")
