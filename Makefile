@@ -34,7 +34,7 @@ test-slow: setup
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
 # Static checks of the API face (the files pyproject.toml's [tool.mypy] names).
-LINT_FILES := sim/__init__.py sim/api sim/pipeline/sweep/evaluation.py examples tests/test_api.py
+LINT_FILES := sim/__init__.py sim/api sim/pipeline/sweep/evaluation.py examples tests/api/test_api.py
 
 lint: setup
 	$(BIN)/ruff check $(LINT_FILES)

@@ -21,7 +21,7 @@ from sim.cli import main
 from sim.errors import RenderError
 from sim.render.synthetic import write_synthetic_run
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 AVAILABLE = gl.available_backends()
 pytestmark = pytest.mark.render
 

@@ -438,7 +438,7 @@ def test_format_reference_documents_every_key():
     )
     from sim.cells.toolfile import ShapeSpec, SuctionSpec, ToolFileSpec
 
-    doc = (Path(__file__).resolve().parents[1] / "docs" / "cell-format.md").read_text()
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "cell-format.md").read_text()
     table_keys = set(re.findall(r"^\| `([a-z][a-z0-9_]*)`", doc, flags=re.M))
     declared = set()
     for model in (CellFileSpec, RobotBlock, ObjectBlock, SeamBlock, SlotBlock, CameraBlock,
@@ -454,7 +454,7 @@ def test_the_shipped_cell_files_are_what_their_derivations_give():
     """models/cells/*.toml are written by models/cells/generate.py from sim/cells/*.py; a
     derivation changed without regenerating (or a hand-edited file) fails here."""
     r = subprocess.run([sys.executable, "models/cells/generate.py", "--check"],
-                       cwd=Path(__file__).resolve().parents[1], capture_output=True, text=True,
+                       cwd=Path(__file__).resolve().parents[2], capture_output=True, text=True,
                        timeout=300)
     assert r.returncode == 0, r.stdout + r.stderr
 

@@ -22,7 +22,7 @@ from sim.core.resources import shipped_scenarios
 from sim.layers import LAYERS, ROOT_EXPORTS, layer_of
 from sim.robots.registry import ROBOTS
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _modules() -> list[tuple[str, Path]]:

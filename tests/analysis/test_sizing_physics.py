@@ -147,7 +147,8 @@ def test_torque_scales_with_speed_squared_without_gravity(tmp_path, monkeypatch)
         built.model.actuator_biasprm[built.friction_act] = 0.0
         built.cell.frictionloss[:] = 0.0
         # s = 2 asks J2 for more than its drive's limit, which now clamps the whole torque
-        # inside the simulation (tests/test_torques.py): lift the limits for this scaling law
+        # inside the simulation (tests/simulation/test_torques.py): lift the limits for this
+        # scaling law
         built.model.actuator_forcerange[built.robot_act] *= 100.0
         built.force_limits[:] *= 100.0
         return built

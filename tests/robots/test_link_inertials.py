@@ -23,7 +23,7 @@ import mujoco
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 KR6 = ROOT / "models" / "kuka_kr6r900_2"
 
 

@@ -17,7 +17,7 @@ from sim.robots.kinematics.model import closed_form_model, kinematic_model
 from sim.robots.registry import ROBOTS
 
 ALL_ROBOTS = sorted(ROBOTS)
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _run(capsys, *argv: str) -> tuple[int, str, str]:

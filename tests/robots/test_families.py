@@ -12,7 +12,7 @@ from sim.robots.registry import ROBOTS, joint_ranges
 
 ALL_ROBOTS = sorted(ROBOTS)
 #: The robots of the seeds' kinematic families (the arms given as data, ChainFamily, are
-#: checked against their URDF and DH products in tests/test_robots_as_data.py).
+#: checked against their URDF and DH products in tests/robots/test_robots_as_data.py).
 SEED_ROBOTS = [n for n in ALL_ROBOTS if isinstance(ROBOTS[n].family, (FiveR, Fanuc6))]
 
 

@@ -852,7 +852,7 @@ def test_many_generated_seams_simulated(arm, kind):
 
 
 # ------------------------------------------------------- every URDF arm through a weld
-#: The shipped arms given by a URDF (tests/test_robots_as_data.py checks their models against
+#: The shipped arms given by a URDF (tests/robots/test_robots_as_data.py checks their models against
 #: MuJoCo's own compile of the URDF and their closed form against the published OPW sets).
 URDF_ARMS = ("kr6r900_2", "irb2400", *LIBRARY)
 
@@ -861,7 +861,7 @@ def check_simulated_torques(case: Case, root: Path) -> Planned | None:
     """:func:`check_simulated`, then the run's recorded joint torques against pinocchio's RNEA
     on the run's own model (:mod:`rnea_oracle`): within 1e-5 of each joint's peak (the model
     goes to pinocchio as MJCF text, its numbers at the text's precision; a 1 % error in one
-    joint's torque is caught: tests/test_torques.py)."""
+    joint's torque is caught: tests/simulation/test_torques.py)."""
     from support.rnea_oracle import tau_id_error
 
     pl = check_simulated(case, root)

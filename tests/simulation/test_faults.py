@@ -26,7 +26,7 @@ def _start(out: Path, scenario: str = SLOW) -> subprocess.Popen:
     return subprocess.Popen([sys.executable, "-I", "-m", "sim", "run", scenario, "--out",
                              str(out), "--no-video", "--no-plots", "--quiet"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            cwd=Path(__file__).resolve().parents[1])
+                            cwd=Path(__file__).resolve().parents[2])
 
 
 def _hidden(out: Path) -> list[Path]:
@@ -363,7 +363,7 @@ def test_sigkill_mid_video_then_rerun(tmp_path, capsys):
     proc = subprocess.Popen([sys.executable, "-I", "-m", "sim", "run", QUICK, "--out", str(out),
                              "--no-plots", "--width", "160", "--height", "120"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=Path(__file__).resolve().parents[1])
+                            cwd=Path(__file__).resolve().parents[2])
     seen = ""
     end = time.monotonic() + 120
     while "cellsim: sizing" not in seen:  # the next stage is the video
@@ -488,7 +488,7 @@ def test_a_real_full_disk_and_a_read_only_parent(tmp_path):
     driver.write_text(_DRIVER)
     done = subprocess.run(["unshare", "-rm", sys.executable, "-I", str(driver), str(tmp_path),
                            QUICK], capture_output=True, text=True, timeout=600,
-                          cwd=Path(__file__).resolve().parents[1])
+                          cwd=Path(__file__).resolve().parents[2])
     assert done.returncode == 0, done.stderr
     seen = json.loads(done.stdout)
     assert seen["first"]["rc"] == 0, seen["first"]["err"]

@@ -20,7 +20,7 @@ import sim
 from sim.errors import RunFolderError
 from sim.scenario import parse_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SHORT = "bugnar_5r_phase1"  # the shortest shipped scenario (10 s of cycle, a second to run)
 
 

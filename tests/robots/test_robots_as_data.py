@@ -752,7 +752,7 @@ def test_the_wrist_centre_stays_within_the_reach_bound_of_a_data_arm(dh_arm):
 def test_a_dh_robot_holds_its_home_pose_on_its_servos(dh_robot):
     """The generated gains hold the arm (and its rated payload) against gravity on the position
     servos alone, with no feed-forward: every joint within 2 mrad after 1 s, no warnings (as
-    the shipped robots, tests/test_cells.py)."""
+    the shipped robots, tests/cells/test_cells.py)."""
     import mujoco
 
     from sim.cells import build_cell

@@ -32,7 +32,7 @@ from sim.scenario import (
 )
 
 SHIPPED = shipped_scenarios()
-DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario-format.md"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "scenario-format.md"
 
 GOOD = """
 name = "t"

@@ -34,7 +34,7 @@ RPM = 60.0 / (2.0 * math.pi)
 SMALL = """
 [catalog]
 name = "test"
-description = "written by tests/test_selection.py"
+description = "written by tests/analysis/test_selection.py"
 
 [[motors]]
 id = "m50"
@@ -494,7 +494,7 @@ def test_the_warnings_counted_are_the_warnings_listed_in_every_report(tmp_path, 
     prints, the same as summary.json's failed warning checks; summary.json, sizing.md and
     report.html give one verdict."""
     scenario = tmp_path / "s.toml"
-    text = (Path(__file__).resolve().parents[1] / "scenarios" / "lrmate200ic_pick_place.toml"
+    text = (Path(__file__).resolve().parents[2] / "scenarios" / "lrmate200ic_pick_place.toml"
             ).read_text()
     assert "[sizing]" not in text
     scenario.write_text(text + '\n[sizing]\ninertia_ratio_max = 2.0\ninertia_ratio = "warning"\n')

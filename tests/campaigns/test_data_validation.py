@@ -59,7 +59,7 @@ from sim.errors import CatalogError
 from sim.robots.kinematics.chain import URDF_QUANTITIES, URDF_ZERO_IS_NONE
 from sim.robots.robotfile import RobotFolderSpec
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 # ---------------------------------------------------------------------------- the valid files
 #: A robot given by a DH table, with every key of robot.toml a DH robot takes but [[links]]

@@ -21,7 +21,7 @@ from support.scenarios import joint_phase, write_scenario
 from sim.pipeline.run import RunOptions, evaluate_scenario
 from sim.scenario import load_scenario
 
-SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 #: The 5R's J2 drive (models/robot_5r/README.md): peak motor torque N m, ratio, efficiency,
 #: rotor inertia kg m^2.
 J2_5R = (46.0, 160.0, 0.8, 2.3e-3)

@@ -29,7 +29,7 @@ from sim.render.overlay import (
 from sim.render.synthetic import JOINTS, write_synthetic_run
 from sim.simulation.runfolder import RunFolderError, RunRecord, load_run
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.render
 
 
