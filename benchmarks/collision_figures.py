@@ -5,10 +5,10 @@
    and whether ``mj_collision`` ever missed a penetrating pair. ``mj_geomDistance`` itself is
    checked against an analytic case first (a cylinder pressed into a box face).
 2. Wrist sweep: per robot, with J1..J3 at ``home`` and J4..J6 over their full ranges (the grid
-   of ``tests/test_self_collision.py``), the smallest distance between two robot links that are
-   not parent and child (collision geoms, ``mj_geomDistance``).
-3. The plunge of ``tests/test_collisions.py``: when the wire tip reaches the base plate's top
-   and when the reported torch-plate collision starts.
+   of ``tests/robots/test_self_collision.py``), the smallest distance between two robot links
+   that are not parent and child (collision geoms, ``mj_geomDistance``).
+3. The plunge of ``tests/simulation/test_collisions.py``: when the wire tip reaches the base
+   plate's top and when the reported torch-plate collision starts.
 
 Usage: python benchmarks/collision_figures.py [depths] [wrist] [plunge]
 """

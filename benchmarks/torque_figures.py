@@ -9,7 +9,7 @@ Prints, for every shipped scenario (or those named):
 
 and the energy balance of a closed frictionless cycle: the largest |work of tau_id - change of
 kinetic + potential energy| over the cycle / its gross energy. These are the quantities
-``tests/test_torques.py`` bounds (1 %, 1e-6, 1e-4).
+``tests/simulation/test_torques.py`` bounds (1 %, 1e-6, 1e-4).
 
 Usage: python benchmarks/torque_figures.py [SCENARIO ...]
 """

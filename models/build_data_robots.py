@@ -6,7 +6,8 @@ cellsim generates such a model from the chain, the drives and the mass
 keeps it in its folder so that it can be read and opened in MuJoCo's viewer like the others.
 
     python models/build_data_robots.py          # rewrite the files
-    python models/build_data_robots.py --check  # exit 1 if a file differs (tests/test_robots_as_data.py)
+    python models/build_data_robots.py --check  # exit 1 if a file differs
+                                                # (tests/robots/test_robots_as_data.py)
 
 It also writes the derived tables of each folder's README (between the ``generated`` markers):
 the chain, the OPW parameters derived from it, the mass model, the drives with the gravity

@@ -6,7 +6,8 @@ part from seed 001's phase-I pose; ``weld_table.py``: seams a 5-axis arm can wel
 mount) and writes it as a cell file (``sim.cells.export``), which is what cellsim reads.
 
     python models/cells/generate.py          # rewrite the files
-    python models/cells/generate.py --check  # exit 1 if a file differs (tests/test_cell_files.py)
+    python models/cells/generate.py --check  # exit 1 if a file differs
+                                             # (tests/cells/test_cell_files.py)
 """
 
 from __future__ import annotations

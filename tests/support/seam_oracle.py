@@ -1,4 +1,4 @@
-"""An independent oracle for weld seams: the seam campaign's (tests/test_seam_campaign.py)
+"""An independent oracle for weld seams: the seam campaign's (tests/campaigns/test_seam_campaign.py)
 judge of a weld, written from the cell file's own numbers with numpy, never from cellsim's seam
 code (``sim.cells.seam`` is not imported here).
 
