@@ -1,8 +1,8 @@
 """The layer order of cellsim, declared once.
 
 A module may import modules of its own layer and of the layers listed before it, never of a
-layer listed after it (``tests/test_architecture.py`` checks every import, including those
-inside functions). ``planners`` is the bottom layer and imports nothing from ``sim``.
+layer listed after it (``tests/house/test_architecture.py`` checks every import, including
+those inside functions). ``planners`` is the bottom layer and imports nothing from ``sim``.
 """
 
 from __future__ import annotations

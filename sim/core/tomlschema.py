@@ -18,8 +18,9 @@ and reducer catalogue or a cell file is read by :meth:`Quantity.problem`, whatev
 
 The message names the file and the key (``drives[0].gear_ratio: must be between 0.01 and
 10000 (a gear ratio), got 1e+308``). The ranges are listed in ``docs/robot-format.md``,
-``docs/cell-format.md`` and :mod:`sim.analysis.catalog`; ``tests/test_data_validation.py``
-takes every numeric key of a valid file and checks its reader against them.
+``docs/cell-format.md`` and :mod:`sim.analysis.catalog`;
+``tests/campaigns/test_data_validation.py`` takes every numeric key of a valid file and checks
+its reader against them.
 """
 
 from __future__ import annotations

@@ -5,8 +5,8 @@ FANUC controller shows other numbers for the same posture:
 
 * **LR Mate 200iC/5L**: the ROS-Industrial URDF's joints are ``J_urdf = s * theta`` with
   ``s = (+1, -1, +1, -1, +1, -1)`` (``models/fanuc_lrmate200ic/README.md``, checked against the
-  URDF chain in ``tests/test_models.py``), and FANUC measures J3 from the horizontal (the J2/J3
-  interaction: the ROS-Industrial FANUC driver converts ``URDF J3 = FANUC J3 + FANUC J2``), so
+  URDF chain in ``tests/robots/test_models.py``), and FANUC measures J3 from the horizontal (the
+  J2/J3 interaction: the ROS-Industrial FANUC driver converts ``URDF J3 = FANUC J3 + FANUC J2``), so
   ``FANUC = (U1, U2, U3 - U2, U4, U5, U6)`` with ``U = s * theta``. FANUC J3 = 0 therefore
   keeps the forearm horizontal whatever J2 is (tested).
 * **LR Mate 100iB** (5 axes): the RoboDK-derived table of ``../shared/reference/robots.md``,

@@ -10,7 +10,7 @@ host per variant (they do not depend on the state, so the controls of every step
 before stepping), and the recorded arrays are assembled by the same function, so checks,
 sizing and the verdict do not know which backend ran.
 
-Differences, all measured by ``tests/test_warp_backend.py`` against the CPU path:
+Differences, all measured by ``tests/simulation/test_warp_backend.py`` against the CPU path:
 
 * MuJoCo Warp computes in float32: joint paths agree to about 1e-5 rad and torques to a
   fraction of a percent on the shipped robots (the tests bound them at 1e-4 rad and 1 %).
