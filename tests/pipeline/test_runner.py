@@ -126,11 +126,18 @@ def test_feedforward_off_is_a_pure_position_servo(tmp_path):
     assert np.all(a["tau_ff"] == 0)
 
 
-UNSTABLE = scenario_text(
-    "robot_5r", [joint_phase([[0, 0, 0, 0, 0], [10, 20, 10, 10, 10], [20, 40, 20, 20, 20]],
-                             name="a", time_s=[0.0, 0.5, 1.0])],
-    name="unstable", description="5R with a far too long time step",
-    simulation={"timestep_s": 0.001})
+UNSTABLE = """
+name = "unstable"
+description = "5R with a far too long time step"
+robot = "robot_5r"
+[simulation]
+timestep_s = 0.001
+[[phases]]
+name = "a"
+planner = "434"
+time_s = [0.0, 0.5, 1.0]
+joints_deg = [[0,0,0,0,0],[10,20,10,10,10],[20,40,20,20,20]]
+"""
 
 
 def test_instability_stops_with_time_and_joint_and_keeps_failed_folder(tmp_path, monkeypatch):
