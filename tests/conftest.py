@@ -1,4 +1,13 @@
-"""Shared pytest configuration for cellsim."""
+"""Shared pytest configuration for cellsim: its fixtures apply to every test folder.
+
+The tests mirror the packages they specify (``tests/planners/``, ``tests/robots/``,
+``tests/cells/``, ``tests/scenario/``, ``tests/simulation/``, ``tests/pipeline/``,
+``tests/analysis/``, ``tests/render/``, ``tests/cli/``, ``tests/api/``), with
+``tests/campaigns/`` for the campaigns across packages and ``tests/house/`` for the house rules
+(layers, packaging). Test files have unique names (pytest's default import mode). This folder is
+on ``sys.path`` (it holds this conftest.py), so every test imports the oracles and factories of
+``tests/support/`` as ``support``; ``tests/data/`` holds the data files (``support.DATA``).
+"""
 
 from __future__ import annotations
 
