@@ -19,7 +19,13 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT))
 
-from test_cell_files import BRACKET_POS_MM, BRACKET_YAW_DEG, SEAM_MM, make_cell, rz  # noqa: E402
+from support.cell_files import (  # noqa: E402
+    BRACKET_POS_MM,
+    BRACKET_YAW_DEG,
+    SEAM_MM,
+    make_cell,
+    rz,
+)
 
 from sim.pipeline.run import evaluate_scenario  # noqa: E402
 from sim.robots.arm import load_arm  # noqa: E402

@@ -101,7 +101,8 @@ def wrist_gaps() -> None:
 def plunge() -> None:
     import sys
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    tests = Path(__file__).resolve().parents[1] / "tests"
+    sys.path[:0] = [str(tests / "simulation"), str(tests)]
     from test_collisions import PLUNGE  # the scenario the test runs
 
     from sim.pipeline.run import RunOptions, run_scenario

@@ -24,7 +24,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+TESTS = Path(__file__).resolve().parents[1] / "tests"
+sys.path[:0] = [str(TESTS / "simulation"), str(TESTS)]
 import test_torques as T  # noqa: E402  (the tests' own helpers, so the figures are theirs)
 
 from sim.analysis.sizing import peak_abs, rms  # noqa: E402

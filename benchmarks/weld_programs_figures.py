@@ -23,13 +23,14 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "scenario"))
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT))
 
+from support import DATA  # noqa: E402
+from support.scenarios import TP_SCENARIO  # noqa: E402
 from test_weld_programs import (  # noqa: E402
-    DATA,
     F0,
-    TP_SCENARIO,
     A,
     B,
     C,
