@@ -18,7 +18,7 @@ from sim.core.resources import scenarios_dir
 
 #: The MJCF the Python builders gave (``dm_control``'s text, 17 significant digits), recorded
 #: before they were replaced by the files.
-ORACLE = Path(__file__).parent / "data" / "tools"
+ORACLE = Path(__file__).resolve().parents[1] / "data" / "tools"
 
 
 @pytest.mark.parametrize("name", ["mig_torch", "mig_torch_long", "vacuum_gripper"])
