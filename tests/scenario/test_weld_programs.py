@@ -536,6 +536,9 @@ BAD_PROGRAMS = {
     "an unreachable CONFIG": (lambda t: t.replace("'N U T, 0, 0, 0',\n\tX =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000",
                                                   "'N D B, 0, 0, 0',\n\tX =   450.000  mm,\tY =   -50.000  mm,\tZ =    50.000"),
                               "CONFIG 'N D B, 0, 0, 0'"),
+    "a J speed too small to plan": (  # found by the hostile campaign: overflow, traceback
+        lambda t: t.replace("J P[1] 50% FINE", "J P[1] 1e-300% FINE"),
+        "at 1e-300 % of the joint speeds the move takes 8e+301 s, over the 1e+06 s"),
     "a missing circular second line": (lambda t: t.replace("    :  P[5] 10mm/sec FINE    ;\n", ""),
                                        "line 14: a circular move's second line"),
 }

@@ -96,7 +96,7 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
                 placed = placed.with_end(solved_end if solved_end is not None
                                          else _solve_target(phase, placed.q[0], context, label))
             if phase.speed_pct is not None:
-                placed = _timed_by_speed(placed, scenario.robot)
+                placed = _timed_by_speed(placed, scenario.robot, label)
             if phase.blend > 0 or phase.blend_fraction > 0:
                 placed, pending = _joint_blend(placed, todo[0] if todo else None, context, label,
                                                scenario.robot)

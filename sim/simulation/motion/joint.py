@@ -16,12 +16,13 @@ from numpy.typing import NDArray
 
 from sim.errors import CellsimError, ReachError, ScenarioError
 from sim.scenario import JointPhase, Phase, plan_phase
+from sim.scenario.phases import MAX_TIME_S
 from sim.simulation.motion.checks import _config_text
 from sim.simulation.motion.context import CartesianContext
 from sim.simulation.motion.seams import _seam_pose
 
 
-def _timed_by_speed(placed: JointPhase, robot: Any) -> JointPhase:
+def _timed_by_speed(placed: JointPhase, robot: Any, label: str = "") -> JointPhase:
     """A phase timed like a controller's joint move at ``speed_pct`` of the joint speed limits:
     the duration makes the peak speed of the joint that takes longest ``speed_pct`` times its
     limit, and no joint's acceleration over its limit (the knots keep their shares of the
@@ -39,6 +40,10 @@ def _timed_by_speed(placed: JointPhase, robot: Any) -> JointPhase:
     st = plan_phase(trial, "").at(ts)
     T = max(float(np.max(np.abs(st.qd).max(axis=0) / vlim)),
             float(np.sqrt(np.max(np.abs(st.qdd).max(axis=0) / alim))), 1e-3)
+    if not T * (1.0 + 1e-3) <= MAX_TIME_S:  # planned at that length, its powers overflow
+        raise ScenarioError(f"{label}: at {placed.speed_pct * 100:g} % of the joint speeds the "
+                            f"move takes {T:.3g} s, over the {MAX_TIME_S:g} s a phase may last; "
+                            "give a larger speed")
     for _ in range(8):  # with the phase's own boundary speeds (a blend): scale until inside
         times = placed.t0 + share / total * T
         out = dataclasses.replace(placed, times=times, durations=np.diff(times))
@@ -76,7 +81,7 @@ def _joint_blend(placed: JointPhase, nxt: Phase | None, ctx: CartesianContext | 
         end = _solve_target(nxt, nq.q[0], ctx, label)
         nq = nq.with_end(end)
     if nxt.speed_pct is not None and robot is not None:
-        nq = _timed_by_speed(nq, robot)
+        nq = _timed_by_speed(nq, robot, label)
     q_p, q_c, q_n = placed.q[-2], placed.q[-1], nq.q[1]
     t_p, t_c, t_n = placed.times[-2], placed.times[-1], nq.times[1]
     d_in, d_out = np.abs(q_c - q_p).max(), np.abs(q_n - q_c).max()
