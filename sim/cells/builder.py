@@ -16,6 +16,7 @@ from sim.cells.compose import (
     suction_actuator_name,
     tip_site_name,
 )
+from sim.cells.mechanisms import tune_gains
 from sim.cells.registry import BARE, tool_from_ref
 from sim.cells.spec import MOUNTS, NO_TOOL, Cell, CellSpec
 from sim.cells.tools import TOOLS, ToolSpec
@@ -118,25 +119,29 @@ def build_cell(cell: CellSpec | None, robot: RobotSpec, *,
     rig = prepare_robot(spec_r, tool_spec, payload)
     layout = cspec.build(rig, mount)
     home_q = layout.home_q if layout.home_q is not None else rig.home_q
-    add_home_keyframe(layout.world, rig, home_q)
+    compiled = add_home_keyframe(layout.world, rig, home_q, layout.mechanisms)
+    if layout.mechanisms:
+        tune_gains(layout.world, layout.mechanisms, compiled)
     p = ROBOT_PREFIX
+    axes = [n for pm in layout.mechanisms for n in pm.joint_names]
+    friction = [a.friction for pm in layout.mechanisms for a in pm.spec.axes]
     return Cell(
         name=cspec.name, robot=spec_r, tool=tool_spec, mount=mount, mjcf=layout.world,
-        joint_names=[f"{p}/{j}" for j in spec_r.joints],
-        actuator_names=[f"{p}/a{i + 1}" for i in range(spec_r.n_joints)],
+        joint_names=[f"{p}/{j}" for j in spec_r.joints] + axes,
+        actuator_names=[f"{p}/a{i + 1}" for i in range(spec_r.n_joints)] + axes,
         tcp_site=f"{p}/tcp", frame0_site=f"{p}/frame0", flange_site=f"{p}/flange",
         seams=layout.seams, parts=layout.parts, slots=layout.slots, cameras=layout.cameras,
         world_from_frame0=layout.world_from_frame0,
         adhesion_actuator=suction_actuator_name(rig), home_q=np.asarray(home_q, float),
         start_q=layout.start_q, payload_kg=payload, tip_site=tip_site_name(rig),
         dims={k: float(v) for k, v in layout.dims.items()}, description=cspec.description,
-        frictionloss=rig.statics.frictionloss.copy(),
+        frictionloss=np.concatenate([rig.statics.frictionloss, friction]),
         objects={name: tuple(g.full_identifier for g in geoms)
                  for name, geoms in layout.objects.items()},
         seam_objects=dict(layout.seam_objects), frames=dict(layout.frames),
         source=cspec.source, _rig=rig,
         rings={name: dict(geoms.params) for name, geoms in layout.objects.items()
-               if isinstance(geoms, Ring)})
+               if isinstance(geoms, Ring)}, mechanisms=layout.mechanisms)
 
 
 __all__ = ["CELL_DEFAULT", "build_cell", "resolve_tool"]

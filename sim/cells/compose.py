@@ -55,6 +55,8 @@ if TYPE_CHECKING:  # MuJoCo and dm_control are imported where a model is made or
     import mujoco
     from dm_control import mjcf
 
+    from sim.cells.mechanisms import PlacedMechanism
+
 ROBOT_PREFIX = "robot"
 #: Name prefix of the robot's friction actuators (``robot/friction_j1``, ...).
 FRICTION_PREFIX = "friction_"
@@ -519,6 +521,7 @@ class Layout:
     objects: dict[str, list[mjcf.Element]] = field(default_factory=dict)
     seam_objects: dict[str, tuple[str, ...]] = field(default_factory=dict)
     frames: dict[str, NDArray[np.float64]] = field(default_factory=dict)
+    mechanisms: tuple[PlacedMechanism, ...] = ()
 
 
 def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
@@ -533,16 +536,20 @@ def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
         raise CellsimError(f"cell model does not compile: {text}") from None
 
 
-def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np.float64]
-                      ) -> mujoco.MjModel:
-    """Add keyframe ``home``: robot at ``home_q``, free bodies where built, suction off."""
+def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np.float64],
+                      mechanisms: tuple[PlacedMechanism, ...] = ()) -> mujoco.MjModel:
+    """Add keyframe ``home``: robot at ``home_q``, the mechanisms at their home, free bodies
+    where built, suction off."""
     import mujoco
 
     m = compile_model(world)
     qpos = m.qpos0.copy()
     ctrl = np.zeros(m.nu)
-    for j, qj in zip(rig.spec.joints, home_q, strict=True):
-        jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{ROBOT_PREFIX}/{j}")
+    values = [(f"{ROBOT_PREFIX}/{j}", qj) for j, qj in zip(rig.spec.joints, home_q, strict=True)]
+    for pm in mechanisms:
+        values += list(zip(pm.joint_names, pm.home, strict=True))
+    for name, qj in values:
+        jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
         qpos[m.jnt_qposadr[jid]] = qj
     for a in range(m.nu):
         if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT:

@@ -88,7 +88,8 @@ def _shipped_cells() -> Iterator[tuple[str, CellSpec]]:
         tools = tuple(TOOLS[t] for t in (first.tools or ()))
         yield name, CellSpec(name, first.description, robots,
                              None if first.tool is None else TOOLS[first.tool], tools, mounts,
-                             build, any_tool=first.tools is None)
+                             build, any_tool=first.tools is None,
+                             mechanisms=tuple(files[0].mechanisms.values()))
 
 
 #: The shipped cells by name, read from ``models/cells/*.toml`` on first use.
@@ -142,7 +143,8 @@ def load_cell(path: str | Path) -> CellSpec:
     return CellSpec(spec.name, spec.description or f"cell file {path.name}", robots,
                     default_tool, tools, (spec.robot.mount,), make_builder(cf), needs_tool=needs,
                     source=path.resolve(), any_tool=spec.tools is None,
-                    any_robot=spec.robot.model is None)
+                    any_robot=spec.robot.model is None,
+                    mechanisms=tuple(cf.mechanisms.values()))
 
 
 def resolve_cell(ref: str, base: Path | None = None) -> CellSpec:

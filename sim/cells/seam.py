@@ -308,6 +308,17 @@ class Seam:
         a_perp = -(np.cos(w) * n + np.sin(w) * e)
         return np.cos(tau) * a_perp + np.sin(tau) * t
 
+    def weld_normal(self, s: float) -> NDArray[np.float64]:
+        """The seam's local normal at ``s``: the torch axis at zero travel angle, reversed
+        (``cos(w) n + sin(w) e``: from the joint out towards the torch, across the seam), world,
+        unit (3,). Welding downhand (flat, 1F/1G) is this normal pointing up."""
+        t = self.tangent(s)
+        n = self.surface_normal - (self.surface_normal @ t) * t
+        n = _unit(n, f"seam {self.name!r}: the surface normal along the seam;")
+        e = self.torch_side * np.cross(n, t)
+        w = np.deg2rad(self.torch_work_angle_deg)
+        return np.cos(w) * n + np.sin(w) * e
+
     def torch_rotation(self, s: float) -> NDArray[np.float64]:
         """Desired tcp rotation at ``s`` in world, (3, 3); see the module docstring for the axes.
 

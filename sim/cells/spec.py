@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.cells.compose import Layout, RobotRig, compile_model
+from sim.cells.mechanisms import PlacedMechanism
 from sim.cells.seam import Seam
 from sim.cells.tools import ToolSpec
 from sim.robots.kinematics.model import KinematicModel
@@ -44,6 +45,8 @@ class CellSpec:
         any_tool: The cell takes any tool (cell files: the scenario chooses).
         any_robot: The cell takes any robot, a robot folder of one's own included (the bare
             scene, a cell file without ``[robot] model``).
+        mechanisms: Its turntables, positioners and tracks (their axes are driven joints after
+            the robot's).
     """
 
     name: str
@@ -57,6 +60,12 @@ class CellSpec:
     source: Path | None = None
     any_tool: bool = False
     any_robot: bool = False
+    mechanisms: tuple[PlacedMechanism, ...] = ()
+
+    @property
+    def axis_names(self) -> tuple[str, ...]:
+        """The mechanisms' axes (``<mechanism>_<axis>``), in order."""
+        return tuple(n for pm in self.mechanisms for n in pm.joint_names)
 
 
 @dataclass
@@ -69,8 +78,9 @@ class Cell:
         tool: The tool, or None.
         mount: ``"floor"`` or ``"ceiling"``.
         mjcf: The composed world (``dm_control`` model).
-        joint_names: Robot joints ``robot/j1..``, in order.
-        actuator_names: Robot position actuators ``robot/a1..``, in order.
+        joint_names: The driven joints: the robot's ``robot/j1..``, then the mechanisms' axes
+            (``positioner_tilt``, ...), in order.
+        actuator_names: Their position actuators (``robot/a1..``, then the axes' names).
         tcp_site, frame0_site, flange_site: Full site names.
         seams: Weld seams in world, by name (in welding order).
         parts: Free-body names (pick cells), in order.
@@ -85,13 +95,16 @@ class Cell:
         tip_site: The tool's own ``tip`` site (coincides with ``tcp_site``), or None.
         dims: Key dimensions for reports (m, deg where the name says so).
         description: The cell's one-line description.
-        frictionloss: Coulomb friction of each robot joint, N m, (n,), applied by the friction
-            actuators ``robot/friction_jN`` (:mod:`sim.cells.compose`).
+        frictionloss: Coulomb friction of each driven joint, N m (N on a linear axis), (n,),
+            applied by the friction actuators ``robot/friction_jN`` (:mod:`sim.cells.compose`)
+            and ``friction_<axis>`` (:mod:`sim.cells.mechanisms`).
         objects: Geom names of each cell object made of several geoms (a ring of staves).
         seam_objects: Objects each seam joins (its workpieces), by seam name.
         frames: Pose in world of each cell object scenario points may be given in, (4, 4).
         source: The cell file the cell came from (None: built in Python).
         rings: Parameters of each object that is a ring of staves (:class:`compose.Ring`).
+        mechanisms: The cell's turntables, positioners and tracks (their axes follow the
+            robot's joints in :attr:`joint_names`).
     """
 
     name: str
@@ -122,7 +135,19 @@ class Cell:
     frames: dict[str, NDArray[np.float64]] = field(default_factory=dict)
     source: Path | None = None
     rings: dict[str, dict] = field(default_factory=dict)
+    mechanisms: tuple[PlacedMechanism, ...] = ()
     _rig: RobotRig | None = field(default=None, repr=False)
+
+    @property
+    def axis_names(self) -> tuple[str, ...]:
+        """The mechanisms' axes, in order (the driven joints after the robot's)."""
+        return tuple(n for pm in self.mechanisms for n in pm.joint_names)
+
+    @property
+    def axis_home(self) -> NDArray[np.float64]:
+        """The mechanisms' axis values at home, rad or m, in :attr:`axis_names` order."""
+        return np.concatenate([pm.home for pm in self.mechanisms]) if self.mechanisms \
+            else np.zeros(0)
 
     def compile(self) -> mujoco.MjModel:
         """Compile the composed world (``mujoco.MjModel`` with keyframe ``home``)."""

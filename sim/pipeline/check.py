@@ -100,7 +100,8 @@ def _singular_passes(built, motion: Motion, dt: float) -> list[Finding]:
     from sim.robots.kinematics.jacobian import singularity_measures
 
     t = np.arange(motion.t0, motion.t1 + 1e-12, dt)
-    m = singularity_measures(built.context.kinematics, motion.at(t).q)
+    kin = built.context.kinematics
+    m = singularity_measures(kin, motion.at(t).q[:, :kin.n_joints])  # the arm's joints
     phase = motion.phase_index(t)
     cartesian = np.array([pm.cartesian is not None for pm in motion.phases])[phase]
     out = []

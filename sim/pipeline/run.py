@@ -47,6 +47,7 @@ from sim.simulation import runfolder
 from sim.simulation.compile import BuiltCell, build
 from sim.simulation.metrics import make_summary
 from sim.simulation.motion import build_motion, check_motion_limits, check_size
+from sim.simulation.motion.axes import world_from_frame0 as frame0_in_world
 from sim.simulation.simulate import simulate
 
 
@@ -264,7 +265,7 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
                 "joints": {j.joint: {"motor": j.chosen.motor.id if j.chosen else None,
                                      "reducer": j.chosen.reducer.id if j.chosen else None}
                            for j in selected.joints}}
-        checks = run_checks(arrays, summary, scenario.robot,
+        checks = run_checks(arrays, summary, scenario.system,
                             scenario.simulation.tracking_tolerance_deg, sizing,
                             clearance_mm=scenario.simulation.clearance_mm,
                             selection=selected,
@@ -420,7 +421,7 @@ def run_and_write(scenario: Scenario, options: RunOptions | None = None) -> Eval
                 summary["record_hz"] = runfolder.sample_rate(saved["t"])
                 runfolder.write_trajectory(tmp, saved)
                 if options.csv:
-                    runfolder.write_csv(tmp, saved, scenario.robot.joints)
+                    runfolder.write_csv(tmp, saved, scenario.system.joints)
                 if sizing is not None:  # last: report.html links the video, shows the verdict
                     from sim.analysis.report import write_sizing
 
@@ -543,7 +544,7 @@ def _size(scenario: Scenario, built: BuiltCell, record: runfolder.RunRecord,
 
     # the compiled model's drive force range and armature are the same drives'
     # (Scenario.drive_train): the joint torque is checked against the drive's own limit
-    result = size_record(record, scenario.robot, scenario.drive_train, built.force_limits,
+    result = size_record(record, scenario.system, scenario.drive_train, built.force_limits,
                          armature=joint_armature(built.model, built.joint_ids))
     summary["sizing"] = {"hardest_joint": result.hardest_joint,
                          "hardest_margin_pct": result.hardest_margin_pct,
@@ -565,8 +566,9 @@ def _check_tcp_consistency(built: BuiltCell, scenario: Scenario) -> None:
     data.qpos[built.robot_qpos] = q
     mujoco.mj_kinematics(model, data)
     site = built.tcp_site
-    T0 = built.context.world_from_frame0
-    T = np.asarray(built.context.kinematics.fk(q), dtype=float)
+    kin = built.context.kinematics
+    T0 = frame0_in_world(built.context, q[kin.n_joints:])  # a track carries frame 0
+    T = np.asarray(kin.fk(q[:kin.n_joints]), dtype=float)
     p_cf = T0[:3, :3] @ T[:3, 3] + T0[:3, 3]
     R_cf = T0[:3, :3] @ T[:3, :3]
     err = float(np.linalg.norm(data.site_xpos[site] - p_cf))

@@ -8,6 +8,8 @@ A spec is built from a robot folder by :mod:`sim.robots.robotfile`; the shipped 
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
@@ -19,6 +21,7 @@ from sim.core.resources import models_dir
 from sim.errors import KinematicsError
 from sim.robots.drive import Drive
 from sim.robots.families import KinematicFamily
+from sim.robots.mechanisms.spec import AxisSpec
 
 
 @dataclass(frozen=True)
@@ -48,6 +51,9 @@ class RobotSpec:
         estimated_links: Per moving link (J1's first), whether its inertial is an estimate
             (a capsule of an estimated mass, ``robot.toml``'s ``[mass] estimated``, a
             ``[[links]]`` entry marked ``estimate``); empty: none is.
+        external: The cell's external axes after the arm's joints, ``(name, axis)`` each
+            (:meth:`with_axes`): the joint names, limits and drives above then cover them too;
+            the kinematics (``family``, the model files) stay the arm's (:attr:`arm`).
     """
 
     name: str
@@ -64,6 +70,40 @@ class RobotSpec:
     maker_joints: tuple[str, ...] = ()
     maker_matrix: tuple[tuple[float, ...], ...] = ()
     estimated_links: tuple[bool, ...] = ()
+    external: tuple[tuple[str, AxisSpec], ...] = ()
+
+    def with_axes(self, axes: Sequence[tuple[str, AxisSpec]]) -> RobotSpec:
+        """The arm with a cell's external axes after its joints (a cell's driven joints):
+        names, speed and acceleration limits, drives and ranges of both; the arm itself when
+        there are none."""
+        if not axes:
+            return self
+        arm = self.arm
+        k = len(axes)
+        accel = arm.max_accel or (np.inf,) * arm.n_joints
+        return dataclasses.replace(
+            arm, joint_names=arm.joints + tuple(n for n, _ in axes),
+            max_speed=arm.max_speed + tuple(float(a.max_speed) for _, a in axes),
+            max_accel=tuple(accel) + tuple(float(a.max_accel) for _, a in axes),
+            drives=arm.drives + tuple(a.drive for _, a in axes) if arm.drives else (),
+            estimated_links=(arm.estimated_links + (False,) * k) if arm.estimated_links else (),
+            external=tuple(axes))
+
+    @property
+    def n_arm(self) -> int:
+        """The arm's joints (without external axes)."""
+        return self.n_joints - len(self.external)
+
+    @property
+    def arm(self) -> RobotSpec:
+        """The robot without external axes."""
+        if not self.external:
+            return self
+        n = self.n_arm
+        return dataclasses.replace(
+            self, joint_names=self.joints[:n], max_speed=self.max_speed[:n],
+            max_accel=self.max_accel[:n] if np.all(np.isfinite(self.max_accel[:n])) else (),
+            drives=self.drives[:n], estimated_links=self.estimated_links[:n], external=())
 
     @property
     def joints_on_estimates(self) -> tuple[str, ...]:
@@ -117,9 +157,14 @@ def joint_ranges(spec: RobotSpec) -> NDArray[np.float64]:
 
     Returns:
         Array of shape (n_joints, 2): lower and upper limit of joints ``j1..jN``, rad, in the
-        seed's convention (MuJoCo qpos equals the seed's joint value).
+        seed's convention (MuJoCo qpos equals the seed's joint value), then those of the
+        external axes (rad or m, from their mechanism files).
     """
-    return np.array(_mjcf_ranges(str(spec.robot_path), spec.joints), dtype=float)
+    arm = spec.arm
+    ranges = np.array(_mjcf_ranges(str(arm.robot_path), arm.joints), dtype=float)
+    if spec.external:
+        ranges = np.vstack([ranges, [a.range for _, a in spec.external]])
+    return ranges
 
 
 __all__ = ["RobotSpec", "joint_ranges"]

@@ -28,13 +28,14 @@ from sim.cells import BARE, resolve_cell, resolve_tool
 from sim.core.files import read_input_text
 from sim.core.resources import shipped_scenarios
 from sim.core.tomlschema import describe
-from sim.errors import CellsimError, ScenarioError
+from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.robots.registry import resolve_robot
 from sim.scenario.fanuc_ls import read_ls
 from sim.scenario.model import Action, HoldPhase, JointPhase, Phase, Scenario
 from sim.scenario.phases import (
     build_cartesian_phase,
     build_joint_phase,
+    check_axes,
     check_continuity,
     with_ctwd,
 )
@@ -155,18 +156,32 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         if not cell.any_robot and robot.name not in cell.robots:
             raise ScenarioError(f"{where}: robot: cell file {cell.source.name} is laid out for "
                                 f"{cell.robots[0]} ([robot] model), not {robot.name}")
+    cell_axes = {} if cell is None else {
+        n: (a.kind, a.range) for pm in cell.mechanisms
+        for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)}
+    tracks = {pm.name for pm in (() if cell is None else cell.mechanisms)
+              if pm.spec.kind == "track"}
+    for i, pspec in enumerate(spec.phases):
+        if isinstance(pspec, JointPhaseSpec):
+            check_axes(pspec.axes, cell_axes, f"{where}: phases[{i}]")
+        elif isinstance(pspec, (LinearPhaseSpec, CircularPhaseSpec)):
+            if pspec.follow is not None and pspec.follow not in tracks:
+                raise ScenarioError(f"{where}: phases[{i}].follow: "
+                                    f"{UnknownNameError('track', pspec.follow, sorted(tracks))}")
     try:
         tool = resolve_tool(BARE if cell is None else cell, spec.tool, base)
     except CellsimError as exc:
         raise ScenarioError(f"{where}: tool: {exc}") from None
     tool_kind = None if tool is None else tool.kind
     drives: dict[str, dict[str, float]] = {}
+    joints = robot.joints + tuple(cell_axes)
     for joint, override in spec.drives.items():
-        if joint not in robot.joints:
-            close = difflib.get_close_matches(joint, robot.joints, n=1)
+        if joint not in joints:
+            close = difflib.get_close_matches(joint, joints, n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
+            axes = f" and the cell's axes {', '.join(cell_axes)}" if cell_axes else ""
             raise ScenarioError(f"{where}: drives.{joint}: unknown joint{hint}; robot "
-                                f"{robot.name} has {', '.join(robot.joints)}")
+                                f"{robot.name} has {', '.join(robot.joints)}{axes}")
         drives[joint] = {k: v for k, v in override.model_dump().items() if v is not None}
     program_warnings: tuple[str, ...] = ()
     actions = []

@@ -47,6 +47,11 @@ class JointPhase:
         speed_pct: Timed by speed (a TP program's ``J ... x%``): the duration makes the peak
             speed of the joint that takes longest ``speed_pct`` times its limit (the knot times
             are then set when the phase is planned).
+        axes: The external axes' values at the phase's end, rad or m, by axis name
+            (``positioner_tilt``); the others hold. The knots are the robot's (``q``); the axes
+            move with them on the phase's one time law (:mod:`sim.simulation.motion.axes`).
+        downhand: With a seam pose target: the positioner carrying the seam ends where the
+            seam's start is welded downhand.
     """
 
     index: int
@@ -61,6 +66,8 @@ class JointPhase:
     blend: float = 0.0
     blend_fraction: float = 0.0
     speed_pct: float | None = None
+    axes: dict[str, float] = field(default_factory=dict)
+    downhand: bool = False
 
     @property
     def t0(self) -> float:
@@ -162,6 +169,10 @@ class CartesianPhase:
         standoff: The pass's own stand-off along ``seam``, m (its ``ctwd_mm`` less the torch's
             nominal stick-out, :mod:`sim.cells.seam`); None: the seam's
             (:meth:`seam_as_welded`).
+        downhand: Along ``seam``: the positioner carrying it turns it so that its local normal
+            points up at the tool point (coordinated motion, :mod:`sim.simulation.motion.axes`).
+        follow: Along ``seam``: the track (a mechanism's name) that carries the robot with
+            the tool point.
     """
 
     index: int
@@ -189,6 +200,8 @@ class CartesianPhase:
     target: "PoseTarget | None" = None
     standoff: float | None = None
     config: tuple | None = None
+    downhand: bool = False
+    follow: str | None = None
 
     def seam_as_welded(self, seam: Seam) -> Seam:
         """The seam this phase welds: ``seam`` (the cell's seam named ``self.seam``) with the
@@ -283,7 +296,17 @@ class Scenario:
         """
         from sim.robots.drives import apply_overrides
 
-        return apply_overrides(self.robot.drives, self.drives, self.robot.joints)
+        system = self.system
+        return apply_overrides(system.drives, self.drives, system.joints)
+
+    @property
+    def system(self) -> RobotSpec:
+        """The cell's driven joints: the robot's, then its mechanisms' axes
+        (:meth:`RobotSpec.with_axes`: names, limits, drives); the robot itself in a cell
+        without mechanisms."""
+        mechanisms = () if self.cell is None else self.cell.mechanisms
+        return self.robot.with_axes([(n, a) for pm in mechanisms
+                                     for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)])
 
     def scaled(self, speed_scale: float = 1.0, payload_kg: float | None = None) -> "Scenario":
         """This scenario run ``speed_scale`` times faster, optionally with another payload.

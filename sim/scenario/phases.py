@@ -159,9 +159,49 @@ def build_joint_phase(index: int, spec: JointPhaseSpec, robot: RobotSpec, where:
     if spec.blend_deg and ("vf" in boundary or "af" in boundary):
         raise ScenarioError(f"{where}.blend_deg: not with end_velocity/end_acceleration (the "
                             "blend sets them)")
+    if spec.downhand and (target is None or target.seam is None):
+        raise ScenarioError(f"{where}.downhand: goes with to_seam (the seam to weld downhand)")
     return JointPhase(index=index, name=spec.name, planner=spec.planner, times=times,
                       durations=durations, q=q, boundary=boundary, target=target,
-                      blend=math.radians(spec.blend_deg or 0.0))
+                      blend=math.radians(spec.blend_deg or 0.0),
+                      axes=_axes_values(spec.axes or {}), downhand=spec.downhand)
+
+
+def _axes_values(values: dict[str, float]) -> dict[str, float]:
+    """A joint phase's ``axes`` in SI, by axis name (the unit suffix dropped; the names and
+    units are checked against the cell by :func:`check_axes`)."""
+    out = {}
+    for key, v in values.items():
+        name, _, unit = key.rpartition("_")
+        out[key] = float(v)
+        out[name] = float(math.radians(v) if unit == "deg" else v * 1e-3)
+        del out[key]
+    return out
+
+
+def check_axes(spec_values: dict[str, float] | None, axes: dict[str, tuple[str, tuple[float, float]]],
+               where: str) -> None:
+    """Check a joint phase's ``axes`` table against the cell's external axes
+    (``name -> (kind, range)``): known names, the unit of each axis's kind, within range.
+
+    Raises:
+        ScenarioError: One line naming ``<phase>.axes.<key>``.
+    """
+    for key, v in (spec_values or {}).items():
+        name, _, unit = key.rpartition("_")
+        if name not in axes:
+            valid = [f"{n}_{'deg' if k == 'revolute' else 'mm'}" for n, (k, _) in axes.items()]
+            hint = ", ".join(valid) if valid else "none: the cell has no mechanisms"
+            raise ScenarioError(f"{where}.axes.{key}: no such external axis; the cell's: {hint}")
+        kind, (lo, hi) = axes[name]
+        want = "deg" if kind == "revolute" else "mm"
+        if unit != want:
+            raise ScenarioError(f"{where}.axes.{key}: axis {name!r} is {kind}; give {name}_{want}")
+        value = math.radians(v) if unit == "deg" else v * 1e-3
+        if not (math.isfinite(value) and lo - 1e-12 <= value <= hi + 1e-12):
+            scale = math.degrees(1.0) if unit == "deg" else 1e3
+            raise ScenarioError(f"{where}.axes.{key}: {v!r} is outside the axis's range "
+                                f"[{lo * scale:g}, {hi * scale:g}] {unit}")
 
 
 def _pose_target(spec: JointPhaseSpec, where: str) -> PoseTarget | None:
@@ -256,13 +296,16 @@ def build_cartesian_phase(index: int, spec: LinearPhaseSpec | CircularPhaseSpec,
     if spec.orientation == "seam" and spec.seam is None and getattr(spec, "to_seam", None) is None:
         raise ScenarioError(f"{where}.orientation: \"seam\" needs a seam to follow (seam = ...)"
                             " or to go to (to_seam = ...)")
+    if (spec.downhand or spec.follow is not None) and spec.seam is None:
+        key = "downhand" if spec.downhand else "follow"
+        raise ScenarioError(f"{where}.{key}: goes with seam (coordinated motion along a seam)")
     common = dict(index=index, name=spec.name, kind=spec.kind, planner=spec.planner,
                   speed=spec.speed_mm_s * 1e-3, sample_period=spec.sample_period_s,
                   ramp=spec.ramp_s, orientation=spec.orientation, seam=spec.seam,
                   euler_zyx=None if spec.euler_zyx_deg is None
                   else np.deg2rad(np.asarray(spec.euler_zyx_deg, dtype=float)),
                   frame=spec.frame, blend=(spec.blend_mm or 0.0) * 1e-3,
-                  weave=_weave(spec, where))
+                  weave=_weave(spec, where), downhand=spec.downhand, follow=spec.follow)
     if spec.seam is not None and spec.frame != "frame0":
         raise ScenarioError(f"{where}.frame: not used with seam (a seam is in its cell)")
     if isinstance(spec, LinearPhaseSpec):

@@ -86,6 +86,10 @@ class JointPhaseSpec(_Strict):
                        '"world" or a cell object')
     blend_deg: float | None = Field(None, ge=0, description="pass the last knot without "
                                     "stopping into the next joint phase, deg")
+    axes: dict[str, float] | None = Field(None, description="external axes' values at the "
+                                          "phase's end: <mechanism>_<axis>_deg or _mm")
+    downhand: bool = Field(False, description="with to_seam: the positioner ends where the "
+                           "seam's start is welded downhand")
     note: PlainText | None = Field(None, description="free text (e.g. which seed value was "
                                    "chosen)")
 
@@ -117,6 +121,10 @@ class _CartesianSpec(_Strict):
     ctwd_mm: float | None = Field(None, gt=0, le=100, description="with seam: the "
                                   "contact-tip-to-work distance of this pass, mm (default: "
                                   "the seam's)")
+    downhand: bool = Field(False, description="with seam: the positioner carrying the seam "
+                           "turns it so that its normal points up while it is welded")
+    follow: str | None = Field(None, description="with seam: a track (its mechanism's name) "
+                               "carries the robot along the seam")
     note: PlainText | None = None
 
 

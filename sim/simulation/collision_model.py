@@ -148,6 +148,13 @@ class CollisionModel:
         parts = set(cell.parts)
         geoms: dict[int, CheckGeom] = {}
         unnamed: dict[int, int] = {}
+        # the robot's base: the bodies welded to its root (the world's on the floor, a track's
+        # carriage when it stands on one)
+        root = next(b for b in range(1, src.nbody) if src.body(b).name.startswith("robot/"))
+        base_weld = int(src.body_weldid[root])
+        moving_cell = {int(src.body_weldid[src.body(f"{pm.name}_{a.name}").id])
+                       for pm in cell.mechanisms for a in pm.spec.axes}
+        moving_cell |= {int(src.body(pm.mount_body).id) for pm in cell.mechanisms}
         for g in range(src.ngeom):
             body = int(src.geom_bodyid[g])
             bname = src.body(body).name
@@ -160,11 +167,11 @@ class CollisionModel:
             elif bname.startswith("robot/"):
                 if src.geom_group[g] == 3:
                     geoms[g] = CheckGeom(g, gname, LINK, bname,
-                                         base=bool(src.body_weldid[body] == 0))
+                                         base=bool(src.body_weldid[body] == base_weld))
             elif bname in parts:
                 geoms[g] = CheckGeom(g, gname, PART, bname)
             elif src.geom_contype[g] | src.geom_conaffinity[g]:
-                if src.body_weldid[body] != 0:
+                if src.body_weldid[body] != 0 and int(src.body_weldid[body]) not in moving_cell:
                     raise InternalError(f"cell body {bname!r} moves but is neither the robot nor "
                                         "a part: collision checks do not cover it")
                 geoms[g] = CheckGeom(g, gname, CELL, object_of.get(gname, gname))
@@ -214,6 +221,17 @@ class CollisionModel:
             if body.name.startswith("robot/") and body.joints and body.parent is not None:
                 ex = spec.add_exclude()
                 ex.bodyname1, ex.bodyname2 = body.parent.name, body.name
+            if (body.name.startswith("robot/") and body.parent is not None
+                    and body.parent.name and not body.parent.name.startswith("robot/")):
+                # a robot standing on a track: its base sits on the carriage (the bodies up to
+                # the carriage's jointed link)
+                up = body.parent
+                while up is not None and up.name and up.name != "world":
+                    ex = spec.add_exclude()
+                    ex.bodyname1, ex.bodyname2 = up.name, body.name
+                    if up.joints:
+                        break
+                    up = up.parent
         try:
             m = spec.compile()
         except ValueError as exc:

@@ -219,9 +219,17 @@ def motion_bound(cm: CollisionModel, samples: MotionSamples, coarse: NDArray[np.
         lo = np.minimum.reduceat(x, starts)
         return np.maximum(hi, x[ends]) - np.minimum(lo, x[ends])
 
+    import mujoco
+
     robot = np.zeros(len(starts))
-    for j, adr in zip(cm.built.joint_ids, cm.built.robot_qpos, strict=True):
-        robot += span(qpos[:, adr]) * cm.reach_from_joint(int(j))
+    cell = np.zeros(len(starts))  # the cell's mechanisms move their solids and what they carry
+    n_arm = cm.built.cell.robot.n_joints
+    for i, (j, adr) in enumerate(zip(cm.built.joint_ids, cm.built.robot_qpos, strict=True)):
+        slide = m.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE  # moves every point as far
+        move = span(qpos[:, adr]) * (1.0 if slide else cm.reach_from_joint(int(j)))
+        robot += move
+        if i >= n_arm:
+            cell += move
     part = np.zeros(len(starts))
     for adr in cm.built.part_qpos:
         body = int(m.jnt_bodyid[np.flatnonzero(m.jnt_qposadr == adr[0])[0]])
@@ -234,7 +242,7 @@ def motion_bound(cm: CollisionModel, samples: MotionSamples, coarse: NDArray[np.
         turn = np.maximum.reduceat(ang, starts)
         turn = np.maximum(turn, ang[ends])
         part = np.maximum(part, move + r * 2.0 * turn)  # any two samples: twice from the start
-    return {LINK: robot, TOOL: robot, PART: part, CELL: np.zeros(len(starts))}
+    return {LINK: robot, TOOL: robot, PART: part, CELL: cell}
 
 
 def _pair_reach(cm: CollisionModel, bounds: dict[str, NDArray[np.float64]],

@@ -34,8 +34,9 @@ class BuiltCell:
         cell: The composed cell.
         model: The compiled ``mujoco.MjModel`` (with the runner's sensors).
         xml: The compiled model as MJCF (``model.xml`` of the run folder).
-        robot_qpos, robot_dof: qpos and dof addresses of the robot joints, in order, (n,).
-        robot_act: Ids of the robot's position actuators, in joint order, (n,).
+        robot_qpos, robot_dof: qpos and dof addresses of the driven joints (the robot's, then
+            the mechanisms' axes: ``cell.joint_names``), in order, (n,).
+        robot_act: Ids of their position actuators, in joint order, (n,).
         suction_act: Id of the suction actuator, or None.
         sensor_slices: Slices of ``sensordata`` by recorded quantity (``tau0..``, ``tcp_pos``,
             ``tcp_quat``).
@@ -143,14 +144,27 @@ def build(scenario: Scenario) -> BuiltCell:
                            world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float),
                            frames=dict(cell.frames), home_q=np.asarray(cell.home_q, float),
                            flange_to_tcp=np.linalg.inv(site_T(fl)) @ site_T(tcp_site),
-                           robot=scenario.robot)
+                           robot=scenario.robot, **_mechanism_context(cell))
     limits = np.where(model.actuator_forcelimited[robot_act, None].astype(bool),
                       model.actuator_forcerange[robot_act] * model.actuator_gear[robot_act, :1],
                       np.array([-np.inf, np.inf]))
     friction = np.array([a for a in range(model.nu)
-                         if model.actuator(a).name.startswith(f"robot/{FRICTION_PREFIX}")], dtype=int)
+                         if model.actuator(a).name.startswith((f"robot/{FRICTION_PREFIX}",
+                                                               FRICTION_PREFIX))], dtype=int)
     return BuiltCell(cell, model, saved_xml, robot_qpos, robot_dof, robot_act, suction, slices,
                      part_qpos, ctx, jids, tcp_site, frame0_site, limits, friction)
+
+
+def _mechanism_context(cell: Cell) -> dict[str, Any]:
+    """What Cartesian phases need of the cell's mechanisms (:class:`CartesianContext`)."""
+    if not cell.mechanisms:
+        return {}
+    carrier = {obj: pm.name for pm in cell.mechanisms for obj in pm.carries if obj != "robot"}
+    return {"mechanisms": tuple(cell.mechanisms),
+            "seam_mechanism": {seam: carrier[objs[0]] for seam, objs in cell.seam_objects.items()
+                               if objs and objs[0] in carrier},
+            "frame_mechanism": {obj: m for obj, m in carrier.items() if obj in cell.frames},
+            "robot_on": next((pm.name for pm in cell.mechanisms if "robot" in pm.carries), None)}
 
 
 def _apply_drive(actuator: Any, joint: Any, drive: Drive) -> None:

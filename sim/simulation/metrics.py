@@ -273,7 +273,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "tool": None if scenario.tool is None else scenario.tool.name,
         "mount": scenario.mount,
         "payload_kg": scenario.payload_kg,
-        "joints": list(scenario.robot.joints),
+        "joints": list(scenario.system.joints),
         "phases": [{"name": pm.name, "kind": pm.kind, "t0": pm.t0, "t1": pm.t1}
                    for pm in motion.phases],
         "duration_s": motion.duration,
@@ -400,7 +400,7 @@ def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built:
         demand = demand + kv * arrays["qd_ref"] + arrays["tau_ff"]
     excess = np.abs(demand) - arrays["tau_limit"]
     t = arrays["t"]
-    joints = built.cell.robot.joints
+    joints = built.cell.robot.joints + built.cell.axis_names
     out = []
     for j, name in enumerate(joints):
         tol = 1e-9 * max(1.0, float(built.force_limits[j, 1]))
@@ -426,7 +426,8 @@ def singularity_summary(arrays: dict[str, NDArray[Any]], motion: Motion, built: 
 
     step = max(1, int(round(0.01 / dt)))
     t = arrays["t"][::step]
-    m = singularity_measures(built.context.kinematics, arrays["q_ref"][::step])
+    kin = built.context.kinematics
+    m = singularity_measures(kin, arrays["q_ref"][::step, :kin.n_joints])  # the arm's joints
     i = int(np.argmin(m["sigma_min"]))
     out: dict[str, Any] = {"min_sigma": float(m["sigma_min"][i]), "t": float(t[i]),
                            "phase": motion.phases[int(np.atleast_1d(motion.phase_index(t[i]))[0])].name,

@@ -426,9 +426,16 @@ def _arrays(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
     saturated = np.abs(tau_act) >= hi * (1 - 1e-9)
     tau = np.where(saturated, tau_act, tau_act - h * kv * qdd_sim)
     kin = built.context.kinematics
-    T0 = built.context.world_from_frame0
-    poses = np.asarray(kin.fk(ref.q[:n]), dtype=float).reshape(n, 4, 4)
-    tcp_ref = poses[:, :3, 3] @ T0[:3, :3].T + T0[:3, 3]
+    nr = kin.n_joints  # the arm's joints; the external axes follow them
+    poses = np.asarray(kin.fk(ref.q[:n, :nr]), dtype=float).reshape(n, 4, 4)
+    if nj > nr:  # a track carries frame 0
+        from sim.simulation.motion.axes import world_from_frame0
+
+        W = world_from_frame0(built.context, ref.q[:n, nr:])
+        tcp_ref = np.einsum("nij,nj->ni", W[:, :3, :3], poses[:, :3, 3]) + W[:, :3, 3]
+    else:
+        T0 = built.context.world_from_frame0
+        tcp_ref = poses[:, :3, 3] @ T0[:3, :3].T + T0[:3, 3]
     out: dict[str, NDArray[Any]] = {
         "t": t,
         "phase": motion.phase_index(t).astype(np.int32),

@@ -21,6 +21,7 @@ from sim.cells.compose import (
     new_world,
     quat_from_matrix,
 )
+from sim.cells.mechanisms import CONTACT_MOVING, add_mechanism
 from sim.cells.seam import Seam
 from sim.cells.tools import CONTACT_FIXTURE, CONTACT_PART_AFFINITY, CONTACT_PART_TYPE
 from sim.errors import CellError, CellsimError
@@ -37,14 +38,21 @@ def _look(b: ObjectBlock, default: str) -> dict:
     return {"material": b.material or default}
 
 
-def _add_static(world, b: ObjectBlock, solid: Solid, material: str) -> list:
+def _add_static(world, b: ObjectBlock, solid: Solid, material: str, body=None,
+                pose: NDArray[np.float64] | None = None) -> list:
     """A fixture's or workpiece's geoms, placed in the world body at the object's pose (static
-    geometry, as the shipped cells have it); returns the geoms that collide."""
-    T = solid.pose
+    geometry, as the shipped cells have it), or in ``body`` (a mechanism's mount) at ``pose``
+    in it, with the object's mass (``mass_kg``, else solid steel); returns the geoms that
+    collide."""
+    T = solid.pose if pose is None else pose
     bits = CONTACT_FIXTURE if b.collide else 0
-    wb = world.worldbody
+    wb = world.worldbody if body is None else body
     look = _look(b, material)
     common = dict(contype=bits, conaffinity=bits, **_friction(b))
+    if body is not None:  # carried by a mechanism: its mass and inertia count
+        common.update(_carried_mass(b, solid))
+        if b.collide:
+            common.update(CONTACT_MOVING)
     R, t = T[:3, :3], T[:3, 3]
     quat = {} if np.array_equal(R, np.eye(3)) else {"quat": quat_from_matrix(R)}
     if b.shape == "box":
@@ -73,12 +81,16 @@ def _add_static(world, b: ObjectBlock, solid: Solid, material: str) -> list:
                 g.rgba = look["rgba"]
             if b.friction is not None:
                 g.friction = common["friction"]
+            if "density" in common:
+                g.density = common["density"]
+            if body is not None and b.collide:
+                g.contype, g.conaffinity = CONTACT_MOVING["contype"], CONTACT_MOVING["conaffinity"]
         return list(staves) if b.collide else []
     assert solid.verts is not None and solid.faces is not None
     vis = world.asset.add("mesh", name=f"{b.name}_visual", vertex=solid.verts.ravel(),
                           face=solid.faces.ravel(), inertia="shell")
     wb.add("geom", name=f"{b.name}_visual", type="mesh", mesh=vis, pos=t, **quat,
-           contype=0, conaffinity=0, group=1, **look)
+           contype=0, conaffinity=0, group=1, **look, **({} if body is None else {"mass": 0.0}))
     geoms = []
     if b.collide:
         for k, pc in enumerate(solid.pieces):
@@ -86,6 +98,37 @@ def _add_static(world, b: ObjectBlock, solid: Solid, material: str) -> list:
             geoms.append(wb.add("geom", name=f"{b.name}_c{k}", type="mesh", mesh=mesh, pos=t,
                                 **quat, group=3, rgba=(0.5, 0.5, 0.5, 0.3), **common))
     return geoms
+
+
+#: Density of a carried object given no ``mass_kg`` (solid steel), kg/m^3.
+STEEL_DENSITY = 7850.0
+
+
+def _carried_mass(b: ObjectBlock, solid: Solid) -> dict:
+    """MJCF mass keys of a carried object's geoms: uniform density, its ``mass_kg`` spread over
+    its volume (else steel)."""
+    if b.mass_kg is None:
+        return {"density": STEEL_DENSITY}
+    return {"density": float(b.mass_kg) / _volume(b, solid)}
+
+
+def _volume(b: ObjectBlock, solid: Solid) -> float:
+    """The volume MuJoCo gives the object's collision geoms, m^3."""
+    if b.shape == "box":
+        return float(np.prod(np.asarray(b.size_mm) * 1e-3))
+    if b.shape == "cylinder":
+        return float(np.pi * (b.radius_mm * 1e-3) ** 2 * b.length_mm * 1e-3)
+    if b.shape == "sphere":
+        return float(4.0 / 3.0 * np.pi * (b.radius_mm * 1e-3) ** 3)
+    if b.shape == "ring":  # its staves (compose.add_ring): n boxes
+        n = b.segments or 72
+        a0, a1 = np.deg2rad(b.arc_deg) if b.arc_deg is not None else (0.0, 2 * np.pi)
+        r_in, r_out = b.inner_radius_mm * 1e-3, b.radius_mm * 1e-3
+        half_w = r_out * np.tan((a1 - a0) / n / 2.0)
+        return float(n * (r_out - r_in) * 2 * half_w * b.length_mm * 1e-3)
+    from scipy.spatial import ConvexHull
+
+    return float(sum(ConvexHull(pc).volume for pc in solid.pieces))
 
 
 def _add_part(world, b: ObjectBlock, solid: Solid) -> None:
@@ -158,9 +201,17 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
     T_base = cf.base_pose
     world = new_world(f"{spec.name}_{rig.spec.name}", center=tuple(T_base[:3, 3]),
                       extent=3.0 * rig.max_distance_from_frame0())
-    frame = world.worldbody.attach(rig.model)
-    frame.pos = T_base[:3, 3]
-    frame.quat = quat_from_matrix(T_base[:3, :3])
+    mounts = {name: add_mechanism(world, pm) for name, pm in cf.mechanisms.items()}
+    if cf.robot_on is None:
+        frame = world.worldbody.attach(rig.model)
+        frame.pos = T_base[:3, 3]
+        frame.quat = quat_from_matrix(T_base[:3, :3])
+    else:  # on a track's carriage
+        assert cf.robot_local is not None
+        L = cf.robot_local
+        site = mounts[cf.robot_on].add("site", name="robot_base", pos=L[:3, 3],
+                                       quat=quat_from_matrix(L[:3, :3]), size=[0.01], group=4)
+        site.attach(rig.model)
     T0 = T_base @ rig.statics.base_from_frame0
     objects: dict[str, list] = {}
     parts: list[str] = []
@@ -172,7 +223,10 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
             _add_part(world, b, solid)
             parts.append(name)
         else:
-            geoms = _add_static(world, b, solid, ROLE_MATERIAL[b.role])
+            on = cf.mounted.get(name)
+            geoms = (_add_static(world, b, solid, ROLE_MATERIAL[b.role]) if on is None
+                     else _add_static(world, b, solid, ROLE_MATERIAL[b.role], mounts[on[0]],
+                                      on[1]))
             if len(geoms) > 1 or (geoms and geoms[0].name != name):
                 objects[name] = geoms
     seams: dict[str, Seam] = {}
@@ -251,7 +305,8 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
     return Layout(world=world, world_from_frame0=T0, seams=seams, parts=parts,
                   slots=np.array(slots).reshape(-1, 3), cameras=cams, start_q=start_q,
                   home_q=home_q, dims=dims, objects=objects,
-                  seam_objects=seam_objects, frames=frames)
+                  seam_objects=seam_objects, frames=frames,
+                  mechanisms=tuple(cf.mechanisms.values()))
 
 
 class FileBuilder:

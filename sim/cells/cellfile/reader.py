@@ -4,7 +4,8 @@ every problem is one line naming the file and the key."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,7 @@ from sim.cells.cellfile.schema import (
 )
 from sim.cells.cellfile.seams import ctwd_key, seam_in_world, seam_points
 from sim.cells.cellfile.solids import Solid, geom_names, object_pose, read_solid
+from sim.cells.mechanisms import PlacedMechanism
 from sim.core.tomlschema import load_toml
 from sim.errors import CellError, CellsimError, UnknownNameError
 
@@ -28,9 +30,15 @@ class CellFile:
     """A checked cell file (what the builder needs besides the robot).
 
     Attributes:
-        path: The file. spec: Its validated content. solids: Its objects by name.
-        base_pose: The robot base frame in world (mount included), (4, 4).
+        path: The file. spec: Its validated content. solids: Its objects by name (an object
+            on a mechanism at the mechanism's home).
+        base_pose: The robot base frame in world (mount included; on a track: at the track's
+            home), (4, 4).
         default_tool: The default tool reference as written (resolved by :mod:`sim.cells`).
+        mechanisms: The placed mechanisms by name, in the file's order.
+        mounted: Objects on a mechanism: ``name -> (mechanism, pose in its mount frame)``.
+        robot_on: The mechanism the robot's base stands on (a track), or None.
+        robot_local: The robot base frame in that mechanism's mount frame, (4, 4).
     """
 
     path: Path
@@ -38,6 +46,10 @@ class CellFile:
     solids: dict[str, Solid]
     base_pose: NDArray[np.float64]
     default_tool: object = None  # the resolved ``tool`` (a ToolSpec), set by sim.cells
+    mechanisms: dict[str, PlacedMechanism] = field(default_factory=dict)
+    mounted: dict[str, tuple[str, NDArray[np.float64]]] = field(default_factory=dict)
+    robot_on: str | None = None
+    robot_local: NDArray[np.float64] | None = None
 
     @property
     def where(self) -> str:
@@ -55,13 +67,33 @@ def read_cell_file(path: str | Path) -> CellFile:
     path = Path(path)
     spec, _ = load_toml(path, CellFileSpec, CellError)
     where = str(path)
+    mechanisms = read_mechanisms(spec, path)
     solids: dict[str, Solid] = {}
+    mounted: dict[str, tuple[str, NDArray[np.float64]]] = {}
     for i, ob in enumerate(spec.objects):
-        if ob.name in solids or ob.name in RESERVED:
+        if ob.name in solids or ob.name in RESERVED or ob.name in mechanisms:
             what = (f"is already the name of objects[{solids[ob.name].index}]"
-                    if ob.name in solids else "is reserved")
+                    if ob.name in solids else "is a mechanism's name" if ob.name in mechanisms
+                    else "is reserved")
             raise CellError(f"{where}: objects[{i}].name: {ob.name!r} {what}")
-        solids[ob.name] = read_solid(ob, i, path.parent, where)
+        solid = read_solid(ob, i, path.parent, where)
+        if ob.on is not None:
+            if ob.on not in mechanisms:
+                raise CellError(f"{where}: objects[{i}].on: "
+                                f"{UnknownNameError('mechanism', ob.on, list(mechanisms))}")
+            if ob.role == "part":
+                raise CellError(f"{where}: objects[{i}].on: a part is a free body; only "
+                                "fixtures and workpieces are mounted on a mechanism")
+            pm = mechanisms[ob.on]
+            mounted[ob.name] = (ob.on, solid.pose.copy())
+            solid.pose = pm.mount_in_world(pm.home) @ solid.pose
+        solids[ob.name] = solid
+    for pm in mechanisms.values():
+        names = set(pm.joint_names) | {pm.name, pm.mount_body}
+        clash = sorted(names & set(solids))
+        if clash:
+            raise CellError(f"{where}: objects[{solids[clash[0]].index}].name: {clash[0]!r} is "
+                            f"a name of mechanism {pm.name!r}'s model; rename the object")
     owner: dict[str, int] = {}  # every geom name the objects become -> the object's index
     for sd in solids.values():
         for g in geom_names(sd.block, len(sd.pieces)):
@@ -152,6 +184,14 @@ def read_cell_file(path: str | Path) -> CellFile:
     base = object_pose(rb.base_pos_mm, rb.base_euler_zyx_deg)
     if rb.mount == "ceiling":  # a half turn about the base's x axis (exact)
         base[:3, :3] = base[:3, :3] @ np.diag([1.0, -1.0, -1.0])
+    robot_local = None
+    if rb.on is not None:
+        if rb.on not in mechanisms:
+            raise CellError(f"{where}: robot.on: "
+                            f"{UnknownNameError('mechanism', rb.on, list(mechanisms))}")
+        pm = mechanisms[rb.on]
+        robot_local = base
+        base = pm.mount_in_world(pm.home) @ base
     for s in solids.values():
         if s.block.role == "part" or not s.block.collide:
             continue
@@ -160,7 +200,60 @@ def read_cell_file(path: str | Path) -> CellFile:
             raise CellError(f"{where}: robot.base_pos_mm: the robot base {rb.base_pos_mm} mm is "
                             f"{-d * 1e3:.1f} mm inside {s.block.role} {s.block.name!r} "
                             f"(objects[{s.index}]); stand it on the object, not in it")
-    return CellFile(path=path, spec=spec, solids=solids, base_pose=base)
+    carried: dict[str, list[str]] = {name: [] for name in mechanisms}
+    for obj, (mech, _) in mounted.items():
+        carried[mech].append(obj)
+    if rb.on is not None:
+        carried[rb.on].append("robot")
+    mechanisms = {name: dataclasses.replace(pm, carries=tuple(carried[name]))
+                  for name, pm in mechanisms.items()}
+    return CellFile(path=path, spec=spec, solids=solids, base_pose=base, mechanisms=mechanisms,
+                    mounted=mounted, robot_on=rb.on, robot_local=robot_local)
 
 
-__all__ = ["CellFile", "read_cell_file"]
+def read_mechanisms(spec: CellFileSpec, path: Path) -> dict[str, PlacedMechanism]:
+    """The cell file's ``[[mechanisms]]`` placed (their files read, their home values checked).
+
+    Raises:
+        CellError: One line naming the file and the key: a duplicate or reserved name, an
+            unknown mechanism or a bad mechanism file, a home value for an axis the mechanism
+            lacks, in the wrong unit or outside the axis's range.
+    """
+    from sim.robots.mechanisms.registry import mechanism_from_ref
+
+    where = str(path)
+    out: dict[str, PlacedMechanism] = {}
+    for i, mb in enumerate(spec.mechanisms):
+        key = f"{where}: mechanisms[{i}]"
+        if mb.name in out or mb.name in RESERVED:
+            what = "is already a mechanism's name" if mb.name in out else "is reserved"
+            raise CellError(f"{key}.name: {mb.name!r} {what}")
+        try:
+            mech = mechanism_from_ref(mb.model, path.parent)
+        except CellsimError as exc:
+            raise CellError(f"{key}.model: {exc}") from None
+        home = np.zeros(mech.n_axes)
+        units = {a.name: ("deg" if a.kind == "revolute" else "mm") for a in mech.axes}
+        for k, v in mb.home.items():
+            axis, _, unit = k.rpartition("_")
+            if axis not in units:
+                valid = [f"{a}_{u}" for a, u in units.items()]
+                raise CellError(f"{key}.home.{k}: {UnknownNameError('axis', k, valid)}")
+            if unit != units[axis]:
+                raise CellError(f"{key}.home.{k}: axis {axis!r} is "
+                                f"{'revolute' if units[axis] == 'deg' else 'prismatic'}; give "
+                                f"{axis}_{units[axis]}")
+            j = mech.axis_names.index(axis)
+            value = float(np.deg2rad(v) if unit == "deg" else v * 1e-3)
+            lo, hi = mech.axes[j].range
+            if not (np.isfinite(value) and lo - 1e-12 <= value <= hi + 1e-12):
+                shown = np.rad2deg([lo, hi]) if unit == "deg" else np.multiply([lo, hi], 1e3)
+                raise CellError(f"{key}.home.{k}: {v!r} is outside the axis's range "
+                                f"[{shown[0]:g}, {shown[1]:g}] {unit}")
+            home[j] = value
+        pose = object_pose(mb.pos_mm, mb.euler_zyx_deg)
+        out[mb.name] = PlacedMechanism(name=mb.name, spec=mech, pose=pose, home=home)
+    return out
+
+
+__all__ = ["CellFile", "read_cell_file", "read_mechanisms"]

@@ -71,6 +71,7 @@ class RobotBlock(Strict):
     mount: Literal["floor", "ceiling"] = "floor"
     home_deg: list[float] | None = None
     start_deg: list[float] | None = None
+    on: str | None = None
 
 
 class ObjectBlock(Strict):
@@ -94,6 +95,7 @@ class ObjectBlock(Strict):
     material: Literal[MATERIALS] | None = None  # type: ignore[valid-type]
     friction: FRICTION.type | None = None
     collide: bool = True
+    on: str | None = None
 
 
 class SeamBlock(Strict):
@@ -131,6 +133,16 @@ class CameraBlock(Strict):
     fovy_deg: float = Field(45.0, gt=1, lt=170)
 
 
+class MechanismBlock(Strict):
+    """``[[mechanisms]]``: a turntable, positioner or track placed in the cell."""
+
+    name: str = Field(pattern=_NAME)
+    model: str
+    pos_mm: list[Mm] = _vec3([0.0, 0.0, 0.0])
+    euler_zyx_deg: list[Deg] = _vec3([0.0, 0.0, 0.0])
+    home: dict[str, float] = {}
+
+
 class CellFileSpec(Strict):
     """Top level of a cell file."""
 
@@ -144,6 +156,7 @@ class CellFileSpec(Strict):
     slots: list[SlotBlock] = []
     cameras: list[CameraBlock] = []
     dims: dict[str, float] = {}
+    mechanisms: list[MechanismBlock] = []
 
 
-__all__ = ["CameraBlock", "CellFileSpec", "ObjectBlock", "RobotBlock", "SeamBlock", "SlotBlock"]
+__all__ = ["CameraBlock", "CellFileSpec", "MechanismBlock", "ObjectBlock", "RobotBlock", "SeamBlock", "SlotBlock"]

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from sim.errors import ScenarioError
 from sim.scenario import CartesianPhase, HoldPhase, JointPhase, Scenario, plan_phase
+from sim.simulation.motion import axes
 from sim.simulation.motion.blending import (
     _blends,
     _check_seam_blends,
@@ -45,6 +46,14 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     phases: list[PhaseMotion] = []
     t = 0.0
     q = None
+    system = scenario.system
+    joints = system.joints
+    # a cell with external axes: the joint vector is the robot's joints, then the axes
+    # (sim.simulation.motion.axes); n is the robot's share of it
+    n_axes = 0 if context is None else context.n_axes
+    n = system.n_joints - n_axes
+    if n_axes and context is not None:
+        q_axes_home = np.concatenate([pm.home for pm in context.mechanisms])
     todo = list(scenario.phases)
     pending: tuple[NDArray[np.float64], dict[str, NDArray[np.float64]],
                    NDArray[np.float64] | None] | None = None
@@ -64,11 +73,18 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
                 raise ScenarioError(f"{label}.blend_mm: the next phase is not a linear or "
                                     "circular move to blend into (leave blend_mm out)")
             labels = [f"{where}: phases[{ph.index}] ({ph.name})" for ph in group]
-            for pm, lb in zip(_plan_blended(group, t, q, context, labels), labels,
-                              strict=True):
+            if n_axes:
+                assert q is not None
+                _no_coordination(group, labels)
+                ctx_p = axes.posed(context, q[n:])
+                planned = [axes.held(pm, q[n:]) for pm in
+                           _plan_blended(group, t, q[:n], ctx_p, labels)]
+            else:
+                ctx_p, planned = context, _plan_blended(group, t, q, context, labels)
+            for pm, lb in zip(planned, labels, strict=True):
                 if phases:
-                    _check_phase_continuity(phases[-1], pm, label, scenario.robot.joints)
-                _check_end_config(pm, context, lb)
+                    _check_phase_continuity(phases[-1], pm, label, joints)
+                _check_end_config(_robot_part(pm, n), ctx_p, lb)
                 phases.append(pm)
             t = phases[-1].t1
             q = phases[-1].trajectory.at(phases[-1].t1).q
@@ -81,6 +97,17 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
                 qs[0] = context.home_q
                 phase = dataclasses.replace(phase, q=qs)
                 q = np.asarray(context.home_q, dtype=float)
+                if n_axes:
+                    q = np.concatenate([q, q_axes_home])
+            if n_axes:
+                pm = _joint_phase_with_axes(phase, t, q, n, q_axes_home, context, system, label,
+                                            todo)
+                if phases:
+                    _check_phase_continuity(phases[-1], pm, label, joints)
+                phases.append(pm)
+                t = pm.t1
+                q = pm.trajectory.at(pm.t1).q
+                continue
             placed = phase.with_start(t, q)
             solved_end = None
             if pending is not None:  # the previous joint phase blends into this one
@@ -108,18 +135,58 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
         elif isinstance(phase, CartesianPhase):
             if context is None:
                 raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
-            pm = _plan_cartesian(phase, t, q, context, label)
-            _check_end_config(pm, context, label)
+            if n_axes and (phase.downhand or phase.follow is not None):
+                pm = axes.plan_coordinated(phase, t, q, context, label)
+            elif n_axes:
+                ctx_p = axes.posed(context, q[n:])
+                pm = _plan_cartesian(phase, t, q[:n], ctx_p, label)
+                _check_end_config(pm, ctx_p, label)
+                pm = axes.held(pm, q[n:])
+            else:
+                pm = _plan_cartesian(phase, t, q, context, label)
+                _check_end_config(pm, context, label)
         else:  # pragma: no cover - the loader only makes the kinds above
             raise ScenarioError(f"{label}: unknown phase kind {phase.kind!r}")
         if phases:
-            _check_phase_continuity(phases[-1], pm, label, scenario.robot.joints)
+            _check_phase_continuity(phases[-1], pm, label, joints)
         phases.append(pm)
         t = pm.t1
         q = pm.trajectory.at(pm.t1).q
-    motion = Motion(phases=phases, actions=[], n_joints=scenario.robot.n_joints)
+    motion = Motion(phases=phases, actions=[], n_joints=system.n_joints)
     motion.actions = _resolve_actions(scenario, motion)
     return motion
+
+
+def _robot_part(pm: PhaseMotion, n: int) -> PhaseMotion:
+    """A phase with held axes as the robot's alone (for the checks of its arm)."""
+    traj = pm.trajectory
+    return dataclasses.replace(pm, trajectory=traj.robot) if isinstance(traj, axes.HeldAxes) \
+        else pm
+
+
+def _no_coordination(group: list, labels: list[str]) -> None:
+    for ph, lb in zip(group, labels, strict=True):
+        if ph.downhand or ph.follow is not None:
+            key = "downhand" if ph.downhand else "follow"
+            raise ScenarioError(f"{lb}.{key}: not with blend_mm or a polyline seam (coordinated "
+                                "motion welds one line or arc seam per phase)")
+
+
+def _joint_phase_with_axes(phase: JointPhase, t: float, q: NDArray[np.float64] | None, n: int,
+                           q_axes_home: NDArray[np.float64], context: CartesianContext,
+                           system: object, label: str, todo: list) -> PhaseMotion:
+    """A joint phase in a cell with external axes (:func:`axes.joint_with_axes`)."""
+    if phase.blend > 0 or phase.blend_fraction > 0:
+        raise ScenarioError(f"{label}.blend_deg: not yet in a cell with external axes (stop "
+                            "at the phase's last knot)")
+    qe = q_axes_home if q is None else q[n:]
+    placed = phase.with_start(t, None if q is None else q[:n])
+    placed = axes.joint_with_axes(placed, qe, context, tuple(system.joints[n:]), label,
+                                  _solve_target)
+    if phase.speed_pct is not None:
+        placed = _timed_by_speed(placed, system, label)
+    traj = plan_phase(placed, "")
+    return PhaseMotion(placed, placed.t0, placed.t1, traj, knot_times=placed.times.copy())
 
 
 def _resolve_actions(scenario: Scenario, motion: Motion) -> list[tuple[float, str]]:

@@ -56,7 +56,8 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
     from planners.limits import find_limit_violations
     from sim.robots.registry import joint_ranges
 
-    rng = joint_ranges(scenario.robot)
+    system = scenario.system  # the robot's joints and the cell's external axes
+    rng = joint_ranges(system)
     where = scenario.source.name
     # blended phases share one trajectory: each trajectory is checked once (once per phase
     # made the check grow as the square of the number of blended moves) and a violation is
@@ -69,10 +70,10 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
     for group in groups.values():
         found = find_limit_violations(
             group[0].trajectory, lower=rng[:, 0], upper=rng[:, 1],
-            max_velocity=np.asarray(scenario.robot.max_speed) if speed else None,
-            max_acceleration=(np.asarray(scenario.robot.max_accel)
-                              if accel and scenario.robot.max_accel else None),
-            joint_names=scenario.robot.joints)
+            max_velocity=np.asarray(system.max_speed) if speed else None,
+            max_acceleration=(np.asarray(system.max_accel)
+                              if accel and system.max_accel else None),
+            joint_names=system.joints)
         for v in found:
             pm = next((p for p in group if p.t0 <= v.time <= p.t1), group[0])
             out.append(f"{where}: phases[{pm.phase.index}] ({pm.name}): {v.message()}")

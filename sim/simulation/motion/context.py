@@ -30,6 +30,15 @@ class CartesianContext:
         flange_to_tcp: The tcp in the flange frame, (4, 4) (a TP program's UT 0 poses are the
             flange's).
         robot: The robot's registry entry (its maker's joint convention, for TP CONFIG).
+        mechanisms: The cell's turntables, positioners and tracks
+            (:class:`sim.cells.mechanisms.PlacedMechanism`); their axes follow the robot's
+            joints in the motion's joint vector (:mod:`sim.simulation.motion.axes`). Seams,
+            frames and ``world_from_frame0`` above are at the mechanisms' home.
+        seam_mechanism: The mechanism carrying each seam's object, by seam name.
+        frame_mechanism: The mechanism carrying each object, by object name.
+        robot_on: The mechanism (a track) carrying the robot's base, or None.
+        moving: For a context posed at some axis values (:func:`~sim.simulation.motion.axes.posed`):
+            the cell's own context (at home, with its mechanisms); None otherwise.
     """
 
     kinematics: Any
@@ -39,6 +48,16 @@ class CartesianContext:
     home_q: NDArray[np.float64] | None = None
     flange_to_tcp: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     robot: Any = None
+    mechanisms: tuple[Any, ...] = ()
+    seam_mechanism: dict[str, str] = field(default_factory=dict)
+    frame_mechanism: dict[str, str] = field(default_factory=dict)
+    robot_on: str | None = None
+    moving: Any = None
+
+    @property
+    def n_axes(self) -> int:
+        """The external axes after the robot's joints in the joint vector."""
+        return sum(pm.spec.n_axes for pm in self.mechanisms)
 
     def frame0_from(self, frame: str, label: str) -> NDArray[np.float64]:
         """Pose of a named frame in frame 0, (4, 4): ``frame0`` (the robot's), ``world`` or a
