@@ -31,6 +31,11 @@ class KinematicsError(CellsimError):
     """Base class of kinematics errors."""
 
 
+class MechanismError(KinematicsError):
+    """A mechanism file (turntable, positioner, track) is malformed; the message names the file
+    and the key."""
+
+
 class HoldError(KinematicsError):
     """A robot's drives cannot hold the arm against gravity somewhere in its joint ranges.
 
@@ -82,7 +87,7 @@ class RenderError(CellsimError):
 
 __all__ = [
     "CellError", "CellsimError", "CellsimWarning", "InternalError", "KinematicsError",
-    "PlannerError", "RenderError", "RunFolderError", "ScenarioError", "SimulationError",
-    "SingularityWarning", "SweepError", "UnknownNameError", "UnreachableError",
-    "UsageError",
+    "MechanismError", "PlannerError", "RenderError", "RunFolderError", "ScenarioError",
+    "SimulationError", "SingularityWarning", "SweepError", "UnknownNameError",
+    "UnreachableError", "UsageError",
 ]
