@@ -57,6 +57,10 @@ from sim.robots.mechanisms.spec import AxisSpec, LinkSpec, MechanismSpec, Shape
 #: The file name of a mechanism folder (``models/positioners/<name>/mechanism.toml``).
 MECHANISM_FILE = "mechanism.toml"
 
+#: The narrowest range an axis may have, deg or mm (a narrower one is a typo; in SI units it
+#: could vanish altogether).
+MIN_RANGE = 1e-3
+
 #: Axes a mechanism of each kind has: ``(kind of every axis, fewest, most)``.
 KIND_AXES: dict[str, tuple[str, int, int]] = {
     "turntable": ("revolute", 1, 1),
@@ -125,9 +129,13 @@ def _axis(block: AxisBlock, where: str, key: str, shape_names: set[str]) -> Axis
                         f"required for a {block.kind} axis")
     scale = math.pi / 180.0 if block.kind == "revolute" else 1e-3
     lower, upper = getattr(block, units["range"])
+    unit = "deg" if block.kind == "revolute" else "mm"
     if not lower < upper:
         raise _fail(where, f"{key}.{units['range']}",
                     f"lower {lower:g} must be below upper {upper:g}")
+    if upper - lower < MIN_RANGE * (1 - 1e-6):  # rounding: 1.001 - 1.0 is 0.000999...
+        raise _fail(where, f"{key}.{units['range']}", f"[{lower!r}, {upper!r}]: the range must "
+                    f"be at least {MIN_RANGE:g} {unit} wide (the axis could not move)")
     friction = getattr(block, units["friction"])
     d = block.drive
     if d.peak_torque_nm < d.rated_torque_nm:
@@ -213,4 +221,4 @@ def _rotation(euler_zyx_deg: list[float]) -> NDArray[np.float64]:
     return np.asarray(euler_zyx_to_matrix(a, b, c), dtype=float)
 
 
-__all__ = ["KIND_AXES", "MECHANISM_FILE", "read_mechanism"]
+__all__ = ["KIND_AXES", "MECHANISM_FILE", "MIN_RANGE", "read_mechanism"]
