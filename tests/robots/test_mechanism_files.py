@@ -393,6 +393,46 @@ def test_a_bad_value_is_one_line_naming_the_file_the_key_and_the_value(
     assert isinstance(err.value, CellsimError) and not isinstance(err.value, InternalError)
 
 
+def _numbers(node: Any, loc: tuple[Any, ...] = ()) -> list[tuple[tuple[Any, ...], float]]:
+    """Every number of a parsed TOML table with its location."""
+    if isinstance(node, dict):
+        return [x for k, v in node.items() for x in _numbers(v, (*loc, k))]
+    if isinstance(node, list):
+        return [x for i, v in enumerate(node) for x in _numbers(v, (*loc, i))]
+    if isinstance(node, (int, float)) and not isinstance(node, bool):
+        return [(loc, float(node))]
+    return []
+
+
+def test_every_number_of_a_shipped_file_is_refused_just_outside_its_range(tmp_path):
+    """Each numeric key of every shipped file, set just below and just above the range its
+    quantity declares (``docs/mechanism-format.md``, Numbers), is one line naming that key."""
+    import tomllib
+
+    from sim.core.tomlschema import format_loc, quantity_at
+    from sim.robots.mechanisms.schema import MechanismFile
+
+    checked = 0
+    for spec in MECHANISMS.values():
+        raw = tomllib.loads(Path(spec.source).read_text(encoding="utf-8"))
+        for loc, _ in _numbers(raw):
+            q = quantity_at(MechanismFile, loc)
+            assert q is not None, f"{spec.name}: {format_loc(loc)} has no declared range"
+            for bad in (q.lo - max(1.0, abs(q.lo)), q.hi + max(1.0, abs(q.hi))):
+                doc = tomllib.loads(Path(spec.source).read_text(encoding="utf-8"))
+                node: Any = doc
+                for part in loc[:-1]:
+                    node = node[part]
+                node[loc[-1]] = bad
+                file = write(tmp_path, doc, "edge.toml")
+                with pytest.raises(MechanismError) as err:
+                    read_mechanism(file)
+                assert str(err.value).startswith(f"{file}: {format_loc(loc)}: must be between")
+                assert repr(bad) in str(err.value)
+                checked += 1
+    assert checked > 100
+
+
 def test_a_prismatic_axis_refuses_the_revolute_keys(tmp_path):
     doc = _base_doc()
     doc["kind"] = "track"
