@@ -199,10 +199,12 @@ def _shapes(blocks: list[ShapeBlock], where: str, key: str, prefix: str,
             if s.size_mm is not None:
                 raise _fail(where, f"{k}.size_mm", "a cylinder takes radius_mm and length_mm, "
                             f"not size_mm (got {list(s.size_mm)!r})")
-            for need in ("radius_mm", "length_mm"):
-                if getattr(s, need) is None:
-                    raise _fail(where, f"{k}.{need}", "required for a cylinder")
-            size = np.array([s.radius_mm / 1000.0, s.length_mm / 2000.0, 0.0])
+            radius, length = s.radius_mm, s.length_mm
+            if radius is None:
+                raise _fail(where, f"{k}.radius_mm", "required for a cylinder")
+            if length is None:
+                raise _fail(where, f"{k}.length_mm", "required for a cylinder")
+            size = np.array([radius / 1000.0, length / 2000.0, 0.0])
         name = s.name or f"{prefix}{i}"
         if name in names:
             raise _fail(where, f"{k}.name", f"{name!r} names two shapes of the mechanism")

@@ -57,20 +57,17 @@ COLOUR = Quantity("a colour component", "", 0.0, 1.0)
 #: A component of an axis direction (normalised on reading; not all zero).
 AXIS_COMPONENT = Quantity("an axis component", "", -1e6, 1e6)
 
-_VEC3 = {"min_length": 3, "max_length": 3}
-
-
 class ShapeBlock(Strict):
     """``[[base_shapes]]`` and ``[[axes.link.shapes]]``: a box (``size_mm``, full extents) or a
     cylinder (``radius_mm``, ``length_mm``, along its frame's z), in the base or link frame."""
 
     name: str | None = Field(None, pattern=NAME_PATTERN)
     kind: Literal["box", "cylinder"]
-    size_mm: list[SHAPE_SIZE_MM.type] | None = Field(None, **_VEC3)
+    size_mm: list[SHAPE_SIZE_MM.type] | None = Field(None, min_length=3, max_length=3)
     radius_mm: SHAPE_SIZE_MM.type | None = None
     length_mm: SHAPE_SIZE_MM.type | None = None
-    pos_mm: list[MECH_LENGTH_MM.type] = Field([0.0, 0.0, 0.0], **_VEC3)
-    euler_zyx_deg: list[ANGLE_DEG.type] = Field([0.0, 0.0, 0.0], **_VEC3)
+    pos_mm: list[MECH_LENGTH_MM.type] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
+    euler_zyx_deg: list[ANGLE_DEG.type] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
     rgba: list[COLOUR.type] = Field([0.95, 0.6, 0.1, 1.0], min_length=4, max_length=4)
 
 
@@ -78,8 +75,8 @@ class LinkBlock(Strict):
     """``[axes.link]``: the body an axis moves, in its link frame."""
 
     mass_kg: MASS_KG.type
-    com_mm: list[MECH_LENGTH_MM.type] = Field(**_VEC3)
-    inertia_kg_m2: list[PRINCIPAL_INERTIA_KG_M2.type] = Field(**_VEC3)
+    com_mm: list[MECH_LENGTH_MM.type] = Field(min_length=3, max_length=3)
+    inertia_kg_m2: list[PRINCIPAL_INERTIA_KG_M2.type] = Field(min_length=3, max_length=3)
     shapes: list[ShapeBlock] = []
 
 
@@ -89,8 +86,8 @@ class AxisBlock(Strict):
 
     name: str = Field(pattern=NAME_PATTERN)
     kind: Literal["revolute", "prismatic"]
-    pos_mm: list[MECH_LENGTH_MM.type] = Field([0.0, 0.0, 0.0], **_VEC3)
-    axis: list[AXIS_COMPONENT.type] = Field(**_VEC3)
+    pos_mm: list[MECH_LENGTH_MM.type] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
+    axis: list[AXIS_COMPONENT.type] = Field(min_length=3, max_length=3)
     range_deg: list[JOINT_DEG.type] | None = Field(None, min_length=2, max_length=2)
     range_mm: list[TRAVEL_MM.type] | None = Field(None, min_length=2, max_length=2)
     max_speed_deg_s: JOINT_SPEED_DEG_S.type | None = None
@@ -107,8 +104,8 @@ class AxisBlock(Strict):
 class MountBlock(Strict):
     """``[mount]``: where a workpiece or a robot's base is attached, in the last link's frame."""
 
-    pos_mm: list[MECH_LENGTH_MM.type] = Field([0.0, 0.0, 0.0], **_VEC3)
-    euler_zyx_deg: list[ANGLE_DEG.type] = Field([0.0, 0.0, 0.0], **_VEC3)
+    pos_mm: list[MECH_LENGTH_MM.type] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
+    euler_zyx_deg: list[ANGLE_DEG.type] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
 
 
 class MechanismFile(Strict):
