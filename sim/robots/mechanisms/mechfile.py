@@ -30,7 +30,7 @@ SI (m, rad, rad/s, m/s). A sketch::
     pos_mm = [0, 0, 150]
 
 Every problem is one line, :class:`sim.errors.MechanismError` (exit 2), naming the file, the
-key's path and the value (``d500.toml: axes[1].range_deg: lower 10 > upper -10``).
+key's path and the value (``d500.toml: axes[1].range_deg: lower 10.0 must be below upper -10.0``).
 """
 
 from __future__ import annotations
@@ -132,7 +132,7 @@ def _axis(block: AxisBlock, where: str, key: str, shape_names: set[str]) -> Axis
     unit = "deg" if block.kind == "revolute" else "mm"
     if not lower < upper:
         raise _fail(where, f"{key}.{units['range']}",
-                    f"lower {lower:g} must be below upper {upper:g}")
+                    f"lower {lower!r} must be below upper {upper!r}")
     if upper - lower < MIN_RANGE * (1 - 1e-6):  # rounding: 1.001 - 1.0 is 0.000999...
         raise _fail(where, f"{key}.{units['range']}", f"[{lower!r}, {upper!r}]: the range must "
                     f"be at least {MIN_RANGE:g} {unit} wide (the axis could not move)")
