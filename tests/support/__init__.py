@@ -9,6 +9,8 @@ and the repository's paths. Nothing here is a test; pytest collects none of it.
   files run (the hostile-input campaign's base, a TP program's).
 * :mod:`support.cell_files`: a user's cell file with an STL bracket and the scenario that welds
   it (:func:`~support.cell_files.make_cell`).
+* :mod:`support.mechanisms`: mechanism files (turntables, positioners, tracks): a TOML writer,
+  hypothesis strategies of valid files and the oracle judging what is read from them.
 * :mod:`support.robots`: a robot folder from a DH table (:data:`~support.robots.DH_ROBOT`) and
   a scenario that moves it.
 
