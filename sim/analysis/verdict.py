@@ -84,7 +84,8 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                clearance_mm: float = 5.0, selection: Any = None, *,
                torch_angle_tolerance_deg: float,
                flange_load_kg: tuple[float, float] | None = None,
-               tool_load: tuple[str, float, float] | None = None) -> list[RunCheck]:
+               tool_load: tuple[str, float, float] | None = None,
+               tracking_tolerance_mm: float = 0.5) -> list[RunCheck]:
     """Every check of a run (module docstring): joint by joint, then collisions, clearance,
     the Cartesian phases' speeds, the weld phases' torch angles, the weaves, the actuator
     selection when one was made, and the payload (``flange_load_kg``: the tool's mass and the
@@ -103,24 +104,30 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                                load <= spec.payload_kg * (1 + 1e-9),
                                subject=f"tool {tool:g} kg + payload {payload:g} kg on the "
                                f"{spec.name}, rated {spec.payload_kg:g} kg"))
-    track = np.degrees(np.max(np.abs(np.asarray(arrays["q"]) - arrays["q_ref"]), axis=0))
-    speed = np.degrees(np.max(np.abs(np.asarray(arrays["qd"])), axis=0))
-    accel = np.degrees(np.max(np.abs(np.asarray(arrays["qdd_ref"])), axis=0))
+    # a linear axis (a track's) in mm, N; a joint in deg, N m
+    linear = np.array([False] * spec.n_arm + [a.kind == "prismatic" for _, a in spec.external])
+    scale = np.where(linear, 1e3, np.degrees(1.0))
+    track = scale * np.max(np.abs(np.asarray(arrays["q"]) - arrays["q_ref"]), axis=0)
+    speed = scale * np.max(np.abs(np.asarray(arrays["qd"])), axis=0)
+    accel = scale * np.max(np.abs(np.asarray(arrays["qdd_ref"])), axis=0)
     excess = {j: 0.0 for j in spec.joints}
     for s in summary.get("saturation", ()):
         excess[s["joint"]] = max(excess[s["joint"]], float(s["worst_excess_nm"]))
     for k, joint in enumerate(spec.joints):
-        checks.append(RunCheck("tracking", joint, float(track[k]), float(tracking_tolerance_deg),
-                               "deg", bool(track[k] <= tracking_tolerance_deg)))
-        checks.append(RunCheck("saturation", joint, excess[joint], 0.0, "N m",
-                               excess[joint] <= 0.0))
-        vmax = float(np.degrees(spec.max_speed[k]))
-        checks.append(RunCheck("speed", joint, float(speed[k]), vmax, "deg/s",
+        unit = "mm" if linear[k] else "deg"
+        tol = float(tracking_tolerance_mm if linear[k] else tracking_tolerance_deg)
+        checks.append(RunCheck("tracking", joint, float(track[k]), tol, unit,
+                               bool(track[k] <= tol)))
+        checks.append(RunCheck("saturation", joint, excess[joint], 0.0,
+                               "N" if linear[k] else "N m", excess[joint] <= 0.0))
+        vmax = float(scale[k] * spec.max_speed[k])
+        checks.append(RunCheck("speed", joint, float(speed[k]), vmax, f"{unit}/s",
                                bool(speed[k] <= vmax * (1 + 1e-9))))
         if spec.max_accel:
-            amax = float(np.degrees(spec.max_accel[k]))
-            checks.append(RunCheck("acceleration", joint, float(accel[k]), amax, "deg/s^2",
+            amax = float(scale[k] * spec.max_accel[k])
+            checks.append(RunCheck("acceleration", joint, float(accel[k]), amax, f"{unit}/s^2",
                                    bool(accel[k] <= amax * (1 + 1e-9))))
+    checks += mechanism_checks(summary)
     if sizing is not None:
         for j in sizing.joints:
             for c in j.checks:
@@ -193,6 +200,34 @@ def placement_checks(summary: Mapping[str, Any]) -> list[RunCheck]:
     for k, err in enumerate(summary.get("place_error_mm", ())):
         checks.append(RunCheck("part_placed", "", float(err), tol, "mm", float(err) <= tol,
                                subject=f"part {k + 1} in slot {k + 1}"))
+    return checks
+
+
+#: A downhand weld's seam normal may be at most this far from vertical, deg.
+DOWNHAND_TOLERANCE_DEG = 2.0
+
+
+def mechanism_checks(summary: Mapping[str, Any]) -> list[RunCheck]:
+    """Per mechanism (``summary["mechanisms"]``): ``mechanism_payload``, the mass it carries
+    against its rating (a positioner's part and fixtures, a track's robot, kg); per downhand
+    weld (``summary["weld"]``): ``downhand``, the largest angle of the seam's normal from
+    vertical at the tool point, measured with the part where the recorded axes put it, against
+    :data:`DOWNHAND_TOLERANCE_DEG`."""
+    checks = []
+    for name, m in summary.get("mechanisms", {}).items():
+        carried, rated = float(m["carried_kg"]), float(m["rated_payload_kg"])
+        if rated > 0:
+            checks.append(RunCheck("mechanism_payload", "", carried, rated, "kg",
+                                   carried <= rated * (1 + 1e-9),
+                                   subject=f"{name} ({m['model']}) carries {carried:.4g} kg, "
+                                   f"rated {rated:g} kg"))
+    for w in summary.get("weld", ()):
+        if w.get("downhand"):
+            err = float(w["normal_from_vertical_deg"])
+            checks.append(RunCheck("downhand", "", err, DOWNHAND_TOLERANCE_DEG, "deg",
+                                   err <= DOWNHAND_TOLERANCE_DEG,
+                                   subject=f"{w['phase']}: seam {w['seam']} turned by "
+                                   f"{w['carried_by']}"))
     return checks
 
 

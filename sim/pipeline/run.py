@@ -267,6 +267,7 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
                            for j in selected.joints}}
         checks = run_checks(arrays, summary, scenario.system,
                             scenario.simulation.tracking_tolerance_deg, sizing,
+                            tracking_tolerance_mm=scenario.simulation.tracking_tolerance_mm,
                             clearance_mm=scenario.simulation.clearance_mm,
                             selection=selected,
                             torch_angle_tolerance_deg=(

@@ -201,6 +201,7 @@ class SimulationSpec(_Strict):
     enforce_accel_limits: bool = True
     motor_speed_limits: bool = True
     tracking_tolerance_deg: float = Field(0.1, gt=0, le=180)
+    tracking_tolerance_mm: float = Field(0.5, gt=0, le=1000)
     torch_angle_tolerance_deg: float = Field(2.0, gt=0, le=180)
     clearance_mm: float = Field(5.0, ge=0, le=1000)
 

@@ -85,11 +85,15 @@ def _phase_samples(arrays: Mapping[str, NDArray[Any]], pm: PhaseMotion) -> NDArr
 
 
 def measure_seam_phases(arrays: Mapping[str, NDArray[Any]], motion: Motion,
-                        world_from_frame0: NDArray[np.float64], torch_axis: int
-                        ) -> dict[int, SeamMeasurement]:
+                        world_from_frame0: NDArray[np.float64], torch_axis: int,
+                        context: Any = None) -> dict[int, SeamMeasurement]:
     """:func:`measure_seam` of every Cartesian phase along a seam, by phase index, on the
     simulated tool frames (``tcp_pos``, ``tcp_quat``) of the phase's samples; the constant-speed
-    part and a weave's programmed offset, period and full-amplitude part are the phase's own."""
+    part and a weave's programmed offset, period and full-amplitude part are the phase's own.
+
+    A seam on a positioner or turntable (``context``'s mechanisms) moves: the tool frames are
+    measured in the part's frame, carried back by the part's motion the recorded axes give
+    (:func:`_in_part_frame`)."""
     R0 = world_from_frame0[:3, :3]
     out = {}
     for k, pm in enumerate(motion.phases):
@@ -108,10 +112,68 @@ def measure_seam_phases(arrays: Mapping[str, NDArray[Any]], motion: Motion,
                   "weave_period": cart.weave.period,
                   "weave_window": (pm.t0 + cart.fade_in, pm.t1 - cart.fade_out)}
         rot = Rotation.from_quat(arrays["tcp_quat"][idx], scalar_first=True).as_matrix()
-        out[k] = measure_seam(ts, arrays["tcp_pos"][idx], rot, pm.seam, axis_column=torch_axis,
+        pos = arrays["tcp_pos"][idx]
+        if context is not None and context.seam_mechanism.get(pm.seam.name):
+            pos, rot = _in_part_frame(context, pm, arrays["q"][idx], pos, rot)
+        out[k] = measure_seam(ts, pos, rot, pm.seam, axis_column=torch_axis,
                               corner_zones=pm.corner_zones, cruise=(pm.t0 + lo, pm.t0 + hi),
                               **kw)
     return out
+
+
+def _in_part_frame(context: Any, pm: Any, q: NDArray[np.float64], pos: NDArray[np.float64],
+                   rot: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Recorded tool frames (world) in the frame the phase's seam was placed in (``pm.seam``:
+    the part at the axes' values where the phase starts, ``qe0``): carried back by
+    ``D(qe0) D(q)^-1``, ``D`` the part's motion at the recorded axes ``q`` (N, n_joints)."""
+    from sim.simulation.motion.axes import displacement
+
+    n = context.kinematics.n_joints
+    mech = context.seam_mechanism[pm.seam.name]
+    qe0 = np.asarray(pm.trajectory.at(pm.t0).q, dtype=float)[n:]
+    back = displacement(context, mech, qe0) @ np.linalg.inv(displacement(context, mech, q[:, n:]))
+    return (np.einsum("nij,nj->ni", back[:, :3, :3], pos) + back[:, :3, 3],
+            back[:, :3, :3] @ rot)
+
+
+def mechanism_summary(arrays: Mapping[str, NDArray[Any]], built: BuiltCell
+                      ) -> dict[str, dict[str, Any]]:
+    """Per mechanism: its kind and model, what it carries and the mass of it (from the compiled
+    model: the mount's subtree, kg) against its rating, and per axis (``<mechanism>_<axis>``)
+    the recorded travel (deg or mm) and the largest speed."""
+    model = built.model
+    names = list(built.cell.joint_names)
+    out = {}
+    for pm in built.cell.mechanisms:
+        axes = {}
+        for name, ax in zip(pm.joint_names, pm.spec.axes, strict=True):
+            k = names.index(name)
+            scale, unit = (np.degrees(1.0), "deg") if ax.kind == "revolute" else (1e3, "mm")
+            q = np.asarray(arrays["q"][:, k])
+            axes[name] = {"kind": ax.kind, "unit": unit, "min": float(scale * q.min()),
+                          "max": float(scale * q.max()),
+                          "max_speed": float(scale * np.abs(arrays["qd"][:, k]).max())}
+        out[pm.name] = {"kind": pm.spec.kind, "model": pm.spec.name, "carries": list(pm.carries),
+                        "carried_kg": float(model.body(pm.mount_body).subtreemass[0]),
+                        "rated_payload_kg": float(pm.spec.payload_kg), "axes": axes}
+    return out
+
+
+def _normal_from_vertical(context: Any, pm: Any, q: NDArray[np.float64],
+                          s: NDArray[np.float64]) -> float:
+    """Largest angle from vertical of the seam's local normal (:meth:`Seam.weld_normal`) at
+    the tool point's measured place ``s`` along it, with the part where the recorded axes
+    ``q`` (N, n_joints) put it, deg."""
+    from sim.simulation.motion.axes import displacement
+
+    n = context.kinematics.n_joints
+    mech = context.seam_mechanism[pm.seam.name]
+    qe0 = np.asarray(pm.trajectory.at(pm.t0).q, dtype=float)[n:]
+    R = (displacement(context, mech, q[:, n:])
+         @ np.linalg.inv(displacement(context, mech, qe0)))[:, :3, :3]
+    normals = np.array([pm.seam.weld_normal(float(x)) for x in s])
+    up = np.einsum("nij,nj->ni", R, normals)[:, 2]
+    return float(np.degrees(np.arccos(np.clip(up, -1.0, 1.0))).max())
 
 
 def weave_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCell,
@@ -200,6 +262,12 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
                 "travel_angle_error_deg": m.travel_angle_error_deg,
                 "t_worst_angle_s": m.t_worst_angle,
                 "start_error_mm": m.start_error * 1e3, "end_error_mm": m.end_error * 1e3})
+            ctx = built.context
+            if ctx.seam_mechanism.get(pm.seam.name):
+                entry["carried_by"] = ctx.seam_mechanism[pm.seam.name]
+                entry["normal_from_vertical_deg"] = _normal_from_vertical(
+                    ctx, pm, arrays["q"][_phase_samples(arrays, pm)], m.s)
+                entry["downhand"] = bool(getattr(pm.phase, "downhand", False))
             out.append(entry)
             continue
         p = arrays["tcp_pos"][sel]
@@ -265,7 +333,8 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
     peak_id = np.max(np.abs(a["tau_id"]), axis=0)
     rms_diff = np.sqrt(np.mean((a["tau"] - a["tau_id"]) ** 2, axis=0))
     torch_axis = scenario.robot.family.approach_column
-    measured = measure_seam_phases(a, motion, built.context.world_from_frame0, torch_axis)
+    measured = measure_seam_phases(a, motion, built.context.world_from_frame0, torch_axis,
+                                   built.context)
     summary: dict[str, Any] = {
         "scenario": scenario.name,
         "robot": scenario.robot.name,
@@ -293,6 +362,8 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "weave": weave_metrics(a, motion, built, measured),
         "program_warnings": list(scenario.program_warnings),
     }
+    if built.cell.mechanisms:
+        summary["mechanisms"] = mechanism_summary(a, built)
     summary["saturation"] = saturation_intervals(a, motion, built, feedforward=feedforward)
     summary["singularity"] = singularity_summary(a, motion, built, rec.timestep)
     pick = pick_metrics(a, built)

@@ -255,7 +255,7 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
         along = track.pose[:3, :3] @ track.spec.axes[0].axis  # travel direction in the world
         seam_w = ctx0.seams[phase.seam]
         pts = np.array([seam_w.point(float(x)) for x in s_grid])
-        travel = qe0[sl][0] + (pts - pts[0]) @ along
+        travel = qe0[sl.start] + (pts - pts[0]) @ along
         lo, hi = track.spec.axes[0].range
         out = np.nonzero((travel < lo - 1e-9) | (travel > hi + 1e-9))[0]
         if out.size:
@@ -263,7 +263,7 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
             raise ScenarioError(f"{label}.follow: track {track.name!r} would have to travel to "
                                 f"{travel[k] * 1e3:.1f} mm at {s_grid[k] * 1e3:.1f} mm along the "
                                 f"seam, outside its range [{lo * 1e3:g}, {hi * 1e3:g}] mm")
-        q_grid[:, sl[0]] = travel
+        q_grid[:, sl.start] = travel
     from scipy.interpolate import CubicSpline
 
     spline = CubicSpline(s_grid, q_grid, axis=0)
