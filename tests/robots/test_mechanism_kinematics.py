@@ -96,9 +96,18 @@ def brute_force_residual(mech, v, target):
         return -float(oracle_direction(mech, q, v) @ target)
 
     starts = np.argsort(-cos, axis=None)[:3]
-    best = min(minimize(f, [A.flat[k], B.flat[k]], method="BFGS", options={"gtol": 1e-12}).fun
-               for k in starts)
-    return float(np.arccos(np.clip(-best, -1.0, 1.0)))
+    best = min((minimize(f, [A.flat[k], B.flat[k]], method="BFGS", options={"gtol": 1e-12})
+                for k in starts), key=lambda res: res.fun)
+    q = np.zeros(mech.n_axes)
+    q[rev] = best.x
+    return angles_to(oracle_direction(mech, q, v), target).min()
+
+
+def angles_to(V, target):
+    """Angles (rad) between the rows of ``V`` and ``target`` (atan2: exact near 0, unlike
+    acos of a dot product)."""
+    V = np.atleast_2d(V)
+    return np.arctan2(np.linalg.norm(np.cross(V, target), axis=-1), V @ target)
 
 
 # -------------------------------------------------------------------------------- generators
@@ -233,7 +242,9 @@ def reaches(mech, q, v, target, tol=1e-9):
 def test_orient_turns_v_onto_any_reachable_target(mech, v, data):
     """A target made by turning ``v`` through random axis values is reached exactly (1e-9),
     with a residual of 0, inside the ranges, and no farther from q_near than that known
-    solution (2 pi shifts allowed), prismatic axes held at q_near."""
+    solution (2 pi shifts allowed; to 1e-6: where the two solutions nearly touch their angles
+    are defined only to about the square root of the machine epsilon), prismatic axes held at
+    q_near."""
     q_true = data.draw(angles(mech.n_axes))
     q_near = data.draw(angles(mech.n_axes))
     for i, ax in enumerate(mech.axes):
@@ -251,7 +262,7 @@ def test_orient_turns_v_onto_any_reachable_target(mech, v, data):
     known = q_true.copy()
     for i in revolute(mech):
         known[i] += 2 * np.pi * np.round((q_near[i] - known[i]) / (2 * np.pi))
-    assert np.linalg.norm(sol.q - q_near) <= np.linalg.norm(known - q_near) + 1e-9
+    assert np.linalg.norm(sol.q - q_near) <= np.linalg.norm(known - q_near) + 1e-6
 
 
 @settings(max_examples=25, deadline=None, derandomize=True,
@@ -294,8 +305,7 @@ def test_v_along_the_rotate_axis_leaves_the_rotate_axis_at_q_near(mech, data):
     assert sol.q[1] == q_near[1]
     ts = np.linspace(-np.pi, np.pi, 3601)
     Q = np.stack([ts, np.full_like(ts, q_near[1])], -1)
-    best = np.arccos(np.clip((oracle_direction(mech, Q, w2_mount) @ target).max(), -1, 1))
-    assert sol.residual_rad <= best + 1e-9
+    assert sol.residual_rad <= angles_to(oracle_direction(mech, Q, w2_mount), target).min() + 1e-9
     assert abs(angle(oracle_direction(mech, sol.q, w2_mount), target) - sol.residual_rad) < 1e-9
 
 
@@ -379,8 +389,7 @@ def test_a_turntable_brings_v_to_the_targets_polar_angle_closest(w, pos, mount, 
     assert sol.residual_rad == pytest.approx(expected, abs=1e-7)
     assert abs(angle(oracle_direction(table, sol.q, v), y) - sol.residual_rad) < 1e-9
     ts = np.linspace(-np.pi, np.pi, 361)[:, None]
-    assert sol.residual_rad <= np.arccos(np.clip((oracle_direction(table, ts, v) @ y).max(),
-                                                 -1, 1)) + 1e-9
+    assert sol.residual_rad <= angles_to(oracle_direction(table, ts, v), y).min() + 1e-9
     assert abs(sol.q[0] - near) <= np.pi + 1e-9
 
 
@@ -391,21 +400,23 @@ def test_a_turntable_brings_v_to_the_targets_polar_angle_closest(w, pos, mount, 
 @given(mech=positioners(track=False), data=st.data())
 def test_a_circumferential_seam_turns_the_rotate_axis_once_round(mech, data):
     """A circumferential seam about the rotate axis (radial or bisector normals at ``bevel``
-    from the radial, turning through 360 deg) onto a reachable target: the tilt holds, the
-    rotate axis advances monotonically (unwrapped, past +-pi) by 2 pi in all, every sample
-    reached exactly."""
+    from the radial, turning through 360 deg, sampled every 2.5 or every 45 deg) onto a
+    reachable target: the tilt holds (the path keeps to its branch, however coarse the
+    sampling), the rotate axis advances monotonically (unwrapped, past +-pi) by 2 pi in all,
+    every sample reached exactly."""
     a = mech.mount[:3, :3].T @ mech.axes[1].axis  # the rotate axis in the mount frame
     e1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(a, e1)
     bevel = np.deg2rad(data.draw(st.sampled_from([0.0, 45.0, -30.0, 60.0])))
-    s = np.linspace(0.0, 2 * np.pi, 145)
+    n = data.draw(st.sampled_from([145, 9]))
+    s = np.linspace(0.0, 2 * np.pi, n)
     V = (np.cos(bevel) * (np.cos(s)[:, None] * e1 + np.sin(s)[:, None] * e2)
          + np.sin(bevel) * a)
     target = oracle_direction(mech, data.draw(angles(2)), V[0])
     Q = orient_path(mech, V, target, data.draw(angles(2)))
-    assert Q.shape == (145, 2)
-    for k in range(145):
+    assert Q.shape == (n, 2)
+    for k in range(n):
         assert reaches(mech, Q[k], V[k], target), k
     np.testing.assert_allclose(Q[:, 0], Q[0, 0], atol=1e-6)
     np.testing.assert_allclose(Q[:, 1], Q[0, 1] - s, atol=1e-6)

@@ -4,6 +4,8 @@ and the repository's paths. Nothing here is a test; pytest collects none of it.
 * :mod:`support.seam_oracle`, :mod:`support.rnea_oracle`, :mod:`support.window_oracle`: judges
   written independently of cellsim (a weld from a cell file's own numbers, pinocchio's inverse
   dynamics, the sustained value of a signal).
+* :mod:`support.mechanism_oracle`: a mechanism's (positioner, turntable, track) inverse dynamics
+  with a payload on its mount, Newton-Euler written from first principles.
 * :mod:`support.scenarios`: a scenario file from keyword arguments (:func:`~support.scenarios.
   scenario_text`, :func:`~support.scenarios.write_scenario`), and the scenarios several test
   files run (the hostile-input campaign's base, a TP program's).

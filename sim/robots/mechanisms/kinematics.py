@@ -126,8 +126,8 @@ class Orientation:
     """A solution of :func:`orient`.
 
     Attributes:
-        q: Axis values, rad or m, (n_axes,) (prismatic axes and free revolute axes: the
-            nearby configuration's values).
+        q: Axis values, rad or m, (n_axes,), inside the axis ranges (to :data:`RANGE_TOL`)
+            (prismatic axes and free revolute axes: the nearby configuration's values).
         residual_rad: Angle left between the turned direction and the target, rad: 0 (to
             round-off) where the mechanism can reach the target, else the least angle error
             it can achieve (a turntable asked to tilt, a positioner whose tilt cannot reach).
@@ -164,33 +164,46 @@ def _subproblem2(w1: NDArray[np.float64], w2: NDArray[np.float64], u: NDArray[np
     parallel to ``w2``).
 
     The vector ``c = exp(w2 t2) u = exp(-w1 t1) y`` lies on the circle of ``u`` about ``w2``
-    and on the circle of ``y`` about ``w1``. On the first, ``c = a2 w2 + r2 (cos(phi) e +
-    sin(phi) f)`` with ``e`` the unit vector perpendicular to ``w2`` towards ``w1`` and ``f =
-    w2 x e``; the second asks ``w1.c = w1.y``, i.e. ``cos(phi) = (w1.y - (w1.w2)(w2.u)) /
-    (r2 |w1 x w2|)``: two solutions ``+-phi`` (branches +1, -1: the side of the axes' plane
-    ``c`` lies on) where the circles cross, one (branch 0) where they touch. Where they do not
-    meet (``|cos(phi)| > 1``) the one closest solution: ``phi = 0`` or ``pi``, the point of
-    ``u``'s circle in the axes' plane whose polar angle about ``w1`` is nearest ``y``'s (the
-    angle from a point to ``y``'s circle is the difference of their polar angles). ``t2`` is
-    the turn from ``u``'s phi to ``c``'s, ``t1`` subproblem 1 on the turned ``u``. A free angle
-    (``u`` along ``w2``, ``y`` along ``w1``) is NaN."""
-    k = float(w1 @ w2)
+    (polar angle ``b = angle(w2, u)``) and on the circle of ``y`` about ``w1`` (polar angle
+    ``g = angle(w1, y)``). Written ``c = cos(b) w2 + sin(b) (cos(phi) e + sin(phi) f)`` with
+    ``e`` the unit vector perpendicular to ``w2`` towards ``w1`` and ``f = w2 x e``, the
+    spherical triangle ``w1, w2, c`` (sides ``a = angle(w1, w2)``, ``b``, ``g``; angle ``phi``
+    at ``w2``) gives, by the haversine law::
+
+        sin^2(phi/2) = sin((g - |a-b|)/2) sin((g + |a-b|)/2) / (sin a sin b) = h
+        cos^2(phi/2) = sin((a+b - g)/2) sin((a+b + g)/2) / (sin a sin b)     = h'
+
+    (``h + h' = 1``), so ``phi = 2 atan2(sqrt h, sqrt h')``, accurate to round-off everywhere,
+    also where the circles touch or ``y`` lies near ``w1`` (where ``acos`` of a dot product
+    loses half the digits). Two solutions ``+-phi`` (branches +1, -1: the side of the axes'
+    plane ``c`` lies on) where both are positive, one (branch 0) where the circles touch. Where
+    they do not meet the one closest solution: ``phi = 0`` (``h < 0``) or ``pi`` (``h' < 0``),
+    the point of ``u``'s circle whose polar angle about ``w1`` is nearest ``g`` (the angle from
+    a point to ``y``'s circle is the difference of their polar angles). ``t2`` turns ``u``'s
+    ``phi`` to ``c``'s; ``t1`` is subproblem 1 on the turned ``u``. A free angle (``u`` along
+    ``w2``, ``y`` along ``w1``) is NaN."""
     n = np.cross(w1, w2)
-    s = float(np.linalg.norm(n))
-    e = (w1 - k * w2) / s
+    sin_a = float(np.linalg.norm(n))
+    a = float(np.arctan2(sin_a, w1 @ w2))
+    e = (w1 - (w1 @ w2) * w2) / sin_a
     f = np.cross(w2, e)
-    a1, a2 = float(w1 @ y), float(w2 @ u)
-    u_perp = u - a2 * w2
-    r2 = float(np.linalg.norm(u_perp))
-    if r2 < FREE_AXIS_TOL:  # u along w2: the second axis does not move it
+    u_perp = u - (w2 @ u) * w2
+    sin_b = float(np.linalg.norm(u_perp))
+    if sin_b < FREE_AXIS_TOL:  # u along w2: the second axis does not move it
         return [(_subproblem1(w1, u, y), float("nan"), 0)]
-    cos_phi = (a1 - k * a2) / (r2 * s)
+    b = float(np.arctan2(sin_b, w2 @ u))
+    g = float(np.arctan2(np.linalg.norm(np.cross(w1, y)), w1 @ y))
+    d, sigma = abs(a - b), a + b
+    h = np.sin((g - d) / 2) * np.sin((g + d) / 2) / (sin_a * sin_b)
+    h_c = np.sin((sigma - g) / 2) * np.sin((sigma + g) / 2) / (sin_a * sin_b)
     phi_u = float(np.arctan2(f @ u_perp, e @ u_perp))
-    if abs(cos_phi) < 1.0:
-        phi = float(np.arccos(cos_phi))
-        branches = [(phi, 1), (-phi, -1)]
+    if h <= 0.0:
+        branches = [(0.0, 0)]
+    elif h_c <= 0.0:
+        branches = [(np.pi, 0)]
     else:
-        branches = [(0.0 if cos_phi > 0.0 else np.pi, 0)]
+        phi = float(2.0 * np.arctan2(np.sqrt(h), np.sqrt(h_c)))
+        branches = [(phi, 1), (-phi, -1)]
     out = []
     for phi, branch in branches:
         t2 = phi - phi_u
@@ -233,7 +246,7 @@ def _place(t: float, lo: float, hi: float, near: float) -> float | None:
     return float(t + _TWO_PI * k)
 
 
-def _fill(mech: MechanismSpec, rev: list[int], sol: NDArray[np.float64],
+def _fill(rev: list[int], sol: NDArray[np.float64],
           near: NDArray[np.float64]) -> NDArray[np.float64]:
     """Full axis values: ``near`` with the revolute angles ``sol`` (a free one keeps ``near``)."""
     q = near.copy()
@@ -316,7 +329,7 @@ def _nearest_in_range(mech: MechanismSpec, sols: list[tuple[NDArray[np.float64],
             placed[j] = t
         if placed is None:
             continue
-        q = _fill(mech, rev, placed, near)
+        q = _fill(rev, placed, near)
         d = float(np.linalg.norm(q - near))
         if d < best_d:
             best, best_d = (q, branch), d
@@ -373,12 +386,12 @@ def orient_path(mech: MechanismSpec, v_mount_samples: ArrayLike, target: ArrayLi
         y = _unit(Y[k], f"target[{k}]")
         sols = _raw_solutions(mech, rev, v, y)
         same = [(sol, b) for sol, b in sols if branch != 0 and b == branch]
-        best, best_d = prev, np.inf
+        best, best_d, best_b = prev, np.inf, branch
         for sol, b in same or sols:
             for j, i in enumerate(rev):
                 if not np.isnan(sol[j]):
                     sol[j] += _TWO_PI * np.round((prev[i] - sol[j]) / _TWO_PI)
-            q = _fill(mech, rev, sol, prev)
+            q = _fill(rev, sol, prev)
             d = float(np.linalg.norm(q - prev))
             if d < best_d:
                 best, best_d, best_b = q, d, b
