@@ -206,3 +206,39 @@ def test_the_chain_from_a_spec_reads_its_numbers_and_drive_armature():
     assert ax.armature == pytest.approx(2e-4 * 120.0**2)
     assert (ax.mass, ax.friction, ax.damping) == (35.0, 5.0, 2.0)
     assert chain_from_spec(mech, armature=False)[0].armature == 0.0
+
+
+@SETTINGS
+@given(tilt=st.floats(-2.4, 2.4), rotate=st.floats(-7.0, 7.0), m=st.floats(1.0, 500.0),
+       com=vec3())
+def test_a_d500_like_positioner_holding_a_part_needs_the_moments_of_the_weights(tilt, rotate,
+                                                                                m, com):
+    """A tilt (x) - rotate positioner read from its spec, a part of mass m on a turned, raised
+    faceplate, at rest: each axis's torque is the moment about it of the weights of everything
+    it carries (statics with x/z rotation matrices written here)."""
+    drive = Drive(120.0, 0.9, 2e-4, 1.0, 3.0, 3000.0)
+    links = (LinkSpec(80.0, np.array([0.0, 0.02, 0.1]), np.array([3.0, 4.0, 5.0])),
+             LinkSpec(40.0, np.array([0.01, 0.0, 0.03]), np.array([1.0, 1.0, 1.8])))
+    mount = np.eye(4)
+    c30, s30 = np.cos(np.pi / 6), np.sin(np.pi / 6)
+    mount[:3, :3] = [[c30, -s30, 0], [s30, c30, 0], [0, 0, 1]]
+    mount[:3, 3] = [0.0, 0.0, 0.05]
+    mech = MechanismSpec("d500", "D500-like", "positioner", (
+        AxisSpec("tilt", "revolute", np.array([0, 0, 0.8]), np.array([1.0, 0, 0]), (-2.4, 2.4),
+                 1.0, 1.0, drive, links[0]),
+        AxisSpec("rotate", "revolute", np.array([0, 0, 0.25]), np.array([0, 0, 1.0]),
+                 (-20.0, 20.0), 1.0, 1.0, drive, links[1])), mount=mount)
+    tau = inverse_dynamics(chain_from_spec(mech), [tilt, rotate], [0.0, 0.0], [0.0, 0.0],
+                           mount, OraclePayload(m, com, np.diag([2.0, 3.0, 4.0])))
+    ct, st_, cr, sr = np.cos(tilt), np.sin(tilt), np.cos(rotate), np.sin(rotate)
+    Rx = np.array([[1, 0, 0], [0, ct, -st_], [0, st_, ct]])
+    R2 = Rx @ np.array([[cr, -sr, 0], [sr, cr, 0], [0, 0, 1]])
+    o1 = np.array([0, 0, 0.8])
+    o2 = o1 + Rx @ [0, 0, 0.25]
+    weights = [(80.0, o1 + Rx @ links[0].com), (40.0, o2 + R2 @ links[1].com),
+               (m, o2 + R2 @ (mount[:3, 3] + mount[:3, :3] @ com))]
+    up = np.array([0.0, 0.0, G])
+    hold_tilt = np.array([1.0, 0, 0]) @ sum(np.cross(c - o1, w * up) for w, c in weights)
+    hold_rotate = (Rx @ [0, 0, 1.0]) @ sum(np.cross(c - o2, w * up) for w, c in weights[1:])
+    np.testing.assert_allclose(tau, [hold_tilt, hold_rotate], rtol=0,
+                               atol=1e-9 * max(1.0, abs(hold_tilt)))
