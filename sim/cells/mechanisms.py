@@ -74,6 +74,15 @@ class PlacedMechanism:
         return tuple(f"{self.name}_{a.name}" for a in self.spec.axes)
 
     @property
+    def names(self) -> frozenset[str]:
+        """Every name its model takes in the cell (bodies, joints, geoms, the mount)."""
+        spec = self.spec
+        geoms = [f"{self.name}_{s.name or f'base{k}'}" for k, s in enumerate(spec.base_shapes)]
+        geoms += [f"{self.name}_{s.name or f'{a.name}{k}'}" for a in spec.axes
+                  for k, s in enumerate(a.link.shapes)]
+        return frozenset({self.name, self.mount_body, *self.joint_names, *geoms})
+
+    @property
     def mount_body(self) -> str:
         return f"{self.name}_{MOUNT}"
 
@@ -113,7 +122,7 @@ def add_mechanism(world: mjcf.RootElement, pm: PlacedMechanism) -> mjcf.Element:
     base = world.worldbody.add("body", name=pm.name, pos=pm.pose[:3, 3],
                                quat=quat_from_matrix(pm.pose[:3, :3]))
     for k, shape in enumerate(spec.base_shapes):
-        _add_shape(base, shape, f"{pm.name}_base{k}")
+        _add_shape(base, shape, f"{pm.name}_{shape.name or f'base{k}'}")
     parent = base
     for axis, name in zip(spec.axes, pm.joint_names, strict=True):
         body = parent.add("body", name=name, pos=axis.pos)
@@ -124,7 +133,7 @@ def add_mechanism(world: mjcf.RootElement, pm: PlacedMechanism) -> mjcf.Element:
                  axis=axis.axis, range=[lo, hi], limited=True,
                  armature=axis.drive.reflected_inertia, damping=axis.damping)
         for k, shape in enumerate(link.shapes):
-            _add_shape(body, shape, f"{name}{k}")
+            _add_shape(body, shape, f"{pm.name}_{shape.name or f'{axis.name}{k}'}")
         world.actuator.add("position", name=name, joint=name, kp=1.0, kv=0.0,
                            ctrllimited=False, forcelimited=False)
         if axis.friction > 0.0:

@@ -358,7 +358,8 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
                                         for d, p in zip(rms_diff, peak_id)],
         "actions": [{"t": t, "action": act} for t, act in motion.actions],
         "weld": weld_metrics(a, motion, built, torch_axis, measured),
-        "cartesian_speed": cartesian_speeds(a, motion, built.context.world_from_frame0),
+        "cartesian_speed": cartesian_speeds(a, motion, built.context.world_from_frame0,
+                                            built.context),
         "weave": weave_metrics(a, motion, built, measured),
         "program_warnings": list(scenario.program_warnings),
     }
@@ -412,8 +413,8 @@ def _seam_cruise(pm: PhaseMotion, ts: NDArray[np.float64], p: NDArray[np.float64
 
 
 def cartesian_speeds(arrays: Mapping[str, NDArray[Any]], motion: Motion,
-                     world_from_frame0: NDArray[np.float64] | None = None
-                     ) -> list[dict[str, Any]]:
+                     world_from_frame0: NDArray[np.float64] | None = None,
+                     context: Any = None) -> list[dict[str, Any]]:
     """Per Cartesian phase: the set travel speed and the reference tool point's cruise speed,
     mm/s (the median speed over the samples faster than 95 % of the phase's peak, so the ramps
     are left out), and the deviation in percent. A phase sampled too coarsely for its move
@@ -421,7 +422,8 @@ def cartesian_speeds(arrays: Mapping[str, NDArray[Any]], motion: Motion,
     past :data:`SPEED_TOLERANCE`. Along a seam the speed is the progress along it
     (:func:`_seam_cruise`: a weave's lateral motion does not count, nor do the corner zones);
     a weaving phase without a seam has the travel speed of the tool point with the weave's
-    planned displacement taken out."""
+    planned displacement taken out. Along a seam a positioner moves, the speed is relative to
+    the part (the reference tool point carried back by the part's reference motion)."""
     t, p = arrays["t"], arrays["tcp_pos_ref"]
     T = np.eye(4) if world_from_frame0 is None else world_from_frame0
     out = []
@@ -431,6 +433,11 @@ def cartesian_speeds(arrays: Mapping[str, NDArray[Any]], motion: Motion,
         sel = _phase_samples(arrays, pm)
         if sel.size < 3:
             speed = 0.0
+        elif pm.seam is not None and context is not None and \
+                context.seam_mechanism.get(pm.seam.name):
+            rel, _ = _in_part_frame(context, pm, arrays["q_ref"][sel], p[sel],
+                                    np.broadcast_to(np.eye(3), (sel.size, 3, 3)))
+            speed = _seam_cruise(pm, t[sel], rel)
         elif pm.seam is not None:
             speed = _seam_cruise(pm, t[sel], p[sel])
         else:

@@ -89,8 +89,7 @@ def read_cell_file(path: str | Path) -> CellFile:
             solid.pose = pm.mount_in_world(pm.home) @ solid.pose
         solids[ob.name] = solid
     for pm in mechanisms.values():
-        names = set(pm.joint_names) | {pm.name, pm.mount_body}
-        clash = sorted(names & set(solids))
+        clash = sorted(pm.names & set(solids))
         if clash:
             raise CellError(f"{where}: objects[{solids[clash[0]].index}].name: {clash[0]!r} is "
                             f"a name of mechanism {pm.name!r}'s model; rename the object")

@@ -165,11 +165,37 @@ def _downhand_law(ctx: CartesianContext, seam: Any, mech: Any, qe0: NDArray[np.f
 def downhand_start(ctx: CartesianContext, seam_name: str, qe: NDArray[np.float64], label: str
                    ) -> NDArray[np.float64]:
     """The axes ``qe`` with the positioner carrying ``seam_name`` where its start is welded
-    downhand (a joint phase's ``downhand`` with ``to_seam``)."""
+    downhand (a joint phase's ``downhand`` with ``to_seam``): of the positioner's solutions
+    there (each branch, each turn of a revolute axis within its range) the one nearest ``qe``
+    from which the whole seam can be welded downhand within the axes' ranges."""
+    import itertools
+
     mech = _downhand_mechanism(ctx, seam_name, label)
     seam = ctx.seams[seam_name]
+    sl = axis_slices(ctx)[mech.name]
     out = np.asarray(qe, dtype=float).copy()
-    out[axis_slices(ctx)[mech.name]] = _downhand_law(ctx, seam, mech, out, np.zeros(1), label)[0]
+    s = np.linspace(0.0, seam.length(), LAW_SAMPLES // 4)
+    hints = [[out[sl][i]] + ([] if a.kind != "revolute" else
+                             [a.range[0], 0.5 * (a.range[0] + a.range[1]), a.range[1]])
+             for i, a in enumerate(mech.spec.axes)]
+    best, best_d, last = None, np.inf, None
+    for hint in itertools.product(*hints):
+        trial = out.copy()
+        trial[sl] = hint
+        try:
+            q0 = _downhand_law(ctx, seam, mech, trial, s[:1], label)[0]
+            trial[sl] = q0
+            _downhand_law(ctx, seam, mech, trial, s, label)  # the whole seam from there
+        except ScenarioError as exc:
+            last = exc
+            continue
+        d = float(np.linalg.norm(q0 - out[sl]))
+        if d < best_d - 1e-9:
+            best, best_d = q0, d
+    if best is None:
+        assert last is not None
+        raise last
+    out[sl] = best
     return out
 
 
@@ -206,6 +232,22 @@ def moving_frame(ctx: CartesianContext, ctx0: CartesianContext, mech: str | None
     return np.linalg.inv(world_from_frame0(ctx, qe)) @ D @ ctx0.world_from_frame0
 
 
+def hold_roll(poses: NDArray[np.float64], column: int, ref: NDArray[np.float64]
+              ) -> NDArray[np.float64]:
+    """Poses (N, 4, 4) turned about their torch axis (rotation column ``column``) so that the
+    next column is ``ref`` made perpendicular to the axis: a torch is symmetric about its
+    axis, and the part turning under it must not wind the wrist round with it."""
+    a = poses[:, :3, column]
+    b = ref[None, :] - np.einsum("ni,i->n", a, ref)[:, None] * a
+    b /= np.linalg.norm(b, axis=1, keepdims=True)
+    c = np.cross(a, b)
+    out = poses.copy()
+    out[:, :3, column] = a
+    out[:, :3, (column + 1) % 3] = b
+    out[:, :3, (column + 2) % 3] = c
+    return out
+
+
 def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
                      ctx: CartesianContext, label: str) -> PhaseMotion:
     """A weld along a seam with the axes moving (module docstring)."""
@@ -213,6 +255,7 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     from sim.simulation.motion.programmed import _programmed
     from sim.simulation.motion.sampling import (
         _ik_knots_refined,
+        _into_j1_plane,
         _poses,
         _sample_times,
         _turn_limited_period,
@@ -225,7 +268,7 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     ctx0 = posed(ctx, qe0)
     kin = ctx.kinematics
     T0 = np.asarray(kin.fk(qr0), dtype=float)
-    cart, seam = _phase_cart(phase, T0[:3, 3], T0[:3, :3], ctx0, label)
+    cart, seam = _phase_cart(phase, T0[:3, 3], T0[:3, :3], ctx0, label, moving=True)
     assert seam is not None
     mech = ctx.seam_mechanism.get(phase.seam)
     s_grid = np.linspace(0.0, seam.length(), LAW_SAMPLES)
@@ -270,12 +313,22 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     L = float(seam.length())
 
     def axes_at(x: NDArray[np.float64]) -> NDArray[np.float64]:
-        s = np.clip(np.asarray(cart.at(x).path_length, dtype=float), 0.0, L)
-        return spline(s)
+        # the tool path (the tool point's, off the seam by the stand-off: an arc of another
+        # radius) and the seam share their parameter: the same share of each's length
+        u = np.asarray(cart.at(x).path_length, dtype=float) / cart.length
+        return spline(np.clip(u, 0.0, 1.0) * L)
+
+    column = int(kin.family.approach_column)
+    ref = T0[:3, (column + 1) % 3]  # the roll about the torch axis the phase starts with
+
+    five_axis = bool(kin.family.five_axis)
 
     def poses_at(x: NDArray[np.float64]) -> NDArray[np.float64]:
         M = moving_frame(ctx, ctx0, mech, qe0, axes_at(x))
-        return M @ _poses(cart.at(x))
+        poses = hold_roll(M @ _poses(cart.at(x)), column, ref)
+        # a 5-axis arm holds its torch in the vertical plane through J1: the axes' law (a
+        # spline through exact samples) leaves it a few hundredths of a degree out of it
+        return _into_j1_plane(poses) if five_axis else poses
 
     period = _turn_limited_period(cart, phase.sample_period, label)
     ts = _sample_times(cart.duration, period, np.zeros(0), label)

@@ -53,7 +53,7 @@ def default_ramp(phase: CartesianPhase, p0: NDArray[np.float64], seam: Any,
 
 def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.float64],
                 ctx: CartesianContext, label: str, *, corner: bool = False,
-                roll: float | None = None) -> tuple[Any, Any]:
+                roll: float | None = None, moving: bool = False) -> tuple[Any, Any]:
     """The phase's ADNIA move (``CartesianTrajectory``, frame 0) from the tool pose ``p0``,
     ``R0``, with its seam (or ``None``).
 
@@ -61,7 +61,9 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
     point (:class:`sim.simulation.seam_orientation.SeamOrientation`), keeping the roll about
     the torch axis it arrives with. ``corner``: the move is a polyline's next leg, entered
     through a corner that turns the torch (``R0`` is the previous leg's frame, not this leg's
-    start); ``roll`` is then the first leg's roll, kept on every leg."""
+    start); ``roll`` is then the first leg's roll, kept on every leg. ``moving``: the seam
+    moves while it is welded (coordinated motion, :mod:`sim.simulation.motion.axes`): a 5-axis
+    arm's torch plane is checked on the moving targets there, not on the seam at rest."""
     from planners import adnia
 
     F = ctx.frame0_from(phase.frame, label)  # the phase's points are in this frame
@@ -114,7 +116,8 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
                 f"{phase.seam!r} starts at {np.round(start * 1e3, 2).tolist()} mm, {gap * 1e3:.2f} mm "
                 "away; end the previous phase at the seam start")
 
-    if seam is not None and phase.orientation == "seam" and ctx.kinematics.family.five_axis:
+    if (seam is not None and phase.orientation == "seam" and ctx.kinematics.family.five_axis
+            and not moving):
         _check_five_axis_torch(seam, label)
 
     rot_end = None
@@ -149,6 +152,15 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
             cart = adnia.circle_move(center, axis, p0, phase.sweep, phase.speed, **kw)
     except PlannerError as exc:
         raise ScenarioError(f"{label}: {exc}") from None
+    if seam is not None and phase.kind == "circular" and \
+            abs(cart.length / seam.length() - 1.0) > 1e-4:
+        # an arc's tool point kept off the seam by a stand-off runs a coaxial arc of another
+        # radius: the weld's travel speed is the seam's, so the tool point's is scaled
+        speed = phase.speed * cart.length / seam.length()
+        try:
+            cart = adnia.arc_move(p0, via, end, speed, **kw)
+        except PlannerError as exc:
+            raise ScenarioError(f"{label}: {exc}") from None
     if seam is not None and phase.orientation == "seam":
         cart = _along_seam(cart, seam, R0, ctx, label, corner=corner, roll=roll)
     return cart, seam
