@@ -40,6 +40,8 @@ if _TYPE_CHECKING:
     from sim.api import (
         Check,
         Collision,
+        MechanismAxis,
+        MechanismResult,
         RunOptions,
         RunResult,
         Saturation,
@@ -69,7 +71,7 @@ if _TYPE_CHECKING:
 
 __all__ = [
     # the API (sim.api)
-    "Check", "Collision", "RunOptions", "RunResult", "Saturation", "Scenario", "SelectedDrive",
+    "Check", "Collision", "MechanismAxis", "MechanismResult", "RunOptions", "RunResult", "Saturation", "Scenario", "SelectedDrive",
     "SizedJoint", "SizingCheck", "SweepResult", "evaluate", "load_scenario", "run", "sweep",
     # the exception tree (sim.errors; CellsimError is its root)
     "CatalogError", "CellsimError", "CellsimWarning", "InternalError", "ReachError",
@@ -78,8 +80,8 @@ __all__ = [
     "__version__",
 ]
 
-_API_NAMES = frozenset(__all__[:14])
-_ERROR_NAMES = frozenset(__all__[14:-1])
+_API_NAMES = frozenset(__all__[:16])
+_ERROR_NAMES = frozenset(__all__[16:-1])
 
 
 def __getattr__(name: str) -> object:

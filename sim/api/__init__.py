@@ -9,6 +9,8 @@ The package root ``sim`` exports these names lazily (``import sim`` loads none o
 from sim.api.results import (
     Check,
     Collision,
+    MechanismAxis,
+    MechanismResult,
     RunResult,
     Saturation,
     SelectedDrive,
@@ -21,6 +23,6 @@ from sim.pipeline.sweep import SweepResult
 from sim.scenario import Scenario, load_scenario
 
 __all__ = [
-    "Check", "Collision", "RunOptions", "RunResult", "Saturation", "Scenario", "SelectedDrive",
+    "Check", "Collision", "MechanismAxis", "MechanismResult", "RunOptions", "RunResult", "Saturation", "Scenario", "SelectedDrive",
     "SizedJoint", "SizingCheck", "SweepResult", "evaluate", "load_scenario", "run", "sweep",
 ]

@@ -3,7 +3,8 @@
 A :class:`RunResult` is what :func:`sim.evaluate` and :func:`sim.run` return and what
 :meth:`RunResult.load` reads back from a finished run folder. Its fields are the run's
 ``summary.json`` (and ``sizing.json``) in typed form: the verdict, every check, collisions,
-saturation intervals, per-joint sizing and the actuator selection, the stage timings; the
+saturation intervals, per-joint sizing and the actuator selection, the cell's mechanisms
+(positioners, turntables, tracks: what they carry, their axes' travel), the stage timings; the
 recorded arrays come from memory, or from ``trajectory.npz`` on first use for a loaded run.
 ``to_dict()`` gives ``summary.json``'s content back unchanged.
 """
@@ -97,7 +98,9 @@ class SizedJoint:
 
     The peak and RMS figures are the worse of the sources sizing was asked to use (its
     ``basis``: both the inverse dynamics and the simulation by default), joint side in N m and
-    rad/s, motor side in N m and rpm (None for a joint without drive data).
+    rad/s, motor side in N m and rpm (None for a joint without drive data). A prismatic joint
+    (``kind``: a track's axis) has its joint-side figures in :attr:`torque_unit` ``"N"`` and
+    :attr:`speed_unit` ``"m/s"`` (the ``_nm`` and ``_rad_s`` fields hold them).
     """
 
     joint: str
@@ -113,6 +116,17 @@ class SizedJoint:
     motor_rms_torque_nm: float | None
     motor_peak_speed_rpm: float | None
     checks: tuple[SizingCheck, ...]
+    kind: str = "revolute"
+
+    @property
+    def torque_unit(self) -> str:
+        """``"N m"``, or ``"N"`` for a prismatic joint."""
+        return "N" if self.kind == "prismatic" else "N m"
+
+    @property
+    def speed_unit(self) -> str:
+        """``"rad/s"``, or ``"m/s"`` for a prismatic joint."""
+        return "m/s" if self.kind == "prismatic" else "rad/s"
 
     def check(self, key: str) -> SizingCheck | None:
         """The check ``key`` (``"joint_torque"``, ``"motor_rms_torque"``, ...), or None."""
@@ -138,7 +152,78 @@ class SizedJoint:
             motor_peak_torque_nm=worst(motor_side, "peak_torque"),
             motor_rms_torque_nm=worst(motor_side, "rms_torque"),
             motor_peak_speed_rpm=worst(motor_side, "peak_speed_rpm"),
-            checks=tuple(SizingCheck.from_dict(c) for c in d.get("checks", [])))
+            checks=tuple(SizingCheck.from_dict(c) for c in d.get("checks", [])),
+            kind=str(d.get("kind", "revolute")))
+
+
+@dataclass(frozen=True)
+class MechanismAxis:
+    """One axis of a mechanism over the run (``summary.json``'s
+    ``mechanisms[<name>]["axes"][<axis>]``): its ``kind`` (``"revolute"`` or ``"prismatic"``),
+    the ``unit`` of the figures (``"deg"`` for a revolute axis, ``"mm"`` for a prismatic one),
+    the recorded travel ``min`` and ``max``, and the largest recorded speed ``max_speed`` (in
+    ``unit``/s)."""
+
+    name: str
+    kind: Literal["revolute", "prismatic"]
+    unit: Literal["deg", "mm"]
+    min: float
+    max: float
+    max_speed: float
+
+    @property
+    def travel(self) -> float:
+        """``max - min``, in :attr:`unit`."""
+        return self.max - self.min
+
+    @classmethod
+    def from_dict(cls, name: str, d: Mapping[str, Any]) -> MechanismAxis:
+        kind, unit = str(d["kind"]), str(d["unit"])
+        if kind not in ("revolute", "prismatic") or unit not in ("deg", "mm"):
+            raise ValueError(f"axis {name!r}: kind {kind!r}, unit {unit!r}")
+        return cls(name, cast(Literal["revolute", "prismatic"], kind),
+                   cast(Literal["deg", "mm"], unit), float(d["min"]), float(d["max"]),
+                   float(d["max_speed"]))
+
+
+@dataclass(frozen=True)
+class MechanismResult:
+    """A turntable, positioner or track of the cell over the run (``summary.json``'s
+    ``"mechanisms"`` entry).
+
+    Attributes:
+        name: The cell's name for it (its axes are ``<name>_<axis>``).
+        kind: ``"turntable"``, ``"positioner"`` or ``"track"``.
+        model: The mechanism's model (``motopos_d500``, or a file's name).
+        carries: What is mounted on it: object names, ``"robot"`` for a robot on a track.
+        carried_kg: The mass on its mount (what it carries), kg.
+        rated_payload_kg: Its rated payload, kg.
+        axes: Its axes by the cell's name (``positioner_tilt``), in chain order.
+    """
+
+    name: str
+    kind: str
+    model: str
+    carries: tuple[str, ...]
+    carried_kg: float
+    rated_payload_kg: float
+    axes: Mapping[str, MechanismAxis]
+
+    @property
+    def payload_ratio(self) -> float:
+        """``carried_kg / rated_payload_kg`` (inf for a mechanism rated 0 kg)."""
+        if self.rated_payload_kg <= 0:
+            return math.inf
+        return self.carried_kg / self.rated_payload_kg
+
+    @classmethod
+    def from_dict(cls, name: str, d: Mapping[str, Any]) -> MechanismResult:
+        return cls(name=name, kind=str(d["kind"]), model=str(d["model"]),
+                   carries=tuple(str(c) for c in d.get("carries", [])),
+                   carried_kg=float(d["carried_kg"]),
+                   rated_payload_kg=float(d["rated_payload_kg"]),
+                   axes={str(a): MechanismAxis.from_dict(str(a), v)
+                         for a, v in d.get("axes", {}).items()})
 
 
 @dataclass(frozen=True)
@@ -174,6 +259,8 @@ class RunResult:
         sizing_passed: Whether sizing passed on every joint (None when sizing was off).
         selection: The chosen motor and reducer by joint name (empty unless a catalogue
             selection was asked for).
+        mechanisms: The cell's turntables, positioners and tracks by name, in the cell's order
+            (empty for a cell without any).
         timings_s: Wall time of each stage, s.
         path: The run folder (None for a run evaluated in memory).
     """
@@ -192,6 +279,7 @@ class RunResult:
     selection: Mapping[str, SelectedDrive]
     timings_s: Mapping[str, float]
     path: Path | None = None
+    mechanisms: Mapping[str, MechanismResult] = field(default_factory=dict)
     _summary: dict[str, Any] = field(default_factory=dict, repr=False)
     _arrays: dict[str, NDArray[Any]] | None = field(default=None, repr=False)
 
@@ -273,6 +361,8 @@ class RunResult:
                 selection={str(j): SelectedDrive(str(j), d.get("motor"), d.get("reducer"))
                            for j, d in chosen.items()},
                 timings_s={str(k): float(v) for k, v in summary.get("timings_s", {}).items()},
+                mechanisms={str(n): MechanismResult.from_dict(str(n), m)
+                            for n, m in summary.get("mechanisms", {}).items()},
                 path=path, _summary=dict(summary), _arrays=arrays)
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise RunFolderError(f"{where}: not a finished run's summary "
