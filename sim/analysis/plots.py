@@ -11,10 +11,15 @@
   ``|tcp_pos - tcp_pos_ref|`` (mm) against time;
 * ``tracking_error.png``: ``q - q_ref`` per joint (deg) against time;
 * ``torques.png``: simulated actuator torque ``tau`` vs inverse dynamics of the reference
-  ``tau_id`` per joint (N m) against time.
+  ``tau_id`` per joint (N m) against time;
+* ``mechanism_<name>.png`` for every mechanism of the cell (``summary["mechanisms"]``: a
+  positioner, turntable or track): per axis its position, speed and torque (a linear axis's
+  force) against time, reference and simulated.
 
-Units: the scenario's (deg, mm), as every axis label says; torques in N m. Every figure has a
-fixed pixel size (:data:`FIGURE_SIZES` x :data:`DPI`).
+Units: the scenario's (deg, mm), as every axis label says; torques in N m. A linear external
+axis (a track's: a prismatic joint, ``summary["mechanisms"][...]["axes"][...]["kind"]``) is in
+mm, mm/s, ... and its "torque" is a force in N, in every figure. Every figure has a fixed pixel
+size (:data:`FIGURE_SIZES` x :data:`DPI`).
 """
 
 from __future__ import annotations
@@ -38,7 +43,24 @@ FIGURE_SIZES: dict[str, tuple[float, float]] = {
     "tool_path": (14.0, 6.0),
     "tracking_error": (12.0, 8.0),
     "torques": (12.0, 8.0),
+    "mechanism": (12.0, 9.0),
 }
+
+#: Display scale and unit of a joint's position by its kind (rad -> deg, m -> mm).
+POSITION_UNITS: dict[str, tuple[float, str]] = {"revolute": (math.degrees(1.0), "deg"),
+                                                 "prismatic": (1e3, "mm")}
+#: Unit of a joint's "torque" by its kind (a prismatic joint's is a force).
+TORQUE_UNITS = {"revolute": "N m", "prismatic": "N"}
+
+
+def joint_kinds(record: RunRecord) -> list[str]:
+    """Each joint's kind, ``"revolute"`` or ``"prismatic"``, in :attr:`RunRecord.joints`
+    order: a mechanism's axis as its summary entry says (``summary["mechanisms"]``), the
+    robot's joints revolute."""
+    kinds = {axis: str(v.get("kind", "revolute"))
+             for m in record.summary.get("mechanisms", {}).values()
+             for axis, v in m.get("axes", {}).items()}
+    return [kinds.get(name, "revolute") for name in record.joints]
 
 _REF = "#1a9e3f"
 _ACT = "#d62728"
@@ -157,25 +179,27 @@ def joint_figure(record: RunRecord, joint: int) -> Any:
         joint: Column index of the joint.
 
     Returns:
-        A matplotlib ``Figure`` with 4 axes (top to bottom: q, qd, qdd, qddd); in each, the
-        first line is the reference.
+        A matplotlib ``Figure`` with 4 axes (top to bottom: q, qd, qdd, qddd), in deg (a
+        prismatic joint's in mm, :func:`joint_kinds`); in each, the first line is the
+        reference.
     """
     t = record.t
     name = record.joints[joint]
+    scale, u = POSITION_UNITS[joint_kinds(record)[joint]]
     fig = _figure("joint")
     axes = fig.subplots(4, 1, sharex=True)
     rows = (
-        ("q_ref", "q", "position [deg]"),
-        ("qd_ref", "qd", "velocity [deg/s]"),
-        ("qdd_ref", None, "acceleration [deg/s²]"),
-        ("qddd_ref", None, "jerk [deg/s³]"),
+        ("q_ref", "q", f"position [{u}]"),
+        ("qd_ref", "qd", f"velocity [{u}/s]"),
+        ("qdd_ref", None, f"acceleration [{u}/s²]"),
+        ("qddd_ref", None, f"jerk [{u}/s³]"),
     )
     knots = _knots(record)
-    for k, (ax, (ref_key, act_key, label)) in enumerate(zip(axes, rows)):
-        ref = np.degrees(record.get(ref_key)[:, joint])
+    for k, (ax, (ref_key, act_key, label)) in enumerate(zip(axes, rows, strict=True)):
+        ref = scale * record.get(ref_key)[:, joint]
         ax.plot(t, ref, color=_REF, lw=1.6, label="reference")
         if act_key and record.has(act_key):
-            ax.plot(t, np.degrees(record.get(act_key)[:, joint]), color=_ACT, lw=1.0, ls="--",
+            ax.plot(t, scale * record.get(act_key)[:, joint], color=_ACT, lw=1.0, ls="--",
                     label="simulated")
         shade_phases(ax, record.phases, label=k == 0)
         mark_knots(ax, knots)
@@ -235,15 +259,17 @@ def tool_path_figure(record: RunRecord) -> Any:
 
 
 def tracking_error_figure(record: RunRecord) -> Any:
-    """Joint tracking error ``q - q_ref`` (deg) against time, one axes per joint."""
+    """Joint tracking error ``q - q_ref`` (deg; a prismatic joint's in mm) against time, one
+    axes per joint."""
     t = record.t
-    err = np.degrees(record.get("q") - record.get("q_ref"))
+    units = [POSITION_UNITS[k] for k in joint_kinds(record)]
+    err = (record.get("q") - record.get("q_ref")) * np.array([sc for sc, _ in units])
     fig = _figure("tracking_error")
     for j, ax in enumerate(_grid(fig, len(record.joints))):
         ax.plot(t, err[:, j], color=_ACT, lw=1.0)
         shade_phases(ax, record.phases, label=j == 0)
         ax.axhline(0.0, color="0.5", lw=0.5)
-        ax.set_ylabel(f"{record.joints[j]} error [deg]")
+        ax.set_ylabel(f"{record.joints[j]} error [{units[j][1]}]")
         ax.grid(True, lw=0.3)
         if ax.get_subplotspec().is_last_row():
             ax.set_xlabel("time [s]")
@@ -252,21 +278,65 @@ def tracking_error_figure(record: RunRecord) -> Any:
 
 
 def torque_figure(record: RunRecord) -> Any:
-    """Simulated torque vs inverse dynamics of the reference (N m), one axes per joint."""
+    """Simulated torque vs inverse dynamics of the reference (N m; a prismatic joint's force,
+    N), one axes per joint."""
     t = record.t
     tau, tau_id = record.get("tau"), record.get("tau_id")
+    kinds = joint_kinds(record)
     fig = _figure("torques")
     for j, ax in enumerate(_grid(fig, len(record.joints))):
         ax.plot(t, tau_id[:, j], color=_ID, lw=1.6, label="inverse dynamics (reference)")
         ax.plot(t, tau[:, j], color=_ACT, lw=0.9, ls="--", label="simulated")
         shade_phases(ax, record.phases, label=j == 0)
-        ax.set_ylabel(f"{record.joints[j]} torque [N m]")
+        what = "force" if kinds[j] == "prismatic" else "torque"
+        ax.set_ylabel(f"{record.joints[j]} {what} [{TORQUE_UNITS[kinds[j]]}]")
         ax.grid(True, lw=0.3)
         if ax.get_subplotspec().is_last_row():
             ax.set_xlabel("time [s]")
         if j == 0:
             ax.legend(loc="upper right", fontsize=8)
     fig.suptitle("joint torques")
+    return fig
+
+
+def mechanism_figure(record: RunRecord, name: str) -> Any:
+    """One mechanism's axes against time (``mechanism_<name>.png``): a column per axis, rows
+    position and speed (reference solid, simulated dashed) and torque (a linear axis's force:
+    inverse dynamics of the reference solid, simulated dashed), each in its axis's unit (deg or
+    mm, N m or N); the title names its kind, model, what it carries and that mass against its
+    rating (``summary["mechanisms"][name]``)."""
+    m = record.summary["mechanisms"][name]
+    axes_names = list(m["axes"])
+    kinds = joint_kinds(record)
+    t = record.t
+    fig = _figure("mechanism")
+    grid = fig.subplots(3, len(axes_names), sharex=True, squeeze=False)
+    knots = _knots(record)
+    for c, axis in enumerate(axes_names):
+        j = record.joints.index(axis)
+        scale, u = POSITION_UNITS[kinds[j]]
+        what = "force" if kinds[j] == "prismatic" else "torque"
+        rows = (("q_ref", "q", scale, f"position [{u}]"),
+                ("qd_ref", "qd", scale, f"speed [{u}/s]"),
+                ("tau_id", "tau", 1.0, f"{what} [{TORQUE_UNITS[kinds[j]]}]"))
+        for r, (ref_key, act_key, sc, label) in enumerate(rows):
+            ax = grid[r, c]
+            first = "inverse dynamics" if ref_key == "tau_id" else "reference"
+            ax.plot(t, sc * record.get(ref_key)[:, j], color=_ID if r == 2 else _REF, lw=1.6,
+                    label=first)
+            if record.has(act_key):
+                ax.plot(t, sc * record.get(act_key)[:, j], color=_ACT, lw=1.0, ls="--",
+                        label="simulated")
+            shade_phases(ax, record.phases, label=r == 0)
+            mark_knots(ax, knots)
+            ax.set_ylabel(f"{axis} {label}")
+            ax.grid(True, lw=0.3)
+            if r == 2:
+                ax.set_xlabel("time [s]")
+                ax.legend(loc="upper right", fontsize=8)
+    carries = ", ".join(m.get("carries", ())) or "nothing"
+    fig.suptitle(f"{name}: {m['kind']} {m['model']}, carries {carries} "
+                 f"({float(m['carried_kg']):.4g} kg, rated {float(m['rated_payload_kg']):g} kg)")
     return fig
 
 
@@ -290,7 +360,7 @@ def write_plots(run: str | Path | RunRecord, out_dir: str | Path | None = None) 
 
     Returns:
         Paths written: ``joint_<name>.png`` per joint, then ``tool_path.png``,
-        ``tracking_error.png``, ``torques.png``.
+        ``tracking_error.png``, ``torques.png``, then ``mechanism_<name>.png`` per mechanism.
 
     Raises:
         RunFolderError: The run is missing or lacks arrays the plots need.
@@ -316,6 +386,9 @@ def write_plots(run: str | Path | RunRecord, out_dir: str | Path | None = None) 
         ("tracking_error.png", lambda: tracking_error_figure(record)),
         ("torques.png", lambda: torque_figure(record)),
     ]
+    jobs += [(f"mechanism_{re.sub(r'[^A-Za-z0-9_.-]', '_', name)}.png",
+              lambda name=name: mechanism_figure(record, name))
+             for name in record.summary.get("mechanisms", {})]
     written = []
     for filename, build in jobs:
         fig = build()

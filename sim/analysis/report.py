@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from sim.analysis.catalog import describe_entry
+from sim.analysis.mechanism_report import AXIS_HEAD, mechanism_sections
 from sim.analysis.selection import REPORT_TOP
 from sim.analysis.sizing import (
     CHECK_TITLES,
@@ -154,12 +155,24 @@ def sizing_rows(result: SizingResult) -> tuple[list[str], list[dict[str, Any]]]:
             c = j.check(key)
             r[f"{key}_margin_pct"] = c.margin_pct if c else nan
         r["saturated"] = j.saturated
-        rows.append(r)
+        rows.append(r if j.kind == "revolute" else {_linear_column(k): v for k, v in r.items()})
     columns = list(REQUIRED_COLUMNS[:-2]) + ["margin_pct", "pass", "limiting"]
-    for k in rows[0] if rows else ():
+    for k in (k for r in rows for k in r):
         if k not in columns:
             columns.append(k)
     return columns, rows
+
+
+def _linear_column(key: str) -> str:
+    """A prismatic joint's column (a track's axis): its joint-side torques are forces in N,
+    its speeds m/s, its armature a mass in kg (``peak_torque_nm`` -> ``peak_force_n``); the
+    motor's columns and the margins keep their names."""
+    if key.startswith("motor_") or key.endswith("_margin_pct"):
+        return key
+    for a, b in (("torque", "force"), ("_nm", "_n"), ("_rad_s2", "_m_s2"), ("_rad_s", "_m_s"),
+                 ("armature_kg_m2", "armature_kg")):
+        key = key.replace(a, b)
+    return key
 
 
 # --------------------------------------------------------------------------------------------
@@ -177,22 +190,25 @@ def _f(x: float, digits: int = 4) -> str:
     return f"{x:.{digits}g}" if x is not None and np.isfinite(x) else "n/a"
 
 
-def _pair(j: JointSizing, attr: str, motor: bool = False, digits: int = 4) -> str:
+def _pair(j: JointSizing, attr: str, motor: bool = False, digits: int = 4,
+          unit: str = "") -> str:
     src = j.motor if motor else j.stats
     if not src:
         return "n/a"
-    return f"{_f(getattr(src['id'], attr), digits)} / {_f(getattr(src['sim'], attr), digits)}"
+    return (f"{_f(getattr(src['id'], attr), digits)} / {_f(getattr(src['sim'], attr), digits)}"
+            f" {unit}").rstrip()
 
 
-_TABLE_HEAD = ("joint", "peak torque N m (ID / sim)", "RMS torque N m (ID / sim)",
-               "peak speed rad/s (ID / sim)", "peak power W (ID / sim)", "energy J (ID / sim)",
+_TABLE_HEAD = ("joint", "peak torque or force (ID / sim)", "RMS torque or force (ID / sim)",
+               "peak speed (ID / sim)", "peak power W (ID / sim)", "energy J (ID / sim)",
                "motor peak N m (ID / sim)", "motor RMS N m (ID / sim)", "motor speed rpm (ID / sim)",
                "limiting check", "margin %", "verdict")
 
 
 def _table_cells(j: JointSizing) -> list[str]:
     lim = j.limiting
-    return [j.joint, _pair(j, "peak_torque"), _pair(j, "rms_torque"), _pair(j, "peak_speed"),
+    return [j.joint, _pair(j, "peak_torque", unit=j.torque_unit),
+            _pair(j, "rms_torque", unit=j.torque_unit), _pair(j, "peak_speed", unit=j.speed_unit),
             _pair(j, "peak_power"), _pair(j, "energy"), _pair(j, "peak_torque", True),
             _pair(j, "rms_torque", True), _pair(j, "peak_speed_rpm", True),
             (lim.title if lim else "n/a") + (" (simulated torque saturated)" if j.saturated else ""),
@@ -250,7 +266,8 @@ def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
                     summary: Mapping[str, Any] | None = None) -> str:
     """Text of ``sizing.md``: header, the run's verdict (``summary``'s: the same as
     ``report.html`` and ``summary.json``, with its failed checks and warnings), the sizing's
-    own verdict paragraph, table, checks, chart links."""
+    own verdict paragraph, a section per mechanism (:mod:`sim.analysis.mechanism_report`),
+    table, checks, chart links."""
     parts = [f"# Actuator sizing: {result.scenario or 'run'}", ""]
     parts.append(f"Robot: {result.robot or 'n/a'}; cycle duration {result.duration:.3f} s; checks "
                  f"on basis '{result.basis}'.")
@@ -269,7 +286,10 @@ def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
         parts += ["", ("The sizing below is one part of it (the drives' torque, speed and "
                        "envelope checks).")]
     parts += ["", "## Sizing verdict" if run_line is not None else "## Verdict", "",
-              result.verdict, "", "## Per joint", ""]
+              result.verdict, ""]
+    for sec in mechanism_sections(summary or {}, result):
+        parts += [f"## Mechanism {sec.title}", "", sec.load, "", _md_table(AXIS_HEAD, sec.rows), ""]
+    parts += ["## Per joint", ""]
     parts.append(_md_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
     parts += ["", "## Checks", ""]
     parts.append(_md_table(_CHECK_HEAD, [r for j in result.joints for r in _checks_cells(j)]))
@@ -477,6 +497,9 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
     out += _collision_html(summary)
     if selection is not None:
         out += selection_html(selection)
+    for sec in mechanism_sections(summary, result):
+        out += [f"<h2>Mechanism {esc(sec.title)}</h2>", f"<p>{esc(sec.load)}</p>",
+                _html_table(AXIS_HEAD, sec.rows)]
     out.append("<h2>Per joint</h2>")
     out.append(_html_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
     out.append("<h2>Checks, per joint</h2>")

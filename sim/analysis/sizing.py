@@ -70,6 +70,7 @@ from sim.analysis.model_limits import (
 )
 from sim.analysis.sizing_result import (
     CHECK_TITLES,
+    JOINT_UNITS,
     Check,
     JointSizing,
     MotorStats,
@@ -101,6 +102,7 @@ from sim.simulation.runfolder import (
 __all__ = [
     "BASES",
     "CHECK_TITLES",
+    "JOINT_UNITS",
     "PEAK_KNEE_FRACTION",
     "PEAK_WINDOW_S",
     "SATURATION_TOL",
@@ -366,7 +368,8 @@ def _check(key: str, used: float, limit: float, unit: str, source: str, time: fl
                  margin_pct=m, passed=not (np.isfinite(m) and m < 0), source=source, time=time)
 
 
-def _torque_check(s: SignalStats, lo: float, hi: float, t: NDArray, tau: NDArray) -> Check:
+def _torque_check(s: SignalStats, lo: float, hi: float, t: NDArray, tau: NDArray,
+                  unit: str = "N m") -> Check:
     # Sign by sign: the positive side against hi, the negative side against |lo|.
     cands = []
     if hi > 0:
@@ -377,9 +380,9 @@ def _torque_check(s: SignalStats, lo: float, hi: float, t: NDArray, tau: NDArray
         cands.append((margin_pct(-lo, used), used, -lo, float(t[int(np.argmin(tau))])))
     finite = [c for c in cands if np.isfinite(c[0])]
     if not finite:
-        return _check("joint_torque", s.peak_torque, np.inf, "N m", s.source, s.peak_torque_time)
+        return _check("joint_torque", s.peak_torque, np.inf, unit, s.source, s.peak_torque_time)
     m, used, limit, when = min(finite)
-    return _check("joint_torque", used, limit, "N m", s.source, when)
+    return _check("joint_torque", used, limit, unit, s.source, when)
 
 
 def size_trajectory(
@@ -395,6 +398,7 @@ def size_trajectory(
     robot: str = "",
     scenario: str = "",
     phases: Sequence[Mapping[str, Any]] = (),
+    prismatic: Sequence[str] = (),
 ) -> SizingResult:
     """Size every joint of a trajectory (pure computation, no I/O).
 
@@ -411,6 +415,8 @@ def size_trajectory(
         basis: ``"worst"`` (default: each check on the worse source), ``"id"`` or ``"sim"``.
         knee_fraction: Voltage-limit knee of the peak envelope, fraction of max motor speed.
         robot, scenario, phases: Carried into the result for the reports.
+        prismatic: The names of the prismatic joints (a track's axis): their "torque" is a
+            force in N, their speed in m/s, and their checks say so.
 
     Returns:
         The :class:`SizingResult`.
@@ -441,7 +447,10 @@ def size_trajectory(
     windows = {"id": 0.0, "sim": PEAK_WINDOW_S}
 
     joints = []
+    linear = set(prismatic)
     for j, name in enumerate(names):
+        kind = "prismatic" if name in linear else "revolute"
+        torque_unit, speed_unit, _ = JOINT_UNITS[kind]
         lo, hi = float(fr[j, 0]), float(fr[j, 1])
         stats = {s: signal_stats(t, tau[:, j], qd[:, j], qdd[:, j], s, windows[s])
                  for s, (tau, qd, qdd) in sources.items()}
@@ -449,9 +458,9 @@ def size_trajectory(
         for s, (tau, qd, qdd) in sources.items():
             st = stats[s]
             cands.setdefault("joint_torque", {})[s] = _torque_check(
-                st, lo, hi, t, sustained(t, tau[:, j], windows[s]))
+                st, lo, hi, t, sustained(t, tau[:, j], windows[s]), torque_unit)
             cands.setdefault("joint_speed", {})[s] = _check(
-                "joint_speed", st.peak_speed, vmax[j], "rad/s", s, st.peak_speed_time)
+                "joint_speed", st.peak_speed, vmax[j], speed_unit, s, st.peak_speed_time)
         motor: dict[str, MotorStats] = {}
         points = {}
         drive = drives[j] if drives else None
@@ -485,7 +494,7 @@ def size_trajectory(
         joints.append(JointSizing(
             joint=name, stats=stats, motor=motor, drive=drive, torque_range=(lo, hi),
             speed_limit=float(vmax[j]), armature=float(arm[j]), checks=checks,
-            saturated=saturated, points=points))
+            saturated=saturated, points=points, kind=kind))
 
     series = {"t": t, "tau_id": arr["tau_id"], "tau": arr["tau"], "qd_ref": arr["qd_ref"],
               "qd": arr["qd"]}
@@ -549,5 +558,6 @@ def _size(traj: dict[str, NDArray[np.float64]], summary: Mapping[str, Any], wher
         traj, names, drives=drives, forcerange=forcerange, speed_limits=spec.max_speed,
         armature=armature, basis=basis, knee_fraction=knee_fraction,
         robot=str(summary.get("robot", spec.name)), scenario=str(summary.get("scenario", "")),
-        phases=summary.get("phases", ()))
+        phases=summary.get("phases", ()),
+        prismatic=[name for name, axis in spec.external if axis.kind == "prismatic"])
     return dataclasses.replace(result, estimated_joints=spec.joints_on_estimates)

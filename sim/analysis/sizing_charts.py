@@ -33,7 +33,8 @@ _COLORS = {"id": "#1f77b4", "sim": "#d62728"}
 
 
 def chart_torques(result: SizingResult) -> bytes:
-    """PNG: joint torque against time, inverse dynamics and simulation, phases shaded; each
+    """PNG: joint torque against time (a prismatic joint's force, N), inverse dynamics and
+    simulation, phases shaded; each
     axis scaled to its data, the force range drawn as lines where it is in view and named at
     the edge where it is not."""
     from matplotlib.figure import Figure
@@ -60,13 +61,15 @@ def chart_torques(result: SizingResult) -> bytes:
             else:
                 off.append(f"{v:+.4g}")
         shade_phases(ax, phases, label=k == 0)
-        ax.set_ylabel(f"{j.joint} (N m)" + (f"\nlimits {' / '.join(off)}\n(off scale)"
+        ax.set_ylabel(f"{j.joint} ({j.torque_unit})" + (f"\nlimits {' / '.join(off)}\n(off scale)"
                                             if off else ""), fontsize=9)
         ax.grid(alpha=0.3)
     fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncol=2,
                fontsize=8)
     axes[-1].set_xlabel("time (s)")
-    fig.suptitle("Joint torques (dashed: force range, where in view)", fontsize=10)
+    linear = any(j.kind == "prismatic" for j in result.joints)
+    fig.suptitle(f"Joint torques{' and forces' if linear else ''} (dashed: force range, where "
+                 "in view)", fontsize=10)
     return figure_png(fig)
 
 
@@ -107,8 +110,9 @@ def chart_torque_speed(j: JointSizing, knee_fraction: float = PEAK_KNEE_FRACTION
             ax.plot([s_[s].peak_speed], [s_[s].peak_torque], "o", color=_COLORS[s],
                     label=f"peaks ({s})")
             ax.plot([0], [s_[s].rms_torque], "D", color=_COLORS[s], mec="k", label=f"RMS ({s})")
-        ax.set_xlabel("joint speed |qd| (rad/s)")
-        ax.set_ylabel("joint torque |tau| (N m)")
+        force = j.kind == "prismatic"
+        ax.set_xlabel(f"joint speed |qd| ({j.speed_unit})")
+        ax.set_ylabel(f"joint {'force |f|' if force else 'torque |tau|'} ({j.torque_unit})")
         ax.set_title(f"{j.joint}: joint side (no drive data)", fontsize=10)
     if j.drive is not None and j.points:  # the operating cloud in view, envelopes clipped
         speeds = np.concatenate([np.abs(v[0]) for v in j.points.values()])

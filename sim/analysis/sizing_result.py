@@ -131,13 +131,20 @@ CHECK_TITLES = {
 }
 
 
+#: Joint-side units by joint kind: ``(torque, speed, acceleration)``; a prismatic joint (a
+#: track's axis) has a force, a linear speed and acceleration (SI, as the recorded arrays).
+JOINT_UNITS = {"revolute": ("N m", "rad/s", "rad/s^2"), "prismatic": ("N", "m/s", "m/s^2")}
+
+
 @dataclass(frozen=True)
 class JointSizing:
     """Sizing of one joint.
 
     Attributes:
         joint: Joint name.
-        stats: Joint-side statistics by source (``"id"``, ``"sim"``).
+        stats: Joint-side statistics by source (``"id"``, ``"sim"``); for a prismatic joint
+            (:attr:`kind`) its torques are forces in N, its speeds in m/s (:attr:`torque_unit`,
+            :attr:`speed_unit`).
         motor: Motor-side statistics by source; empty without a drive.
         drive: The drive checked (None when the robot has no drive data).
         torque_range: Joint torque limits ``(lo, hi)``, N m (``(-inf, inf)`` when unlimited).
@@ -147,6 +154,7 @@ class JointSizing:
         saturated: The simulated torque reached the force range (the actuator clipped it).
         points: Motor operating points by source: ``(speed_rpm, torque_nm)`` arrays, shape (N,)
             each, signed (for the torque-speed chart; not serialized).
+        kind: ``"revolute"`` or ``"prismatic"`` (a linear external axis: force in N, m/s).
     """
 
     joint: str
@@ -160,6 +168,23 @@ class JointSizing:
     saturated: bool = False
     points: dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
         default_factory=dict, repr=False, compare=False)
+    kind: str = "revolute"
+
+    @property
+    def torque_unit(self) -> str:
+        """Unit of the joint-side "torque": ``"N m"``, or ``"N"`` (a force) for a prismatic
+        joint (a track's axis)."""
+        return JOINT_UNITS[self.kind][0]
+
+    @property
+    def speed_unit(self) -> str:
+        """Unit of the joint-side speed: ``"rad/s"``, or ``"m/s"`` for a prismatic joint."""
+        return JOINT_UNITS[self.kind][1]
+
+    @property
+    def accel_unit(self) -> str:
+        """Unit of the joint-side acceleration: ``"rad/s^2"``, or ``"m/s^2"``."""
+        return JOINT_UNITS[self.kind][2]
 
     @property
     def limiting(self) -> Check | None:
@@ -272,12 +297,17 @@ class SizingResult:
         return verdict_text(self)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary (NaN and infinities become None)."""
+        """JSON-ready dictionary (NaN and infinities become None). Each joint names its
+        ``kind`` and units: a prismatic joint's ``torque_range_nm``, joint-side torques and
+        ``speed_limit_rad_s`` are in its ``torque_unit`` (N) and ``speed_unit`` (m/s)."""
         joints = []
         for j in self.joints:
             lim = j.limiting
             joints.append({
                 "joint": j.joint,
+                "kind": j.kind,
+                "torque_unit": j.torque_unit,
+                "speed_unit": j.speed_unit,
                 "pass": j.passed,
                 "margin_pct": j.margin_pct,
                 "limiting": lim.key if lim else None,
