@@ -71,7 +71,8 @@ if _TYPE_CHECKING:
 
 __all__ = [
     # the API (sim.api)
-    "Check", "Collision", "MechanismAxis", "MechanismResult", "RunOptions", "RunResult", "Saturation", "Scenario", "SelectedDrive",
+    "Check", "Collision", "MechanismAxis", "MechanismResult", "RunOptions", "RunResult",
+    "Saturation", "Scenario", "SelectedDrive",
     "SizedJoint", "SizingCheck", "SweepResult", "evaluate", "load_scenario", "run", "sweep",
     # the exception tree (sim.errors; CellsimError is its root)
     "CatalogError", "CellsimError", "CellsimWarning", "InternalError", "ReachError",

@@ -23,6 +23,7 @@ from sim.pipeline.sweep import SweepResult
 from sim.scenario import Scenario, load_scenario
 
 __all__ = [
-    "Check", "Collision", "MechanismAxis", "MechanismResult", "RunOptions", "RunResult", "Saturation", "Scenario", "SelectedDrive",
+    "Check", "Collision", "MechanismAxis", "MechanismResult", "RunOptions", "RunResult",
+    "Saturation", "Scenario", "SelectedDrive",
     "SizedJoint", "SizingCheck", "SweepResult", "evaluate", "load_scenario", "run", "sweep",
 ]

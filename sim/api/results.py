@@ -179,8 +179,9 @@ class MechanismAxis:
     @classmethod
     def from_dict(cls, name: str, d: Mapping[str, Any]) -> MechanismAxis:
         kind, unit = str(d["kind"]), str(d["unit"])
-        if kind not in ("revolute", "prismatic") or unit not in ("deg", "mm"):
-            raise ValueError(f"axis {name!r}: kind {kind!r}, unit {unit!r}")
+        if (kind, unit) not in (("revolute", "deg"), ("prismatic", "mm")):
+            raise ValueError(f"mechanism axis {name!r}: kind {kind!r} in unit {unit!r} (a "
+                             "revolute axis is in deg, a prismatic one in mm)")
         return cls(name, cast(Literal["revolute", "prismatic"], kind),
                    cast(Literal["deg", "mm"], unit), float(d["min"]), float(d["max"]),
                    float(d["max_speed"]))
