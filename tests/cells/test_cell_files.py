@@ -436,13 +436,14 @@ def test_format_reference_documents_every_key():
         SeamBlock,
         SlotBlock,
     )
+    from sim.cells.cellfile.schema import MechanismBlock
     from sim.cells.toolfile import ShapeSpec, SuctionSpec, ToolFileSpec
 
     doc = (Path(__file__).resolve().parents[2] / "docs" / "cell-format.md").read_text()
     table_keys = set(re.findall(r"^\| `([a-z][a-z0-9_]*)`", doc, flags=re.M))
     declared = set()
     for model in (CellFileSpec, RobotBlock, ObjectBlock, SeamBlock, SlotBlock, CameraBlock,
-                  ToolFileSpec, ShapeSpec, SuctionSpec):
+                  MechanismBlock, ToolFileSpec, ShapeSpec, SuctionSpec):
         for key in model.model_fields:
             assert key in table_keys, f"{model.__name__}.{key} is not documented"
             declared.add(key)
