@@ -56,7 +56,7 @@ name = "move"
 planner = "434"
 time_s = [0.0, {duration_s!r}]
 joints_deg = [{k0}, {k1}]
-axes = {{ track_travel_mm = {travel_mm!r}, positioner_tilt_deg = {tilt_deg!r}, positioner_rotate_deg = {rotate_deg!r} }}
+axes = {{ {axes} }}
 """
 
 
@@ -85,5 +85,6 @@ def axes_scenario(folder: Path, *, travel_mm: float, tilt_deg: float, rotate_deg
     path = folder / "scenario.toml"
     path.write_text(_SCENARIO.format(
         robot=ROBOT, duration_s=float(duration_s), k0=list(KNOTS_DEG[0]), k1=list(KNOTS_DEG[1]),
-        travel_mm=float(travel_mm), tilt_deg=float(tilt_deg), rotate_deg=float(rotate_deg)))
+        axes=f"track_travel_mm = {float(travel_mm)!r}, positioner_tilt_deg = "
+             f"{float(tilt_deg)!r}, positioner_rotate_deg = {float(rotate_deg)!r}"))
     return path
