@@ -148,7 +148,8 @@ HOSTILE = [
 
 
 @pytest.mark.parametrize("path,value,key,piece", HOSTILE,
-                         ids=[f"{p}={v!r}"[:60] for p, v, _, _ in HOSTILE])
+                         ids=[f"{p}={'<deleted>' if v is _DELETE else repr(v)}"[:60]
+                              for p, v, _, _ in HOSTILE])
 def test_a_bad_value_is_one_line_naming_the_file_the_key_and_the_value(
         tmp_path, path, value, key, piece):
     doc = _base_doc()

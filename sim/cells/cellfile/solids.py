@@ -147,9 +147,9 @@ def read_solid(block: ObjectBlock, index: int, base: Path, where: str) -> Solid:
                         "cylinder, sphere or mesh)")
     if block.role == "part" and block.mass_kg is None:
         raise CellError(f"{key}.mass_kg: required for a part (a free body)")
-    if block.role != "part" and block.mass_kg is not None:
-        raise CellError(f"{key}.mass_kg: only parts have a mass (role = \"part\"); "
-                        f"{block.role}s are static")
+    if block.role != "part" and block.mass_kg is not None and block.on is None:
+        raise CellError(f"{key}.mass_kg: only parts and objects on a mechanism have a mass "
+                        f"(role = \"part\", or on = ...); {block.role}s are static")
     s = Solid(block, index, object_pose(block.pos_mm, block.euler_zyx_deg))
     if shape == "box":
         s.radius = float(np.linalg.norm(block.size_mm)) * 0.5e-3
