@@ -30,7 +30,12 @@ silently; a malformed line is a one-line error with its line number):
 * positions: Cartesian (``X, Y, Z`` mm, ``W, P, R`` deg: ``R = Rz(R) Ry(P) Rx(W)``, with
   ``CONFIG : 'N U T, 0, 0, 0'``: flip/no flip, up/down, front (T) / back (B), and the turn
   numbers of J4, J5, J6) or joint (``J1 = ... deg``: the controller's joint convention), with
-  their ``UF`` and ``UT``.
+  their ``UF`` and ``UT``, the extended axes of the robot's group (``E1= .. deg|mm``) and
+  further motion groups (``GP2:`` ..): :mod:`sim.scenario.fanuc_pos`;
+* ``DEFAULT_GROUP = 1,1,*,*,*;`` (``/ATTR``): the motion groups the program moves, which every
+  position holds (``LSProgram.groups``);
+* the motion options ``COORD``, ``PTH``, ``Wjnt``, ``INC`` are kept as flags of the motion
+  (``LSMotion.options``) and are warnings while not simulated (:data:`UNSIMULATED_OPTIONS`).
 
 :func:`parse_ls` gives a :class:`LSProgram`; :func:`write_ls` writes one, and
 :func:`write_weave_schedules` its schedule table.
@@ -46,28 +51,14 @@ from pydantic import Field
 
 from sim.core.tomlschema import Strict, load_toml
 from sim.errors import ScenarioError
-
-
-@dataclass(frozen=True)
-class LSPosition:
-    """A position of the /POS section (or a position register given to the scenario).
-
-    Attributes:
-        index: n of ``P[n]``. uf, ut: Its user frame and tool numbers.
-        xyzwpr: ``(X, Y, Z, W, P, R)`` in mm and deg, or None for a joint position.
-        config: ``(flip, up, front, turn4, turn5, turn6)``: ``"N"``/``"F"``, ``"U"``/``"D"``,
-            ``"T"``/``"B"``, ints; None for a joint position.
-        joints_deg: The controller's joint values (deg), or None for a Cartesian position.
-        line: Line number of ``P[n]{`` in the file.
-    """
-
-    index: int
-    uf: int
-    ut: int
-    xyzwpr: tuple[float, ...] | None = None
-    config: tuple | None = None
-    joints_deg: tuple[float, ...] | None = None
-    line: int = 0
+from sim.scenario.fanuc_pos import (
+    LSGroup,
+    LSPosition,
+    format_default_group,
+    format_position,
+    parse_default_group,
+    parse_position,
+)
 
 
 @dataclass(frozen=True)
@@ -79,6 +70,9 @@ class LSMotion:
         circular move's via point (C only). speed: The value; unit: ``"%"``, ``"mm/sec"``,
         ``"cm/min"``, ``"inch/min"`` or ``"sec"``. cnt: None for FINE, else 0..100.
         arc: ``"start"`` / ``"end"`` option on the line, or None. line: line number.
+        options: The motion options kept as flags, as written canonically, in order:
+        ``"COORD"`` (coordinated motion with another group), ``"PTH"``, ``"Wjnt"``, ``"INC"``
+        (:data:`FLAG_OPTIONS`); each is also a warning while in :data:`UNSIMULATED_OPTIONS`.
     """
 
     kind: str
@@ -89,6 +83,7 @@ class LSMotion:
     via: tuple[str, int] | None = None
     arc: str | None = None
     line: int = 0
+    options: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -126,8 +121,10 @@ class LSOther:
 @dataclass
 class LSProgram:
     """A parsed TP program: its name, instructions in order, positions by index, warnings
-    (``(line, text)`` for every instruction not run), and the weave schedules of its sidecar
-    table (``weave_table``: that file, None when there is none)."""
+    (``(line, text)`` for every instruction not run), the weave schedules of its sidecar
+    table (``weave_table``: that file, None when there is none), and the motion groups it moves
+    (``groups``: its ``DEFAULT_GROUP``'s, at ``groups_line``; without one (``groups_line`` 0),
+    those its positions hold), which every position holds."""
 
     name: str
     instructions: list = field(default_factory=list)
@@ -136,6 +133,8 @@ class LSProgram:
     path: Path | None = None
     weave_schedules: dict[int, WeaveSchedule] = field(default_factory=dict)
     weave_table: Path | None = None
+    groups: tuple[int, ...] = (1,)
+    groups_line: int = 0
 
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
@@ -161,6 +160,12 @@ _WEAVE_VALUES = (("frequency", "Hz"), ("amplitude", "mm"), ("right dwell", "s"),
 MAX_WEAVE_HZ = 20.0
 #: Most motion instructions a program may hold (a long weld program has some hundreds).
 MAX_PROGRAM_MOTIONS = 2000
+#: Longest line read (a controller's lines are shorter than 256 characters).
+MAX_LINE_CHARS = 2000
+#: Motion options kept as flags of :class:`LSMotion` (``options``), by their upper-case form.
+FLAG_OPTIONS = {"COORD": "COORD", "PTH": "PTH", "WJNT": "Wjnt", "INC": "INC"}
+#: The flags that are still warnings: program.py does not run them.
+UNSIMULATED_OPTIONS = frozenset({"COORD", "PTH", "Wjnt", "INC"})
 
 
 def _speed(value: str, unit: str, path, line: int) -> tuple[float, str]:
@@ -181,9 +186,11 @@ def _err(path, line: int, text: str) -> ScenarioError:
     return ScenarioError(f"{path}: line {line}: {text}")
 
 
-def _options(rest: str, path, line: int, warnings: list) -> str | None:
-    """The arc option of a motion line (``Arc Start[..]`` / ``Arc End[..]``); any other option
-    is a warning."""
+def _options(rest: str, path, line: int, warnings: list,
+             flags: list | None = None) -> str | None:
+    """The arc option of a motion line (``Arc Start[..]`` / ``Arc End[..]``), and its flags
+    (:data:`FLAG_OPTIONS`) appended to ``flags``; any other option is a warning, and so is a
+    flag of :data:`UNSIMULATED_OPTIONS`."""
     arc = None
     rest = rest.strip()
     while rest:
@@ -193,7 +200,12 @@ def _options(rest: str, path, line: int, warnings: list) -> str | None:
             rest = rest[m.end():].strip()
             continue
         m = re.match(r"^(\S+(?:\[[^\]]*\])?)\s*", rest)
-        warnings.append((line, f"motion option {m.group(1)!r} not simulated"))
+        flag = FLAG_OPTIONS.get(m.group(1).upper())
+        if flag is not None and flags is not None:
+            if flag not in flags:
+                flags.append(flag)
+        if flag is None or flag in UNSIMULATED_OPTIONS:
+            warnings.append((line, f"motion option {m.group(1)!r} not simulated"))
         rest = rest[m.end():].strip()
     return arc
 
@@ -212,6 +224,9 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
     while i < len(lines):
         raw = lines[i]
         ln = i + 1
+        if len(raw) > MAX_LINE_CHARS:
+            raise _err(path, ln, f"a line of {len(raw):,} characters (at most {MAX_LINE_CHARS:,}; "
+                       "a TP program's lines are short)")
         s = raw.strip()
         i += 1
         if not s:
@@ -243,9 +258,11 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
                 pending_circ = None
                 speed, unit = _speed(mc.group(3), mc.group(4), path, ln)
                 cnt = None if mc.group(5).upper() == "FINE" else int(mc.group(6))
+                flags: list[str] = []
+                arc = _options(mc.group(7), path, ln, prog.warnings, flags)
                 prog.instructions.append(LSMotion(
                     "C", (mc.group(1).upper(), int(mc.group(2))), speed, unit, cnt, via=via,
-                    arc=_options(mc.group(7), path, ln, prog.warnings), line=cline))
+                    arc=arc, line=cline, options=tuple(flags)))
                 _check_motion(prog.instructions[-1], path, ln)
                 continue
             if not body or body.startswith("!") or body.startswith("//"):
@@ -256,17 +273,20 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
                     raise _err(path, ln, f"a continuation line ({body!r}) after no motion")
                 from dataclasses import replace
 
-                arc = _options(body[1:], path, ln, prog.warnings)
-                if arc is not None:
-                    prog.instructions[-1] = replace(last, arc=arc)
+                flags = list(last.options)
+                arc = _options(body[1:], path, ln, prog.warnings, flags)
+                prog.instructions[-1] = replace(last, arc=last.arc if arc is None else arc,
+                                                options=tuple(flags))
                 continue
             mm = _MOTION.match(body)
             if mm:
                 kind = mm.group(1).upper()
                 speed, unit = _speed(mm.group(4), mm.group(5), path, ln)
                 cnt = None if mm.group(6).upper() == "FINE" else int(mm.group(7))
+                flags = []
+                arc = _options(mm.group(8), path, ln, prog.warnings, flags)
                 mo = LSMotion(kind, (mm.group(2).upper(), int(mm.group(3))), speed, unit, cnt,
-                              arc=_options(mm.group(8), path, ln, prog.warnings), line=ln)
+                              arc=arc, line=ln, options=tuple(flags))
                 _check_motion(mo, path, ln)
                 prog.instructions.append(mo)
                 continue
@@ -310,7 +330,7 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
             block = []
             start = ln
             while i < len(lines) and not lines[i].strip().startswith("};"):
-                block.append(lines[i])
+                block.append((i + 1, lines[i]))
                 i += 1
             if i >= len(lines):
                 raise _err(path, start, f"P[{m.group(1)}]: no closing '}};'")
@@ -318,10 +338,16 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
             if int(m.group(1)) in prog.positions:
                 raise _err(path, start, f"P[{m.group(1)}] is already defined (line "
                            f"{prog.positions[int(m.group(1))].line})")
-            prog.positions[int(m.group(1))] = _position(int(m.group(1)), " ".join(block),
-                                                        path, start)
+            prog.positions[int(m.group(1))] = parse_position(int(m.group(1)), block, path,
+                                                             start)
             continue
         if section in ("prog", "/ATTR", "/APPL"):
+            mg = re.match(r"^DEFAULT_GROUP\s*=\s*([^;]*);?\s*$", s, re.I)
+            if mg and section != "/APPL":
+                if prog.groups_line:
+                    raise _err(path, ln, f"DEFAULT_GROUP is given twice (line {prog.groups_line})")
+                prog.groups = parse_default_group(mg.group(1), path, ln)
+                prog.groups_line = ln
             continue
         if section == "/END":
             break
@@ -336,7 +362,33 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
                    "move); split it into several programs")
     if not prog.name:
         raise _err(path, 1, "no /PROG line (is this a TP program in ASCII form?)")
+    _check_groups(prog, path)
     return prog
+
+
+def _check_groups(prog: LSProgram, path) -> None:
+    """Every position holds the program's motion groups: ``DEFAULT_GROUP``'s, or without one
+    those of its first position (which become ``prog.groups``)."""
+    def names(groups) -> str:
+        return ", ".join(f"GP{g}" for g in groups)
+
+    first = None
+    for k in sorted(prog.positions, key=lambda k: prog.positions[k].line):
+        pos = prog.positions[k]
+        have = pos.group_numbers
+        if not prog.groups_line and first is None:
+            prog.groups, first = have, pos
+        if have == prog.groups:
+            continue
+        src = (f"DEFAULT_GROUP (line {prog.groups_line}) = {format_default_group(prog.groups)}"
+               if prog.groups_line else f"P[{first.index}] (line {first.line})")
+        extra = [g for g in pos.groups if g.number not in prog.groups]
+        if extra:
+            raise _err(path, extra[0].line, f"P[{k}] has GP{extra[0].number}, but {src} moves "
+                       f"{names(prog.groups)} only")
+        missing = [g for g in prog.groups if g not in have]
+        raise _err(path, pos.line, f"P[{k}] has no {names(missing)}, but {src} moves "
+                   f"{names(prog.groups)}")
 
 
 def _weave(m: re.Match, path, ln: int) -> LSWeave:
@@ -391,34 +443,6 @@ def _check_motion(mo: LSMotion, path, ln: int) -> None:
         raise _err(path, ln, f"speed {mo.speed:g} %: at most 100")
     if mo.cnt is not None and not 0 <= mo.cnt <= 100:
         raise _err(path, ln, f"CNT{mo.cnt}: 0..100")
-
-
-def _position(index: int, block: str, path, ln: int) -> LSPosition:
-    uf = re.search(r"UF\s*:\s*(\d+)", block)
-    ut = re.search(r"UT\s*:\s*(\d+)", block)
-    if not uf or not ut:
-        raise _err(path, ln, f"P[{index}]: needs 'UF : n, UT : n'")
-    joints = re.findall(rf"J(\d+)\s*=\s*({_NUM})\s*deg", block)
-    if joints:
-        vals = [float(v) for _, v in sorted(joints, key=lambda kv: int(kv[0]))]
-        return LSPosition(index, int(uf.group(1)), int(ut.group(1)), joints_deg=tuple(vals),
-                          line=ln)
-    vals = []
-    for name in ("X", "Y", "Z", "W", "P", "R"):
-        m = re.search(rf"(?<![A-Za-z]){name}\s*=\s*({_NUM})", block)
-        if not m:
-            raise _err(path, ln, f"P[{index}]: no {name} value (a Cartesian position needs X, Y, "
-                       "Z mm and W, P, R deg; a joint position J1.. deg)")
-        vals.append(float(m.group(1)))
-    mc = re.search(r"CONFIG\s*:\s*'\s*([NF])\s*([UD])?\s*([TB])\s*,\s*(-?\d+)\s*,\s*(-?\d+)\s*,"
-                   r"\s*(-?\d+)\s*'", block, re.I)
-    if not mc:
-        raise _err(path, ln, f"P[{index}]: no CONFIG : 'N U T, 0, 0, 0' (flip, up/down, "
-                   "front/back, turns of J4, J5, J6)")
-    config = (mc.group(1).upper(), (mc.group(2) or "U").upper(), mc.group(3).upper(),
-              int(mc.group(4)), int(mc.group(5)), int(mc.group(6)))
-    return LSPosition(index, int(uf.group(1)), int(ut.group(1)), xyzwpr=tuple(vals),
-                      config=config, line=ln)
 
 
 def read_ls(path: str | Path) -> LSProgram:
@@ -485,17 +509,27 @@ def write_weave_schedules(schedules: dict[int, WeaveSchedule], program: str) -> 
     return "\n".join(L)
 
 
-def _fmt(v: float) -> str:
-    return f"{v:10.3f}"
-
-
 def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
              comment: str = "") -> str:
-    """A TP program in ASCII form (what :func:`parse_ls` reads)."""
+    """A TP program in ASCII form (what :func:`parse_ls` reads): positions with their
+    extended axes and motion groups (:func:`~sim.scenario.fanuc_pos.format_position`), and
+    ``DEFAULT_GROUP`` naming the groups they hold.
+
+    Raises:
+        ScenarioError: Positions that do not all hold the same motion groups.
+    """
+    groups = (1,)
+    for i, k in enumerate(sorted(positions)):
+        have = positions[k].group_numbers
+        if i and have != groups:
+            raise ScenarioError(f"write_ls {name}: P[{k}] holds groups {have} but "
+                                f"P[{min(positions)}] {groups}; every position of a program "
+                                "holds the same groups")
+        groups = have
     L = [f"/PROG  {name.upper()}", "/ATTR", f'COMMENT\t\t= "{comment[:16]}";',
          "PROG_SIZE\t= 0;", "FILE_NAME\t= ;", "VERSION\t\t= 0;",
          f"LINE_COUNT\t= {len(instructions)};", "MEMORY_SIZE\t= 0;", "PROTECT\t\t= READ_WRITE;",
-         "DEFAULT_GROUP\t= 1,*,*,*,*;", "/MN"]
+         f"DEFAULT_GROUP\t= {format_default_group(groups)};", "/MN"]
     n = 0
 
     def add(text: str) -> None:
@@ -508,6 +542,7 @@ def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
             term = "FINE" if ins.cnt is None else f"CNT{ins.cnt}"
             speed = f"{ins.speed:g}{ins.unit}"
             arc = "" if ins.arc is None else f" Arc {'Start' if ins.arc == 'start' else 'End'}[1]"
+            arc = "".join(f" {o}" for o in ins.options) + arc
             tgt = f"{ins.target[0]}[{ins.target[1]}]"
             if ins.kind == "C":
                 add(f"C {ins.via[0]}[{ins.via[1]}]")
@@ -530,25 +565,12 @@ def write_ls(name: str, instructions: list, positions: dict[int, LSPosition],
             add(f"!{ins.value}")
     L.append("/POS")
     for k in sorted(positions):
-        p = positions[k]
-        L.append(f"P[{k}]{{")
-        L.append("   GP1:")
-        if p.joints_deg is not None:
-            L.append(f"\tUF : {p.uf}, UT : {p.ut},")
-            js = [f"J{j + 1}= {v:10.3f} deg" for j, v in enumerate(p.joints_deg)]
-            for r in range(0, len(js), 3):
-                L.append("\t" + ",\t".join(js[r:r + 3]) + ("," if r + 3 < len(js) else ""))
-        else:
-            f, u, t, t4, t5, t6 = p.config
-            L.append(f"\tUF : {p.uf}, UT : {p.ut},\t\tCONFIG : '{f} {u} {t}, {t4}, {t5}, {t6}',")
-            x, y, z, w, pp, r = p.xyzwpr
-            L.append(f"\tX = {_fmt(x)}  mm,\tY = {_fmt(y)}  mm,\tZ = {_fmt(z)}  mm,")
-            L.append(f"\tW = {_fmt(w)} deg,\tP = {_fmt(pp)} deg,\tR = {_fmt(r)} deg")
-        L.append("};")
+        L += format_position(k, positions[k])
     L.append("/END")
     return "\n".join(L) + "\n"
 
 
-__all__ = ["MAX_PROGRAM_MOTIONS", "MAX_WEAVE_HZ", "WEAVE_PATTERNS", "LSMotion", "LSOther", "LSPosition", "LSProgram",
-           "LSWeave", "WeaveSchedule", "parse_ls", "read_ls", "read_weave_schedules",
+__all__ = ["FLAG_OPTIONS", "MAX_LINE_CHARS", "MAX_PROGRAM_MOTIONS", "MAX_WEAVE_HZ",
+           "UNSIMULATED_OPTIONS", "WEAVE_PATTERNS", "LSGroup", "LSMotion", "LSOther", "LSPosition",
+           "LSProgram", "LSWeave", "WeaveSchedule", "parse_ls", "read_ls", "read_weave_schedules",
            "weave_table_path", "write_ls", "write_weave_schedules"]
