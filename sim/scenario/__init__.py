@@ -5,7 +5,8 @@ Owns: :mod:`~sim.scenario.schema` (the declared keys, pydantic), :mod:`~sim.scen
 (:class:`Scenario` in SI units, with its robot, cell and tool resolved into spec objects
 once), :mod:`~sim.scenario.loader` (TOML -> :class:`Scenario`, one-line errors naming the file
 and key), :mod:`~sim.scenario.phases` (the phases built from their entries, in SI units),
-:mod:`~sim.scenario.planning` (planning of joint phases), :mod:`~sim.scenario.fanuc_ls` and
+:mod:`~sim.scenario.planning` (planning of joint phases), :mod:`~sim.scenario.fanuc_ls`,
+:mod:`~sim.scenario.fanuc_pos` (its positions: motion groups, extended axes) and
 :mod:`~sim.scenario.program` (FANUC TP programs as phases). May import: planners,
 :mod:`sim.errors`, :mod:`sim.core`, :mod:`sim.robots`, :mod:`sim.cells`.
 """
