@@ -137,21 +137,22 @@ class LSProgram:
     groups_line: int = 0
 
 
-_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_NUM = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
 _TARGET = r"(P|PR)\[\s*(\d+)\s*(?::[^\]]*)?\]"
 _SPEED = rf"({_NUM}|WELD_SPEED|R\[\s*\d+\s*\])\s*(%|mm/sec|cm/min|inch/min|sec|)"
 _TERM = r"(FINE|CNT\s*(\d+))"
 _MOTION = re.compile(rf"^([JL])\s+{_TARGET}\s+{_SPEED}\s+{_TERM}\s*(.*)$", re.I)
 _CIRC1 = re.compile(rf"^C\s+{_TARGET}\s*$", re.I)
 _CIRC2 = re.compile(rf"^:\s*{_TARGET}\s+{_SPEED}\s+{_TERM}\s*(.*)$", re.I)
+_OPTION = re.compile(r"\s*(?:Arc\s+(Start|End)\s*\[[^\]]*\]|(\S+(?:\[[^\]]*\])?))", re.I)
 _ARC = re.compile(r"^Arc\s+(Start|End)\s*\[[^\]]*\]\s*$", re.I)
 _FRAME = re.compile(r"^(UFRAME_NUM|UTOOL_NUM)\s*=\s*(\d+)\s*$", re.I)
 _WAIT = re.compile(rf"^WAIT\s+({_NUM})\s*\(?\s*sec\s*\)?\s*$", re.I)
-_LINE = re.compile(r"^\s*(\d+)\s*:\s*(.*?)\s*;?\s*$")
+_LINE = re.compile(r"^\s*(\d+)\s*:(.*)$")  # its body: stripped, and of one closing ;
 #: ArcTool's weave patterns, as the instruction writes them (longest first for the match).
 WEAVE_PATTERNS = ("Figure 8", "Sine 2", "Circle", "Sine", "L")
 _WEAVE_ALT = "|".join(p.replace(" ", r"\s*") for p in WEAVE_PATTERNS)
-_WEAVE = re.compile(rf"^Weave\s+({_WEAVE_ALT})\s*\[\s*(.*?)\s*\]\s*$", re.I)
+_WEAVE = re.compile(rf"^Weave\s+({_WEAVE_ALT})\s*\[(.*)\]\s*$", re.I)
 _WEAVE_END = re.compile(r"^Weave\s+End\s*(?:\[\s*(\d+)\s*\])?\s*$", re.I)
 #: The values of ``Weave Sine[f, a, r, l]``: name and unit (the unit may be left out).
 _WEAVE_VALUES = (("frequency", "Hz"), ("amplitude", "mm"), ("right dwell", "s"),
@@ -162,6 +163,10 @@ MAX_WEAVE_HZ = 20.0
 MAX_PROGRAM_MOTIONS = 2000
 #: Longest line read (a controller's lines are shorter than 256 characters).
 MAX_LINE_CHARS = 2000
+#: Most lines a program may have (9,999 instructions and their positions fit many times).
+MAX_PROGRAM_LINES = 200_000
+#: Most warnings listed; one more line says that there were more.
+MAX_WARNINGS = 500
 #: Motion options kept as flags of :class:`LSMotion` (``options``), by their upper-case form.
 FLAG_OPTIONS = {"COORD": "COORD", "PTH": "PTH", "WJNT": "Wjnt", "INC": "INC"}
 #: The flags that are still warnings: program.py does not run them.
@@ -186,27 +191,34 @@ def _err(path, line: int, text: str) -> ScenarioError:
     return ScenarioError(f"{path}: line {line}: {text}")
 
 
+def _warn(warnings: list, line: int, text: str) -> None:
+    """A warning, while fewer than :data:`MAX_WARNINGS` are listed (then one saying so)."""
+    if len(warnings) < MAX_WARNINGS:
+        warnings.append((line, text))
+    elif len(warnings) == MAX_WARNINGS:
+        warnings.append((line, f"more warnings from this line on are not listed (at most "
+                               f"{MAX_WARNINGS})"))
+
+
 def _options(rest: str, path, line: int, warnings: list,
              flags: list | None = None) -> str | None:
     """The arc option of a motion line (``Arc Start[..]`` / ``Arc End[..]``), and its flags
     (:data:`FLAG_OPTIONS`) appended to ``flags``; any other option is a warning, and so is a
     flag of :data:`UNSIMULATED_OPTIONS`."""
     arc = None
-    rest = rest.strip()
-    while rest:
-        m = re.match(r"^Arc\s+(Start|End)\s*\[[^\]]*\]\s*", rest, re.I)
-        if m:
+    rest = rest.rstrip()
+    at = 0
+    while at < len(rest):
+        m = _OPTION.match(rest, at)
+        at = m.end()
+        if m.group(1):
             arc = m.group(1).lower()
-            rest = rest[m.end():].strip()
             continue
-        m = re.match(r"^(\S+(?:\[[^\]]*\])?)\s*", rest)
-        flag = FLAG_OPTIONS.get(m.group(1).upper())
-        if flag is not None and flags is not None:
-            if flag not in flags:
-                flags.append(flag)
+        flag = FLAG_OPTIONS.get(m.group(2).upper())
+        if flag is not None and flags is not None and flag not in flags:
+            flags.append(flag)
         if flag is None or flag in UNSIMULATED_OPTIONS:
-            warnings.append((line, f"motion option {m.group(1)!r} not simulated"))
-        rest = rest[m.end():].strip()
+            _warn(warnings, line, f"motion option {m.group(2)!r} not simulated")
     return arc
 
 
@@ -216,6 +228,9 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
     Raises:
         ScenarioError: A malformed line (one line: file, line number, what is wrong).
     """
+    if text.count("\n") >= MAX_PROGRAM_LINES:
+        raise _err(path, MAX_PROGRAM_LINES + 1, f"more than {MAX_PROGRAM_LINES:,} lines (split "
+                   "the program)")
     lines = text.splitlines()
     prog = LSProgram(name="", path=Path(path))
     section = None
@@ -238,13 +253,14 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
         if s.startswith("/"):
             key = s.split()[0]
             if key not in ("/ATTR", "/MN", "/POS", "/END", "/APPL", "/APPL_END"):
-                prog.warnings.append((ln, f"section {key} not read"))
+                _warn(prog.warnings, ln, f"section {key} not read")
             section = key
             continue
         if section == "/MN":
             m = _LINE.match(raw)
             if m:
                 body = m.group(2).strip()
+                body = body[:-1].rstrip() if body.endswith(";") else body
             elif s.startswith(":"):  # a circular move's second line, or options continued
                 body = s.rstrip(";").strip()
             else:
@@ -321,7 +337,7 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
                     raise _err(path, ln, f"WAIT {mw.group(1)} sec: a time is >= 0")
                 prog.instructions.append(LSOther("wait", float(mw.group(1)), ln))
                 continue
-            prog.warnings.append((ln, f"instruction not simulated: {body}"))
+            _warn(prog.warnings, ln, f"instruction not simulated: {body}")
             continue
         if section == "/POS":
             m = re.match(r"^P\[\s*(\d+)\s*(?::[^\]]*)?\]\s*\{\s*$", s)
@@ -397,7 +413,7 @@ def _weave(m: re.Match, path, ln: int) -> LSWeave:
     written = " ".join(m.group(1).split())
     pattern = next(p for p in WEAVE_PATTERNS if p.replace(" ", "").lower()
                    == written.replace(" ", "").lower())
-    arg = m.group(2)
+    arg = m.group(2).strip()
     what = f"Weave {pattern}[{arg}]"
     if re.fullmatch(r"\d+", arg):
         if int(arg) < 1:

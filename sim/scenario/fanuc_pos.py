@@ -57,7 +57,7 @@ MAX_GROUPS = 8
 #: Longest line of a position block (a controller writes fewer than 100 characters).
 MAX_POS_LINE = 1000
 
-_NUM = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+_NUM = re.compile(r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?")
 _HEADER = re.compile(r"^GP\s*(\d+)\s*:\s*(.*)$", re.I)
 _FRAME = re.compile(r"^(UF|UT)\s*:\s*(\S*)$", re.I)
 _CONFIG = re.compile(r"^CONFIG\s*:\s*(.*)$", re.I)
@@ -155,10 +155,15 @@ def _err(path, line: int, text: str) -> ScenarioError:
     return ScenarioError(f"{path}: line {line}: {text}")
 
 
+def _cut(text: str, n: int = 40) -> str:
+    """Text of the file shown in a message: at most ``n`` characters."""
+    return text if len(text) <= n else text[:n - 3] + "..."
+
+
 def _items(text: str, path, ln: int, what: str) -> list[str]:
     """A line's comma-separated items (a quoted CONFIG keeps its commas)."""
     if text.count("'") % 2:
-        raise _err(path, ln, f"{what}: a quote (') is not closed: {text.strip()!r}")
+        raise _err(path, ln, f"{what}: a quote (') is not closed: {_cut(text.strip())!r}")
     return [s.strip() for s in _ITEM.findall(text) if s.strip()]
 
 
@@ -179,7 +184,8 @@ class _Group:
             if key in self.frames:
                 raise _err(path, ln, f"{what}: {key} is given twice (line {self.frames[key][1]})")
             if not re.fullmatch(r"\d{1,4}", mf.group(2)):
-                raise _err(path, ln, f"{what}: '{item}': {key} is a frame number, '{key} : n'")
+                raise _err(path, ln, f"{what}: {_cut(item)!r}: {key} is a frame number, "
+                           f"'{key} : n'")
             self.frames[key] = (int(mf.group(2)), ln)
             return
         mc = _CONFIG.match(item)
@@ -188,18 +194,18 @@ class _Group:
                 raise _err(path, ln, f"{what}: CONFIG is given twice (line {self.config[1]})")
             cv = _CONFIG_VALUE.match(mc.group(1).strip())
             if not cv:
-                raise _err(path, ln, f"{what}: {item!r}: CONFIG : 'N U T, 0, 0, 0' (flip N/F, "
-                           "up/down U/D, front/back T/B, turns of J4, J5, J6)")
+                raise _err(path, ln, f"{what}: {_cut(item)!r}: CONFIG : 'N U T, 0, 0, 0' (flip "
+                           "N/F, up/down U/D, front/back T/B, turns of J4, J5, J6)")
             self.config = ((cv.group(1).upper(), (cv.group(2) or "U").upper(),
                             cv.group(3).upper(), int(cv.group(4)), int(cv.group(5)),
                             int(cv.group(6))), ln)
             return
         mv = _VALUE.match(item)
         if not mv:
-            raise _err(path, ln, f"{what}: {item!r} is not a position value ('NAME = value "
+            raise _err(path, ln, f"{what}: {_cut(item)!r} is not a position value ('NAME = value "
                        "unit', 'UF : n', 'UT : n' or CONFIG : '...')")
         letters, digits, text, unit = mv.group(1).upper(), mv.group(2), mv.group(3), mv.group(4)
-        name = letters + digits
+        name = _cut(letters + digits, 12)
         if not ((letters in _CARTESIAN and not digits) or (letters in ("J", "E") and digits)):
             raise _err(path, ln, f"{what}: {name} is not a position value (X, Y, Z, W, P, R, "
                        "J1.., E1..)")
@@ -212,18 +218,19 @@ class _Group:
         if name in self.values:
             raise _err(path, ln, f"{what}: {name} is given twice (line {self.values[name][2]})")
         if not _NUM.fullmatch(text):
-            raise _err(path, ln, f"{what}: {name} = {text!r}: not a number")
+            raise _err(path, ln, f"{what}: {name} = {_cut(text)!r}: not a number")
         value = float(text)
         if not math.isfinite(value):
-            raise _err(path, ln, f"{what}: {name} = {text}: not a finite number")
+            raise _err(path, ln, f"{what}: {name} = {_cut(text)}: not a finite number")
         unit = unit.lower()
         if letters in ("X", "Y", "Z") and unit not in ("", "mm"):
-            raise _err(path, ln, f"{what}: {name} is in mm, not {unit!r}")
+            raise _err(path, ln, f"{what}: {name} is in mm, not {_cut(unit, 12)!r}")
         if letters in ("W", "P", "R") and unit not in ("", "deg"):
-            raise _err(path, ln, f"{what}: {name} is in deg, not {unit!r}")
+            raise _err(path, ln, f"{what}: {name} is in deg, not {_cut(unit, 12)!r}")
         if letters in ("J", "E") and unit not in AXIS_KIND:
-            raise _err(path, ln, f"{what}: {name} = {text} {unit}: the unit is deg (a rotary "
-                       "axis) or mm (a linear one)" + ("" if unit else ", and is not left out"))
+            raise _err(path, ln, f"{what}: {name} = {_cut(text)} {_cut(unit, 12)}: the unit is deg "
+                       "(a rotary axis) or mm (a linear one)"
+                       + ("" if unit else ", and is not left out"))
         self.values[name] = (value, unit, ln)
 
     def indexed(self, letter: str, path) -> list[tuple[float, str, int]]:
@@ -248,9 +255,7 @@ class _Group:
         if joints and cart:
             raise _err(path, self.values[cart[0]][2], f"{what}: both joint (J1 ..) and Cartesian "
                        f"({cart[0]} ..) values; a position is one or the other")
-        if joints:
-            if self.config is not None:
-                raise _err(path, self.config[1], f"{what}: CONFIG in a joint position (J1 ..)")
+        if joints:  # a CONFIG beside joint values says nothing more: not kept
             if self.number == 1:
                 bad = next((v for v in joints if v[1] != "deg"), None)
                 if bad is not None:
@@ -292,7 +297,7 @@ def parse_position(index: int, block: list[tuple[int, str]], path, line: int) ->
         if mh:
             number = int(mh.group(1)) if len(mh.group(1)) <= 3 else 0
             if not 1 <= number <= MAX_GROUPS:
-                raise _err(path, ln, f"{where}: GP{mh.group(1)}: motion groups are GP1 .. "
+                raise _err(path, ln, f"{where}: GP{_cut(mh.group(1), 6)}: motion groups are GP1 .. "
                            f"GP{MAX_GROUPS}")
             if any(g.number == number for g in groups):
                 raise _err(path, ln, f"{where}: GP{number} is given twice")
@@ -327,7 +332,7 @@ def parse_default_group(text: str, path, ln: int) -> tuple[int, ...]:
     """
     entries = [e.strip() for e in text.split(",")]
     if not 1 <= len(entries) <= MAX_GROUPS or any(e not in ("1", "*") for e in entries):
-        raise _err(path, ln, f"DEFAULT_GROUP = {text.strip()[:60]!r}: up to {MAX_GROUPS} "
+        raise _err(path, ln, f"DEFAULT_GROUP = {_cut(text.strip())!r}: up to {MAX_GROUPS} "
                    "entries, each 1 (the program moves that group) or * (e.g. 1,1,*,*,*)")
     groups = tuple(k + 1 for k, e in enumerate(entries) if e == "1")
     if 1 not in groups:

@@ -439,3 +439,36 @@ def test_a_huge_line_is_refused_by_its_length():
     text = hand_text(BASE).replace("E1=", "E1=" + "1" * 100_000, 1)
     with pytest.raises(ScenarioError, match=r"line \d+: (P\[1\]: )?a line of 100,0\d\d characters"):
         parse_ls(text, "big.ls")
+
+
+def test_a_long_value_is_cut_in_the_message():
+    text = hand_text(BASE).replace("E1=", "E1=" + "x" * 900 + " ", 1)
+    with pytest.raises(ScenarioError) as e:
+        parse_ls(text, "long.ls")
+    assert len(str(e.value)) < 200 and "..." in str(e.value)
+
+
+def test_the_program_s_lines_and_warnings_are_bounded():
+    from sim.scenario.fanuc_ls import MAX_PROGRAM_LINES, MAX_WARNINGS
+
+    with pytest.raises(ScenarioError, match=rf"line {MAX_PROGRAM_LINES + 1}: more than"):
+        parse_ls("/PROG X\n" + "\n" * MAX_PROGRAM_LINES, "many.ls")
+    body = "\n".join(f"{k}: DO[1]=ON ;" for k in range(1, 2 * MAX_WARNINGS))
+    prog = parse_ls(f"/PROG X\n/MN\n{body}\n/END\n", "w.ls")
+    assert len(prog.warnings) == MAX_WARNINGS + 1
+    assert "not listed" in prog.warnings[-1][1] and prog.warnings[-2][0] == MAX_WARNINGS + 2
+
+
+@pytest.mark.parametrize("line", [
+    "1: a" + " " * 900 + "b" + " " * 900 + "c",  # the line pattern took cubic time: 17 s
+    "1: Weave Sine[" + " " * 1900 + "x",          # the weave pattern: 3 s
+    "1: WAIT " + "1" * 1900 + "x",                # a number's digits: quadratic
+    "1: L P[1] 100mm/sec FINE " + "a " * 900,     # 900 options
+])
+def test_lines_built_to_make_the_patterns_backtrack_are_read_at_once(line):
+    """Each of these took seconds to match before the patterns were made linear (no clock
+    here: a regression shows as a slow test)."""
+    try:
+        parse_ls(f"/PROG X\n/MN\n{line}\n{line}\n{line}\n/END\n", "slow.ls")
+    except ScenarioError as e:
+        assert "\n" not in str(e)
