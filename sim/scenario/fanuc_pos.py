@@ -46,8 +46,7 @@ from sim.errors import ScenarioError
 
 #: Unit of an extended axis or of a joint of GP2 .. -> the kind of axis it is.
 AXIS_KIND = {"deg": "revolute", "mm": "prismatic"}
-#: Unit -> factor from the written value to SI (rad, m).
-_TO_SI = {"deg": math.pi / 180.0, "mm": 1e-3}
+
 #: Most extended axes of a group (``E1`` .. ``E9``).
 MAX_EXT_AXES = 9
 #: Most joints of a group (``J1`` .. ``J9``).
@@ -66,6 +65,16 @@ _CONFIG_VALUE = re.compile(r"^'\s*([NF])\s*([UD])?\s*([TB])\s*,\s*(-?\d{1,3})\s*
 _VALUE = re.compile(r"^([A-Za-z]+)(\d*)\s*=\s*(\S*?)\s*([A-Za-z]*)$")
 _ITEM = re.compile(r"(?:[^,']|'[^']*')+")
 _CARTESIAN = ("X", "Y", "Z", "W", "P", "R")
+
+
+def to_si(value: float, unit: str) -> float:
+    """A value written in ``unit`` (``"deg"`` / ``"mm"``) in SI: rad / m."""
+    return math.radians(value) if unit == "deg" else value / 1000.0
+
+
+def from_si(value: float, unit: str) -> float:
+    """An SI value (rad / m) in ``unit`` (``"deg"`` / ``"mm"``), as written."""
+    return math.degrees(value) if unit == "deg" else value * 1000.0
 
 
 @dataclass(frozen=True)
@@ -262,7 +271,7 @@ class _Group:
                     raise _err(path, bad[2], f"{what}: the robot's joints (J1 ..) are in deg")
                 out["joints_deg"] = tuple(v for v, _, _ in joints)
             else:
-                out["joints"] = tuple(v * _TO_SI[u] for v, u, _ in joints)
+                out["joints"] = tuple(to_si(v, u) for v, u, _ in joints)
                 out["joint_units"] = tuple(u for _, u, _ in joints)
         else:
             for name in _CARTESIAN:
@@ -274,7 +283,7 @@ class _Group:
                            "up/down, front/back, turns of J4, J5, J6)")
             out["xyzwpr"] = tuple(self.values[k][0] for k in _CARTESIAN)
             out["config"] = self.config[0]
-        out["ext"] = tuple(v * _TO_SI[u] for v, u, _ in ext)
+        out["ext"] = tuple(to_si(v, u) for v, u, _ in ext)
         out["ext_units"] = tuple(u for _, u, _ in ext)
         return out
 
@@ -353,7 +362,7 @@ def _fmt(v: float) -> str:
 
 
 def _axis(name: str, value_si: float, unit: str) -> str:
-    v = value_si / _TO_SI[unit]
+    v = from_si(value_si, unit)
     return f"{name}= {_fmt(v)}  mm" if unit == "mm" else f"{name}= {_fmt(v)} deg"
 
 
@@ -405,4 +414,5 @@ def format_position(k: int, p: LSPosition) -> list[str]:
 
 
 __all__ = ["AXIS_KIND", "MAX_EXT_AXES", "MAX_GROUPS", "MAX_GROUP_JOINTS", "LSGroup", "LSPosition",
-           "format_default_group", "format_position", "parse_default_group", "parse_position"]
+           "format_default_group", "format_position", "from_si", "parse_default_group",
+           "parse_position", "to_si"]

@@ -472,3 +472,20 @@ def test_lines_built_to_make_the_patterns_backtrack_are_read_at_once(line):
         parse_ls(f"/PROG X\n/MN\n{line}\n{line}\n{line}\n/END\n", "slow.ls")
     except ScenarioError as e:
         assert "\n" not in str(e)
+
+
+def test_a_second_robot_as_gp2_with_its_own_track_reads_and_writes_back():
+    """GP2 Cartesian (a second arm) with its CONFIG and an E1 of its own."""
+    text = hand_text(BASE).replace(
+        "\tUF : 1, UT : 2,\n\tJ1=    90.000  deg,\tJ2=   -30.000  deg",
+        "\tUF : 2, UT : 3,\t\tCONFIG : 'F D B, 1, 0, -1',\n"
+        "\tX =   1.500 mm,\tY =   -2.250 mm,\tZ =   3.000 mm,\n"
+        "\tW =   4.000 deg,\tP =   5.000 deg,\tR =   -6.000 deg,\n\tE1=   -250.500  mm")
+    assert "CONFIG : 'F D B" in text
+    prog = parse_ls(text, "two.ls")
+    g = prog.positions[1].gp2
+    assert (g.uf, g.ut, g.joints, g.config) == (2, 3, None, ("F", "D", "B", 1, 0, -1))
+    assert g.xyzwpr == (1.5, -2.25, 3.0, 4.0, 5.0, -6.0)
+    assert g.ext == (-0.2505,) and g.ext_kinds == ("prismatic",)
+    again = parse_ls(write_ls("TWO", prog.instructions, prog.positions), "again.ls")
+    assert again.positions[1].gp2 == replace(g, line=again.positions[1].gp2.line)
