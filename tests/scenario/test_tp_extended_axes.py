@@ -339,8 +339,7 @@ CORRUPTIONS = [
     ("-1e400", _sub_value("J2", "J2=   -1e400  deg"), "not a finite number"),
     ("duplicate E1", lambda s: s + ",\tE1=   2.000  mm" if "E1=" in s else None, "given twice"),
     ("J9999", _sub_value("J1", "J9999= 1.000 deg"), "J1 .. J9"),
-    ("robot joint in mm", lambda s: s.replace("J1=", "J1=").replace(" deg,\tJ2", " mm,\tJ2")
-     if "J1=" in s and "J2=" in s and "J3=" in s and s.count(" deg,\tJ2") else None,
+    ("robot joint in mm", lambda s: s.replace(" deg,\tJ2", " mm,\tJ2") if "J3=" in s else None,
      "are in deg"),
     ("quote", lambda s: s.replace("CONFIG : '", "CONFIG : ") if "CONFIG" in s else None,
      "quote"),
