@@ -54,6 +54,7 @@ from sim.errors import ScenarioError
 from sim.scenario.fanuc_pos import (
     LSGroup,
     LSPosition,
+    check_groups,
     format_default_group,
     format_position,
     parse_default_group,
@@ -378,33 +379,8 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
                    "move); split it into several programs")
     if not prog.name:
         raise _err(path, 1, "no /PROG line (is this a TP program in ASCII form?)")
-    _check_groups(prog, path)
+    prog.groups = check_groups(prog.positions, prog.groups, prog.groups_line, path)
     return prog
-
-
-def _check_groups(prog: LSProgram, path) -> None:
-    """Every position holds the program's motion groups: ``DEFAULT_GROUP``'s, or without one
-    those of its first position (which become ``prog.groups``)."""
-    def names(groups) -> str:
-        return ", ".join(f"GP{g}" for g in groups)
-
-    first = None
-    for k in sorted(prog.positions, key=lambda k: prog.positions[k].line):
-        pos = prog.positions[k]
-        have = pos.group_numbers
-        if not prog.groups_line and first is None:
-            prog.groups, first = have, pos
-        if have == prog.groups:
-            continue
-        src = (f"DEFAULT_GROUP (line {prog.groups_line}) = {format_default_group(prog.groups)}"
-               if prog.groups_line else f"P[{first.index}] (line {first.line})")
-        extra = [g for g in pos.groups if g.number not in prog.groups]
-        if extra:
-            raise _err(path, extra[0].line, f"P[{k}] has GP{extra[0].number}, but {src} moves "
-                       f"{names(prog.groups)} only")
-        missing = [g for g in prog.groups if g not in have]
-        raise _err(path, pos.line, f"P[{k}] has no {names(missing)}, but {src} moves "
-                   f"{names(prog.groups)}")
 
 
 def _weave(m: re.Match, path, ln: int) -> LSWeave:

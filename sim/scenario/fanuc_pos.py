@@ -27,8 +27,7 @@ are separated by commas, one name a value: a name written twice, a missing or ot
 and Cartesian values in one group are one-line errors naming the line.
 
 The program's ``DEFAULT_GROUP = 1,1,*,*,*;`` (``/ATTR``) names the groups its motions move
-(:func:`parse_default_group`); every position holds exactly those (checked by the reader,
-:mod:`sim.scenario.fanuc_ls`).
+(:func:`parse_default_group`); every position holds exactly those (:func:`check_groups`).
 
 Units: the extended axes and the joint values of GP2 .. are kept in SI (rad, m) with the unit
 each was written in (``deg`` is a revolute axis, ``mm`` a prismatic one: :data:`AXIS_KIND`), so
@@ -350,6 +349,38 @@ def parse_default_group(text: str, path, ln: int) -> tuple[int, ...]:
     return groups
 
 
+def check_groups(positions: dict[int, LSPosition], groups: tuple[int, ...], groups_line: int,
+                 path) -> tuple[int, ...]:
+    """The program's motion groups, which every position holds: ``groups`` of its
+    ``DEFAULT_GROUP`` at ``groups_line``, or without one (``groups_line`` 0) those of its first
+    position.
+
+    Raises:
+        ScenarioError: A position without one of them, or with another, naming its line.
+    """
+    def names(numbers) -> str:
+        return ", ".join(f"GP{g}" for g in numbers)
+
+    first = None
+    for k in sorted(positions, key=lambda k: positions[k].line):
+        pos = positions[k]
+        have = pos.group_numbers
+        if not groups_line and first is None:
+            groups, first = have, pos
+        if have == groups:
+            continue
+        src = (f"DEFAULT_GROUP (line {groups_line}) = {format_default_group(groups)}"
+               if groups_line else f"P[{first.index}] (line {first.line})")
+        extra = [g for g in pos.groups if g.number not in groups]
+        if extra:
+            raise _err(path, extra[0].line, f"P[{k}] has GP{extra[0].number}, but {src} moves "
+                       f"{names(groups)} only")
+        missing = [g for g in groups if g not in have]
+        raise _err(path, pos.line, f"P[{k}] has no {names(missing)}, but {src} moves "
+                   f"{names(groups)}")
+    return groups
+
+
 def format_default_group(groups: tuple[int, ...] | list[int]) -> str:
     """The ``DEFAULT_GROUP`` value naming ``groups`` (``(1, 2)`` -> ``"1,1,*,*,*"``; at least five
     entries, as controllers write it)."""
@@ -414,5 +445,5 @@ def format_position(k: int, p: LSPosition) -> list[str]:
 
 
 __all__ = ["AXIS_KIND", "MAX_EXT_AXES", "MAX_GROUPS", "MAX_GROUP_JOINTS", "LSGroup", "LSPosition",
-           "format_default_group", "format_position", "from_si", "parse_default_group",
-           "parse_position", "to_si"]
+           "check_groups", "format_default_group", "format_position", "from_si",
+           "parse_default_group", "parse_position", "to_si"]
