@@ -173,6 +173,9 @@ class CartesianPhase:
             points up at the tool point (coordinated motion, :mod:`sim.simulation.motion.axes`).
         follow: Along ``seam``: the track (a mechanism's name) that carries the robot with
             the tool point.
+        axes: External axes' values at the move's end, rad or m, by axis name (a TP program's
+            coordinated move, ``COORD``): they move in proportion to the path travelled, and
+            the path and the orientation are relative to ``frame`` (carried by its mechanism).
     """
 
     index: int
@@ -202,6 +205,7 @@ class CartesianPhase:
     config: tuple | None = None
     downhand: bool = False
     follow: str | None = None
+    axes: dict[str, float] = field(default_factory=dict)
 
     def seam_as_welded(self, seam: Seam) -> Seam:
         """The seam this phase welds: ``seam`` (the cell's seam named ``self.seam``) with the

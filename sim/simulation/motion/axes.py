@@ -250,16 +250,9 @@ def hold_roll(poses: NDArray[np.float64], column: int, ref: NDArray[np.float64]
 
 def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
                      ctx: CartesianContext, label: str) -> PhaseMotion:
-    """A weld along a seam with the axes moving (module docstring)."""
+    """A weld along a seam with the axes moving (module docstring), or a move whose axes go
+    to ``phase.axes`` (:func:`_plan_moving_frame`)."""
     from sim.simulation.motion.cartesian import _phase_cart
-    from sim.simulation.motion.programmed import _programmed
-    from sim.simulation.motion.sampling import (
-        _ik_knots_refined,
-        _into_j1_plane,
-        _poses,
-        _sample_times,
-        _turn_limited_period,
-    )
 
     if phase.weave is not None:
         raise ScenarioError(f"{label}.weave: not with coordinated motion (downhand, follow) yet")
@@ -269,7 +262,8 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     kin = ctx.kinematics
     T0 = np.asarray(kin.fk(qr0), dtype=float)
     cart, seam = _phase_cart(phase, T0[:3, 3], T0[:3, :3], ctx0, label, moving=True)
-    assert seam is not None
+    if seam is None:  # a coordinated move (COORD) in a frame: its axes move with the path
+        return _plan_moving_frame(phase, t0, q0, ctx, ctx0, cart, label)
     mech = ctx.seam_mechanism.get(phase.seam)
     s_grid = np.linspace(0.0, seam.length(), LAW_SAMPLES)
     q_grid = np.broadcast_to(qe0, (LAW_SAMPLES, qe0.size)).copy()
@@ -318,6 +312,49 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
         u = np.asarray(cart.at(x).path_length, dtype=float) / cart.length
         return spline(np.clip(u, 0.0, 1.0) * L)
 
+    return _sampled(phase, t0, qr0, qe0, ctx, ctx0, cart, seam, mech, axes_at, label)
+
+
+def _plan_moving_frame(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
+                       ctx: CartesianContext, ctx0: CartesianContext, cart: Any, label: str
+                       ) -> PhaseMotion:
+    """A move whose external axes go to ``phase.axes`` in proportion to the path travelled,
+    its path and orientation relative to ``phase.frame`` (a TP program's ``COORD``)."""
+    n = ctx.kinematics.n_joints
+    qr0, qe0 = q0[:n], q0[n:]
+    names = [nm for pm in ctx.mechanisms for nm in pm.joint_names]
+    qe1 = qe0.copy()
+    for name, value in phase.axes.items():
+        qe1[names.index(name)] = value
+    mech = ctx.frame_mechanism.get(phase.frame)
+    if mech is None and np.any(qe1 != qe0) and ctx.robot_on is None:
+        raise ScenarioError(f"{label}.frame: a coordinated move's points are in the frame of "
+                            f"a part a mechanism carries; {phase.frame!r} is fixed")
+
+    def axes_at(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        u = np.clip(np.asarray(cart.at(x).path_length, dtype=float) / cart.length, 0.0, 1.0)
+        return qe0 + u[:, None] * (qe1 - qe0)
+
+    return _sampled(phase, t0, qr0, qe0, ctx, ctx0, cart, None, mech, axes_at, label)
+
+
+def _sampled(phase: CartesianPhase, t0: float, qr0: NDArray[np.float64],
+             qe0: NDArray[np.float64], ctx: CartesianContext, ctx0: CartesianContext, cart: Any,
+             seam: Any, mech: str | None, axes_at: Any, label: str) -> PhaseMotion:
+    """A coordinated move sampled: the targets carried by the axes' law ``axes_at(t)``, the
+    robot's inverse kinematics along them, the axes' values beside its joints, one
+    polynomial through both (:func:`plan_coordinated`)."""
+    from sim.simulation.motion.programmed import _programmed
+    from sim.simulation.motion.sampling import (
+        _ik_knots_refined,
+        _into_j1_plane,
+        _poses,
+        _sample_times,
+        _turn_limited_period,
+    )
+
+    kin = ctx.kinematics
+    T0 = np.asarray(kin.fk(qr0), dtype=float)
     column = int(kin.family.approach_column)
     ref = T0[:3, (column + 1) % 3]  # the roll about the torch axis the phase starts with
 
@@ -325,7 +362,9 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
 
     def poses_at(x: NDArray[np.float64]) -> NDArray[np.float64]:
         M = moving_frame(ctx, ctx0, mech, qe0, axes_at(x))
-        poses = hold_roll(M @ _poses(cart.at(x)), column, ref)
+        poses = M @ _poses(cart.at(x))
+        if seam is not None:  # along a seam the torch's roll is the arm's to choose
+            poses = hold_roll(poses, column, ref)
         # a 5-axis arm holds its torch in the vertical plane through J1: the axes' law (a
         # spline through exact samples) leaves it a few hundredths of a degree out of it
         return _into_j1_plane(poses) if five_axis else poses

@@ -135,7 +135,7 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
         elif isinstance(phase, CartesianPhase):
             if context is None:
                 raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
-            if n_axes and (phase.downhand or phase.follow is not None):
+            if n_axes and (phase.downhand or phase.follow is not None or phase.axes):
                 pm = axes.plan_coordinated(phase, t, q, context, label)
             elif n_axes:
                 ctx_p = axes.posed(context, q[n:])
