@@ -38,6 +38,7 @@ class LimitViolation:
             acceleration otherwise (rad, rad/s, rad/s^2).
         limit: The limit exceeded (the lower or upper bound, or the magnitude limit), SI.
         first_time: First sampled time at which the limit is exceeded, s.
+        linear: The joint is linear (a track's): values in m, messages in mm.
     """
 
     joint: int
@@ -47,11 +48,17 @@ class LimitViolation:
     value: float
     limit: float
     first_time: float
+    linear: bool = False
 
     def message(self) -> str:
-        """One-line description, in degrees."""
+        """One-line description, in degrees (a linear joint's in mm)."""
         unit = _UNITS[self.quantity]
         deg = np.degrees
+        if self.linear:
+            unit = unit.replace("deg", "mm")
+
+            def deg(x: float) -> float:
+                return 1e3 * x
         if self.quantity == "position":
             side = "below lower" if self.value < self.limit else "above upper"
             what = f"position {deg(self.value):.4g} {unit} is {side} limit {deg(self.limit):.4g} {unit}"
@@ -74,8 +81,8 @@ def _per_joint(name: str, value: ArrayLike | None, n: int) -> NDArray[np.float64
 def find_limit_violations(traj: Trajectory, *, lower: ArrayLike | None = None,
                           upper: ArrayLike | None = None, max_velocity: ArrayLike | None = None,
                           max_acceleration: ArrayLike | None = None,
-                          joint_names: Sequence[str] | None = None, dt: float | None = None
-                          ) -> list[LimitViolation]:
+                          joint_names: Sequence[str] | None = None, dt: float | None = None,
+                          linear: Sequence[bool] | None = None) -> list[LimitViolation]:
     """Every (joint, quantity) whose limit the trajectory exceeds, without raising.
 
     Args:
@@ -86,6 +93,7 @@ def find_limit_violations(traj: Trajectory, *, lower: ArrayLike | None = None,
         joint_names: Names for messages; default "j1", "j2", ...
         dt: Sampling period, s; default: 2000 samples over the duration and at least 20 per
             segment when the trajectory has knots.
+        linear: Per joint, whether it is linear (m; its messages in mm); default none is.
 
     Returns:
         Violations ordered by joint, then position (lower, upper), velocity, acceleration.
@@ -127,6 +135,7 @@ def find_limit_violations(traj: Trajectory, *, lower: ArrayLike | None = None,
     def first(mask: NDArray[np.bool_], t_worst: float) -> float:
         return float(times[np.argmax(mask)]) if mask.any() else t_worst
 
+    lin = [False] * n if linear is None else [bool(x) for x in linear]
     out: list[LimitViolation] = []
     for j in range(n):
         if lo is not None:
@@ -135,14 +144,14 @@ def find_limit_violations(traj: Trajectory, *, lower: ArrayLike | None = None,
             lim = float(lo[j])
             if val < lim - RELATIVE_SLACK * max(1.0, abs(lim)):
                 out.append(LimitViolation(j, names[j], "position", t, val, lim,
-                                          first(states.q[:, j] < lim, t)))
+                                          first(states.q[:, j] < lim, t), lin[j]))
         if hi is not None:
             ex = (float(ext.q_max[j]), float(ext.q_max_time[j])) if ext is not None else None
             val, t = worst(states.q, j, 1.0, ex)
             lim = float(hi[j])
             if val > lim + RELATIVE_SLACK * max(1.0, abs(lim)):
                 out.append(LimitViolation(j, names[j], "position", t, val, lim,
-                                          first(states.q[:, j] > lim, t)))
+                                          first(states.q[:, j] > lim, t), lin[j]))
         for quantity, series, lim_arr, peak, tpk in (
                 ("velocity", states.qd, vmax, "qd_peak", "qd_time"),
                 ("acceleration", states.qdd, amax, "qdd_peak", "qdd_time")):
@@ -158,7 +167,7 @@ def find_limit_violations(traj: Trajectory, *, lower: ArrayLike | None = None,
                 val = np.copysign(float(getattr(ext, peak)[j]), val)
             if abs(val) > lim * (1.0 + RELATIVE_SLACK):
                 out.append(LimitViolation(j, names[j], quantity, t, float(val), lim,
-                                          first(np.abs(series[:, j]) > lim, t)))
+                                          first(np.abs(series[:, j]) > lim, t), lin[j]))
     return out
 
 

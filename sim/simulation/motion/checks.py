@@ -73,7 +73,8 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
             max_velocity=np.asarray(system.max_speed) if speed else None,
             max_acceleration=(np.asarray(system.max_accel)
                               if accel and system.max_accel else None),
-            joint_names=system.joints)
+            joint_names=system.joints,
+            linear=[False] * system.n_arm + [a.kind == "prismatic" for _, a in system.external])
         for v in found:
             pm = next((p for p in group if p.t0 <= v.time <= p.t1), group[0])
             out.append(f"{where}: phases[{pm.phase.index}] ({pm.name}): {v.message()}")
