@@ -43,16 +43,13 @@ from support.axes_cells import (
     combined,
     judge_part_frame_weld,
     mechanism_file,
-    part_in_world,
-    pose,
     positioner_cell,
     robot_mass_kg,
 )
+from support.axes_loads import axes_scenario, loads, positioner_torques
 from support.axes_tracks import TrackCase, momentum_balance, track_cases
-from support.axes_welds import WeldCase, weld_cases
-from support.mechanism_oracle import OracleAxis, OraclePayload, inverse_dynamics
+from support.axes_welds import WeldCase, judge_coordinated, weld_cases
 from support.scenarios import joint_phase, scenario_text
-from support.seam_oracle import rot_zyx
 
 import sim
 from sim.robots.drive import COULOMB_SPEED
@@ -78,19 +75,6 @@ def _phases(r: sim.RunResult) -> dict[str, dict]:
 
 
 # ------------------------------------------------------------------ 1. coordinated weld
-def judge_coordinated(case: WeldCase, r: sim.RunResult, axes_offset_deg: float = 0.0):
-    """The part-frame oracle on a run of ``case``: the part's frame from the recorded axes
-    (shifted by ``axes_offset_deg``: a planted fault)."""
-    a = r.arrays
-    weld = _phases(r)["weld"]
-    q_axes = a["q"][:, 6:] + np.radians(axes_offset_deg)
-    T = part_in_world(D500, case.base(), case.part_local(), q_axes)
-    return judge_part_frame_weld(case.seam_geom(), a["t"], a["tcp_pos"], a["tcp_quat"], T,
-                                 weld["t0"], weld["t1"], case.speed * 1e-3,
-                                 pos_tol_m=POS_TOL_M, angle_tol_deg=ANGLE_TOL_DEG,
-                                 speed_tol=SPEED_TOL)
-
-
 @FAST
 @given(case=weld_cases())
 def test_a_coordinated_downhand_weld_holds_the_seam_in_the_parts_frame(case, tmp_path_factory):
@@ -100,7 +84,7 @@ def test_a_coordinated_downhand_weld_holds_the_seam_in_the_parts_frame(case, tmp
     disguise); the axes 0.2 deg off, or the seam 1 mm off, fail the oracle."""
     folder = tmp_path_factory.mktemp("weld")
     r = sim.evaluate(sim.load_scenario(case.write(folder)))
-    j = judge_coordinated(case, r)
+    j = judge_coordinated(case, r.arrays, _phases(r)["weld"])
     assert j.verdict.ok, f"{case}: {j.verdict.failures}"
     assert {"path_dev_mm", "speed_err_pct", "work_angle_err_deg",
             "travel_angle_err_deg"} <= set(j.verdict.figures), f"{case}: nothing judged"
@@ -112,9 +96,9 @@ def test_a_coordinated_downhand_weld_holds_the_seam_in_the_parts_frame(case, tmp
     assert np.abs(r.arrays["q"][sel, 6:]).max() > np.radians(5.0), (
         f"{case}: the positioner stayed near zero; the downhand pose was not taken")
     # planted faults
-    off = judge_coordinated(case, r, axes_offset_deg=0.2)
+    off = judge_coordinated(case, r.arrays, _phases(r)["weld"], axes_offset_deg=0.2)
     assert not off.verdict.ok, f"{case}: axes 0.2 deg off passed: {off.verdict.figures}"
-    moved = judge_coordinated(case.shifted(1.0), r)
+    moved = judge_coordinated(case.shifted(1.0), r.arrays, _phases(r)["weld"])
     assert not moved.verdict.ok, f"{case}: seam 1 mm off passed: {moved.verdict.figures}"
     # the summary says what the oracle measured
     (w,) = r.to_dict()["weld"]
@@ -130,77 +114,13 @@ def test_a_coordinated_weld_passes_the_runs_own_speed_check(tmp_path):
     case = WeldCase(pos=(560.0, 0.0), yaw=0.0, kind="arc", size=(50.0, 80.0), offset=(0.0, 0.0),
                     start_deg=0.0, sweep=90.0, work=45.0, travel=0.0, speed=15.0)
     r = sim.evaluate(sim.load_scenario(case.write(tmp_path)))
-    assert judge_coordinated(case, r).verdict.ok
+    assert judge_coordinated(case, r.arrays, _phases(r)["weld"]).verdict.ok
     bad = [f"{c.name}: {c.subject} ({c.value:.4g} {c.unit})" for c in r.failed_checks
            if c.name in ("cartesian_speed", "path_deviation", "torch_angle")]
     assert not bad, bad
 
 
 # ------------------------------------------------------------------ 2. positioner torques
-def oracle_chain(mech: dict) -> list[OracleAxis]:
-    """The oracle's chain from the mechanism file's own numbers (mm -> m; armature = the
-    drive's rotor inertia times its ratio squared; Coulomb friction)."""
-    out = []
-    for ax in mech["axes"]:
-        d, link = ax["drive"], ax["link"]
-        out.append(OracleAxis(ax["kind"], np.asarray(ax.get("pos_mm", (0, 0, 0))) * 1e-3,
-                              ax["axis"], link["mass_kg"], np.asarray(link["com_mm"]) * 1e-3,
-                              link["inertia_kg_m2"],
-                              armature=d["rotor_inertia_kg_m2"] * d["gear_ratio"] ** 2,
-                              damping=ax.get("damping", 0.0),
-                              friction=ax.get("friction_nm", ax.get("friction_n", 0.0))))
-    return out
-
-
-def positioner_torques(r: sim.RunResult, solids: list[Solid], yaw_deg: float,
-                       scale_mass: float = 1.0) -> np.ndarray:
-    """The oracle's tilt and rotate torques along the recorded reference."""
-    a = r.arrays
-    m, c, inertia = combined(solids, scale_mass)
-    m_ = D500["mount"]
-    gravity = rot_zyx((yaw_deg, 0.0, 0.0)).T @ np.array([0.0, 0.0, -9.81])
-    return inverse_dynamics(oracle_chain(D500), a["q_ref"][:, 6:], a["qd_ref"][:, 6:],
-                            a["qdd_ref"][:, 6:], mount=pose(m_["pos_mm"], m_["euler_zyx_deg"]),
-                            payload=OraclePayload(m, c, inertia), gravity=gravity)
-
-
-@st.composite
-def loads(draw):
-    """A plate and a steel workpiece (box or cylinder, up to ~200 kg) 40-120 mm off the
-    faceplate's centre in x and y and turned about every axis, the positioner's placement, and
-    two moves of the axes: tilting 30-120 deg and rotating 45-180 deg either way, then on by
-    up to 90 and 150 deg (within the axes' ranges)."""
-    fl = lambda lo, hi: draw(st.floats(lo, hi, allow_nan=False))  # noqa: E731
-    sign = lambda: draw(st.sampled_from((-1.0, 1.0)))  # noqa: E731
-    plate = Solid("box", (fl(-30, 30), fl(-30, 30), 10.0), (fl(-180, 180), 0.0, 0.0),
-                  size_mm=(fl(200, 400), fl(200, 400), 20.0))
-    centre = (sign() * fl(40, 120), sign() * fl(40, 120), fl(80, 220))
-    turn = (fl(-180, 180), fl(-60, 60), fl(-60, 60))
-    if draw(st.booleans()):
-        work = Solid("cylinder", centre, turn, radius_mm=fl(60, 150), length_mm=fl(80, 300))
-    else:
-        work = Solid("box", centre, turn, size_mm=(fl(80, 300), fl(80, 300), fl(80, 300)))
-    first = (sign() * fl(30, 120), sign() * fl(45, 180))
-    second = (first[0] - sign() * fl(30, 90), first[1] - sign() * fl(45, 150))
-    second = (float(np.clip(second[0], -130, 130)), float(np.clip(second[1], -195, 195)))
-    return [plate, work], (fl(500, 900), fl(-300, 300), fl(-180, 180)), [first, second]
-
-
-def _axes_scenario(folder: Path, solids: list[Solid], place: tuple[float, float, float],
-                   targets: list[tuple[float, float]]) -> Path:
-    objects = [dict(name=f"w{k}", role="workpiece", on="positioner", **s.fields())
-               for k, s in enumerate(solids)]
-    (folder / "cell.toml").write_text(positioner_cell(place[:2] + (0.0,), place[2], objects))
-    H = list(HOME_DEG)
-    phases = [joint_phase([H], name=f"move{k}", durations_s=[4.0],
-                          axes={"positioner_tilt_deg": tilt, "positioner_rotate_deg": rot})
-              for k, (tilt, rot) in enumerate(targets)]
-    phases[0] = joint_phase([H, H], name="move0", time_s=[0.0, 4.0], axes=phases[0]["axes"])
-    path = folder / "axes.toml"
-    path.write_text(scenario_text("lrmate200ic5l", phases, cell="cell.toml", tool="mig_torch"))
-    return path
-
-
 @FAST
 @given(load=loads())
 def test_positioner_torques_equal_an_independent_newton_euler(load, tmp_path_factory):
@@ -209,19 +129,20 @@ def test_positioner_torques_equal_an_independent_newton_euler(load, tmp_path_fac
     recorded reference motion) to 1e-6 of the peak; the parts' centre of mass is off the tilt
     axis (on the faceplate, 150 mm and more above it, and off the rotate axis), so gravity
     loads both axes; a part 1 % heavier fails."""
-    solids, place, targets = load
+    solids, pos, euler, targets = load
     folder = tmp_path_factory.mktemp("torques")
-    r = sim.evaluate(sim.load_scenario(_axes_scenario(folder, solids, place, targets)))
+    r = sim.evaluate(sim.load_scenario(axes_scenario(folder, solids, pos, euler, targets)))
     assert r.joints[6:] == ("positioner_tilt", "positioner_rotate")
     tau_id = r.arrays["tau_id"][:, 6:]
     peak = np.abs(tau_id).max(axis=0)
-    err = np.abs(positioner_torques(r, solids, place[2]) - tau_id).max(axis=0)
+    err = np.abs(positioner_torques(r.arrays, solids, euler) - tau_id).max(axis=0)
     assert np.all(err <= TORQUE_TOL * peak), f"error {err} N m for peaks {peak} N m"
     # the part's centre of mass is off the tilt axis: gravity takes a share of the tilt torque
     m, c, _ = combined(solids)
     mount_z = D500["mount"]["pos_mm"][2] * 1e-3
     assert np.hypot(c[0], c[2] + mount_z) > 0.1
-    heavy = np.abs(positioner_torques(r, solids, place[2], scale_mass=1.01) - tau_id).max(axis=0)
+    heavy = positioner_torques(r.arrays, solids, euler, scale_mass=1.01)
+    heavy = np.abs(heavy - tau_id).max(axis=0)
     assert heavy[0] > 100 * TORQUE_TOL * peak[0], f"1 % more mass unseen: {heavy} N m"
     summary = r.to_dict()["mechanisms"]["positioner"]
     assert summary["carried_kg"] == pytest.approx(m, rel=1e-9)
@@ -234,10 +155,11 @@ def test_a_carried_workpiece_takes_its_given_mass(tmp_path):
     pipe = Solid("cylinder", (60.0, -40.0, 120.0), radius_mm=80.0, length_mm=200.0,
                  mass_kg=25.0)
     solids = [pipe]
-    r = sim.evaluate(sim.load_scenario(_axes_scenario(tmp_path, solids, (650.0, 0.0, 0.0),
-                                                      [(-45.0, 90.0), (30.0, -30.0)])))
+    r = sim.evaluate(sim.load_scenario(axes_scenario(tmp_path, solids, (650.0, 0.0, 0.0),
+                                                     (0.0, 0.0, 0.0),
+                                                     [(-45.0, 90.0), (30.0, -30.0)])))
     tau_id = r.arrays["tau_id"][:, 6:]
-    err = np.abs(positioner_torques(r, solids, 0.0) - tau_id).max(axis=0)
+    err = np.abs(positioner_torques(r.arrays, solids, (0.0, 0.0, 0.0)) - tau_id).max(axis=0)
     assert np.all(err <= TORQUE_TOL * np.abs(tau_id).max(axis=0)), err
     assert r.to_dict()["mechanisms"]["positioner"]["carried_kg"] == pytest.approx(25.0)
 

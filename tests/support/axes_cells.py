@@ -216,15 +216,17 @@ def combined(solids: Sequence[Solid], scale_mass: float = 1.0) -> tuple[float, A
 
 
 # ------------------------------------------------------------------------------ cells
-def positioner_cell(pos_mm: Sequence[float], yaw_deg: float, objects: Sequence[Mapping[str, Any]],
+def positioner_cell(pos_mm: Sequence[float], turn: float | Sequence[float],
+                    objects: Sequence[Mapping[str, Any]],
                     seams: Sequence[Mapping[str, Any]] = (), *, name: str = "positioner",
                     model: str = "motopos_d500", home: Mapping[str, float] | None = None
                     ) -> str:
     """A cell file: the LR Mate 200iC/5L at the origin with the MIG torch, a D500 (or
-    ``model``) called ``name`` at ``pos_mm`` turned ``yaw_deg`` about z, the ``objects``
-    (their ``on`` given by the caller) and ``seams``."""
+    ``model``) called ``name`` at ``pos_mm`` turned ``turn`` (a yaw about z, or Z-Y-X angles;
+    deg), the ``objects`` (their ``on`` given by the caller) and ``seams``."""
+    euler = [float(turn), 0.0, 0.0] if isinstance(turn, (int, float)) else list(turn)
     mech: dict[str, Any] = {"name": name, "model": model, "pos_mm": list(pos_mm),
-                            "euler_zyx_deg": [yaw_deg, 0.0, 0.0]}
+                            "euler_zyx_deg": euler}
     if home:
         mech["home"] = dict(home)
     doc: dict[str, Any] = {

@@ -20,6 +20,7 @@ touch onto the start, the weld with ``downhand = true`` and the arc on.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -27,13 +28,24 @@ from typing import Any
 import numpy as np
 from hypothesis import strategies as st
 
-from support.axes_cells import HOME_DEG, Solid, pose, positioner_cell
+from support.axes_cells import (
+    D500_FILE,
+    HOME_DEG,
+    PartFrameWeld,
+    Solid,
+    judge_part_frame_weld,
+    mechanism_file,
+    part_in_world,
+    pose,
+    positioner_cell,
+)
 from support.scenarios import joint_phase, scenario_text
 from support.seam_oracle import SeamGeom
 
 #: The plate on the faceplate (mm): full extents and its centre's height on the mount.
 PLATE_MM = (320.0, 320.0, 12.0)
 READY_DEG = (0.0, 8.0, -30.0, 0.0, -60.0, 0.0)
+D500 = mechanism_file(D500_FILE)
 
 
 @dataclass(frozen=True)
@@ -136,6 +148,20 @@ class WeldCase:
         return replace(self, shift_mm=mm)
 
 
+def judge_coordinated(case: WeldCase, arrays: Any, weld: Mapping[str, float],
+                      axes_offset_deg: float = 0.0, pos_tol_m: float = 0.1e-3,
+                      speed_tol: float = 0.01, angle_tol_deg: float = 0.5) -> PartFrameWeld:
+    """The part-frame oracle on a run of ``case`` (``weld``: the weld phase's ``t0``, ``t1``):
+    the part's frame from the D500's forward kinematics (its file's numbers) at the RECORDED
+    axis values (shifted by ``axes_offset_deg``: a planted fault)."""
+    q_axes = np.asarray(arrays["q"])[:, 6:] + np.radians(axes_offset_deg)
+    T = part_in_world(D500, case.base(), case.part_local(), q_axes)
+    return judge_part_frame_weld(case.seam_geom(), arrays["t"], arrays["tcp_pos"],
+                                 arrays["tcp_quat"], T, weld["t0"], weld["t1"],
+                                 case.speed * 1e-3, pos_tol_m=pos_tol_m,
+                                 angle_tol_deg=angle_tol_deg, speed_tol=speed_tol)
+
+
 @st.composite
 def weld_cases(draw: Any, kinds: tuple[str, ...] = ("arc", "line")) -> WeldCase:
     """A generated :class:`WeldCase` (module docstring)."""
@@ -159,4 +185,4 @@ def weld_cases(draw: Any, kinds: tuple[str, ...] = ("arc", "line")) -> WeldCase:
                     speed=fl(8.0, 20.0))
 
 
-__all__ = ["PLATE_MM", "READY_DEG", "WeldCase", "weld_cases"]
+__all__ = ["D500", "PLATE_MM", "READY_DEG", "WeldCase", "judge_coordinated", "weld_cases"]
