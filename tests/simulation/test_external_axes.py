@@ -221,10 +221,15 @@ def test_a_robot_on_a_track_welds_a_seam_longer_than_its_reach_in_one_pass(case,
     assert r.to_dict()["mechanisms"]["track"]["carried_kg"] == pytest.approx(robot_mass_kg())
 
 
-def test_the_track_case_is_out_of_the_arms_reach_without_the_track():
-    """The seams drawn are longer than the arm can span from one place: twice its reach."""
-    case = TrackCase(length_mm=2000.0, side_mm=480.0, speed=40.0, track_x_mm=0.0)
-    assert case.length_mm > 2 * 892.0
+def test_the_shortest_track_seam_is_out_of_the_arms_reach_without_the_track(tmp_path):
+    """The seams drawn are longer than the arm reaches from one place: the shortest (2 m)
+    welded without ``follow = "track"`` is refused, out of reach, in one line."""
+    path = TrackCase(length_mm=2000.0, side_mm=460.0, speed=40.0, track_x_mm=0.0).write(tmp_path)
+    path.write_text(path.read_text().replace('follow = "track"\n', ""))
+    assert "follow" not in path.read_text()
+    with pytest.raises(sim.ReachError, match=r"track.toml: phases\[4\] \(weld\).*reach") as exc:
+        sim.evaluate(sim.load_scenario(path))
+    assert "\n" not in str(exc.value)
 
 
 # ------------------------------------------------------------------ 4. hostile inputs
