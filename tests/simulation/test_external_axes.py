@@ -361,3 +361,15 @@ def test_generated_axis_values_outside_range_or_unit_are_refused(axis, suffix, s
         assert main(["check", str(path)]) == 2
     err = buf.getvalue().strip().splitlines()
     assert len(err) == 1 and "hostile.toml" in err[0] and key in err[0], err
+
+
+def test_follow_naming_a_track_the_robot_does_not_stand_on_is_refused(tmp_path):
+    """A track in the cell, the robot beside it on the floor: ``follow = "track"`` is one line
+    naming the file and the key, exit code 2."""
+    path = TrackCase(length_mm=600.0, side_mm=460.0, speed=10.0, track_x_mm=0.0).write(tmp_path)
+    cell = tmp_path / "cell.toml"
+    cell.write_text(cell.read_text().replace('on = "track"\n', ""))
+    res = _check(path)
+    lines = res.stderr.strip().splitlines()
+    assert res.returncode == 2 and len(lines) == 1, res.stderr
+    assert "track.toml" in lines[0] and "follow" in lines[0] and "'track'" in lines[0], lines
