@@ -20,6 +20,11 @@ draws more):
    (MuJoCo's forward kinematics of the reference for the bodies' centres, differenced twice),
    and, where the arm holds still, ``(robot + carriage) a + armature a + friction`` exactly;
 4. hostile inputs for the new keys: one line naming the file and the key, exit code 2.
+
+The oracles' own parts are checked here too: the mechanism file's forward kinematics at hand
+poses, the solids' mass properties against a Monte Carlo integral. Cases are drawn
+deterministically (``derandomize``) and not shrunk (each is a whole run; a failing one is
+printed whole).
 """
 
 from __future__ import annotations
@@ -106,6 +111,9 @@ def test_a_coordinated_downhand_weld_holds_the_seam_in_the_parts_frame(case, tmp
     assert w["carried_by"] == "positioner" and w["downhand"] is True
     assert w["normal_from_vertical_deg"] == pytest.approx(j.normal_from_vertical_deg.max(),
                                                            abs=0.05)
+    assert w["max_path_deviation_mm"] <= POS_TOL_M * 1e3
+    assert abs(w["travel_speed_mm_s"] / case.speed - 1.0) <= SPEED_TOL
+    assert w["torch_angle_error_deg"] <= ANGLE_TOL_DEG
 
 
 def test_a_coordinated_weld_passes_the_runs_own_speed_check(tmp_path):
