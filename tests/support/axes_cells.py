@@ -62,9 +62,9 @@ def _value(v: Any) -> str:
 
 
 def toml_text(doc: Mapping[str, Any]) -> str:
-    """``doc`` as TOML: plain keys (a mapping as an inline table) first, then ``[table]`` for a
-    key whose value is marked by a leading ``"[table]"`` wrapper :class:`Table`, then arrays of
-    tables for lists of mappings."""
+    """``doc`` as TOML: plain keys first (a plain mapping as an inline table), then a
+    ``[key]`` table for each value that is a :class:`Table`, then ``[[key]]`` arrays of tables
+    for lists of mappings."""
     lines = [f"{k} = {_value(v)}" for k, v in doc.items()
              if not isinstance(v, Table) and not _tables(v)]
     for k, v in doc.items():
