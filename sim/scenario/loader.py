@@ -166,8 +166,9 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
             check_axes(pspec.axes, cell_axes, f"{where}: phases[{i}]")
         elif isinstance(pspec, (LinearPhaseSpec, CircularPhaseSpec)):
             if pspec.follow is not None and pspec.follow not in tracks:
-                raise ScenarioError(f"{where}: phases[{i}].follow: "
-                                    f"{UnknownNameError('track', pspec.follow, sorted(tracks))}")
+                what = (UnknownNameError('track', pspec.follow, sorted(tracks)) if tracks
+                        else f"no track {pspec.follow!r}: the cell has none")
+                raise ScenarioError(f"{where}: phases[{i}].follow: {what}")
     try:
         tool = resolve_tool(BARE if cell is None else cell, spec.tool, base)
     except CellsimError as exc:

@@ -189,6 +189,9 @@ def read_cell_file(path: str | Path) -> CellFile:
             raise CellError(f"{where}: robot.on: "
                             f"{UnknownNameError('mechanism', rb.on, list(mechanisms))}")
         pm = mechanisms[rb.on]
+        if pm.spec.kind != "track":
+            raise CellError(f"{where}: robot.on: {rb.on!r} is a {pm.spec.kind}; a robot's base "
+                            "stands on a track")
         robot_local = base
         base = pm.mount_in_world(pm.home) @ base
     for s in solids.values():
