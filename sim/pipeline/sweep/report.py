@@ -41,7 +41,8 @@ def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
     parts = ["# Sweep", "",
              f"{len(result.outcomes)} variants ({ok} succeeded), {result.workers} worker(s), "
              f"{result.wall_s:.1f} s wall-clock. Speed scale s divides the knot times "
-             "(s = 2: twice as fast). Torques are the larger of inverse dynamics and simulation.",
+             "(s = 2: twice as fast). Torques are the larger of inverse dynamics and simulation "
+             "(a linear axis's, a track's, are forces in N).",
              ""]
     head = ["payload kg", "speed scale", *joints]
 
@@ -94,7 +95,7 @@ def sweep_chart(result: SweepResult) -> bytes:
         ax_p, ax_s = axes[k]
         lines(ax_p, payloads, scales, lambda s: f"speed x{s:g}", lambda x, s: (x, s, j))
         lines(ax_s, scales, payloads, lambda p: f"{p:g} kg", lambda x, p: (p, x, j))
-        ax_p.set_ylabel(f"{j} torque (N m)")
+        ax_p.set_ylabel(f"{j} torque (N m; N on a linear axis)")
         for ax in (ax_p, ax_s):
             ax.grid(alpha=0.3)
         if k == 0:
