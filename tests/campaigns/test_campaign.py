@@ -26,6 +26,7 @@ from support import DATA, ROOT
 from support.cell_files import CELL, make_cell
 from support.robots import DH_ROBOT, DH_SCENARIO
 from support.scenarios import CAMPAIGN_BASE, TP_SCENARIO
+from support.toml_values import toml_value
 
 from sim.cli import main
 
@@ -54,24 +55,7 @@ def _set(doc: Any, path: tuple, value: Any) -> None:
     doc[path[-1]] = value
 
 
-def _toml_value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "nan"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + "}"
-    raise TypeError(v)
+_toml_value = toml_value  # the shared writer (tests/support/toml_values.py)
 
 
 def dump_toml(doc: dict) -> str:

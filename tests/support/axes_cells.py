@@ -20,7 +20,6 @@ Oracles, from first principles and the files' own numbers (nothing from ``sim``)
 
 from __future__ import annotations
 
-import json
 import math
 import tomllib
 from collections.abc import Mapping, Sequence
@@ -32,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from support.seam_oracle import rot_zyx
+from support.toml_values import toml_value
 
 Array = NDArray[np.float64]
 
@@ -47,18 +47,7 @@ HOME_DEG = (0.0, 0.0, 0.0, 0.0, -90.0, 0.0)
 
 
 # ------------------------------------------------------------------------------ TOML
-def _value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, float)):
-        return repr(float(v)) if isinstance(v, float) else str(v)
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, Mapping):
-        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
-    if isinstance(v, Sequence):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    raise TypeError(f"no TOML value for {v!r}")
+_value = toml_value  # the shared writer (toml_values.py)
 
 
 def toml_text(doc: Mapping[str, Any]) -> str:

@@ -16,23 +16,10 @@ import numpy as np
 from hypothesis import strategies as st
 
 from sim.robots.mechanisms import MechanismSpec
-
+from support.toml_values import toml_value
 
 # ----------------------------------------------------------------------------- TOML writing
-def _value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "nan"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, (int, str)):
-        return repr(v) if isinstance(v, int) else '"' + v.replace('"', '\\"') + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    raise TypeError(type(v))
+_value = toml_value  # the shared writer (toml_values.py)
 
 
 def toml_text(doc: dict[str, Any], prefix: str = "") -> str:
