@@ -112,9 +112,13 @@ def _poly_text(coeffs: np.ndarray, var: str) -> str:
 
 def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
     """Human-readable tables (degrees), one block per phase and joint."""
+    axes = scenario.system.n_joints - scenario.robot.n_joints
     lines = [f"scenario {scenario.name}: robot {scenario.robot.name} "
-             f"({scenario.robot.n_joints} joints), {len(planned)} polynomial phase(s)",
-             "coefficients in degrees; normalized time t = (tau - tau_k-1)/t_k, "
+             f"({scenario.robot.n_joints} joints"
+             + (f" and {axes} external axes" if axes else "")
+             + f"), {len(planned)} polynomial phase(s)",
+             "coefficients in degrees (a linear axis's in mm); normalized time "
+             "t = (tau - tau_k-1)/t_k, "
              "last segment in t_bar = t - 1; real time in powers of tau [s]"]
     deg = 180.0 / np.pi
     for pp in planned:
@@ -124,16 +128,19 @@ def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
         inside = _window(pp)
         lines.append(f"phase {pp.phase.index + 1} {pp.phase.name!r}: planner {pp.phase.planner}, "
                      f"knots at {', '.join(f'{t:g}' for t in knots[inside[0]:inside[-1] + 2])} s")
-        for j, jname in enumerate(scenario.robot.joints[: traj.n_joints]):
-            lines.append(f"  joint {jname}")
+        linear = {n for n, a in scenario.system.external if a.kind == "prismatic"}
+        for j, jname in enumerate(scenario.system.joints[: traj.n_joints]):
+            scale = 1e3 if jname in linear else deg
+            lines.append(f"  joint {jname}" + (" (mm)" if jname in linear else ""))
             for s in inside:
                 var = traj.segment_variable(s)
                 lines.append(f"    segment {s + 1}: {knots[s]:g} -> {knots[s + 1]:g} s "
                              f"(t_{s + 1} = {knots[s + 1] - knots[s]:g} s)")
                 lines.append("      normalized: "
-                             + _poly_text(np.asarray(traj.normalized_coefficients[s][j]) * deg, var))
+                             + _poly_text(np.asarray(traj.normalized_coefficients[s][j]) * scale,
+                                          var))
                 lines.append("      real:       "
-                             + _poly_text(np.asarray(traj.real_coefficients[s][j]) * deg, "tau"))
+                             + _poly_text(np.asarray(traj.real_coefficients[s][j]) * scale, "tau"))
     return "\n".join(lines)
 
 

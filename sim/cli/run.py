@@ -96,10 +96,14 @@ def run(args: argparse.Namespace) -> int:
     )
     summary = run_scenario(scenario, options)
     out = (args.out or default_out_dir(scenario))
-    track = max(summary["max_tracking_error_deg"])
+    units = summary.get("joint_units") or ["deg"] * len(summary["max_tracking_error_deg"])
+    track = max(e for e, u in zip(summary["max_tracking_error_deg"], units, strict=True)
+                if u == "deg")
+    linear = "".join(f", {j} {e:.4f} mm" for j, e, u in zip(
+        summary["joints"], summary["max_tracking_error_deg"], units, strict=True) if u == "mm")
     line = (f"{scenario.name}: {summary['duration_s']:.3f} s simulated in {summary['wall_s']:.2f} s "
-            f"(x{summary['realtime_factor']:.1f} real time); max tracking error {track:.4f} deg; "
-            f"max tcp deviation {summary['max_tcp_deviation_mm']:.3f} mm")
+            f"(x{summary['realtime_factor']:.1f} real time); max tracking error {track:.4f} deg"
+            f"{linear}; max tcp deviation {summary['max_tcp_deviation_mm']:.3f} mm")
     print(line)
     for line in summary.get("program_warnings", []):
         print(f"  program: {line}")
@@ -132,9 +136,11 @@ def run(args: argparse.Namespace) -> int:
     checks = summary.get("checks", [])
     failed = [c for c in checks if not c["pass"] and c.get("severity", "error") == "error"]
     warned = [c for c in checks if not c["pass"] and c.get("severity") == "warning"]
+    unit_of = dict(zip(summary["joints"], summary.get("joint_units") or (), strict=False))
     for s in summary.get("saturation", [])[:10]:
+        force = "N" if unit_of.get(s["joint"]) == "mm" else "N m"
         print(f"  saturation {s['joint']}: {s['t0']:.3f}-{s['t1']:.3f} s ({s['phase']}), "
-              f"demand over the drive's limit by up to {s['worst_excess_nm']:.4g} N m")
+              f"demand over the drive's limit by up to {s['worst_excess_nm']:.4g} {force}")
     for c in summary.get("collisions", [])[:10]:
         print(f"  collision {c['bodies'][0]} / {c['bodies'][1]}: {c['t0']:.3f}-{c['t1']:.3f} s "
               f"({c['phase']}), {c['depth_mm']:.1f} mm deep ({c['geoms'][0]}, {c['geoms'][1]})")

@@ -329,6 +329,9 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
     a = rec.arrays
     sim_time = rec.steps * rec.timestep
     track = np.max(np.abs(a["q"] - a["q_ref"]), axis=0)
+    system = scenario.system  # a linear axis's (a track's) tracking error in m, shown in mm
+    units = ["deg"] * system.n_arm + ["mm" if ax.kind == "prismatic" else "deg"
+                                      for _, ax in system.external]
     dev = np.linalg.norm(a["tcp_pos"] - a["tcp_pos_ref"], axis=1)
     peak_id = np.max(np.abs(a["tau_id"]), axis=0)
     rms_diff = np.sqrt(np.mean((a["tau"] - a["tau_id"]) ** 2, axis=0))
@@ -343,6 +346,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "mount": scenario.mount,
         "payload_kg": scenario.payload_kg,
         "joints": list(scenario.system.joints),
+        **({"joint_units": units} if system.external else {}),
         "phases": [{"name": pm.name, "kind": pm.kind, "t0": pm.t0, "t1": pm.t1}
                    for pm in motion.phases],
         "duration_s": motion.duration,
@@ -352,7 +356,8 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "realtime_factor": sim_time / rec.wall_s if rec.wall_s > 0 else None,
         "feedforward": feedforward,
         "max_tracking_error_rad": [float(x) for x in track],
-        "max_tracking_error_deg": [float(np.degrees(x)) for x in track],
+        "max_tracking_error_deg": [float(x * 1e3 if u == "mm" else np.degrees(x))
+                                   for x, u in zip(track, units, strict=True)],
         "max_tcp_deviation_mm": float(np.max(dev) * 1e3),
         "torque_rms_diff_pct_of_peak": [float(100 * d / p) if p > 0 else 0.0
                                         for d, p in zip(rms_diff, peak_id)],

@@ -107,6 +107,31 @@ class HeldAxes:
         t, _ = self.robot.sample(dt)
         return t, self.at(t)
 
+    # the robot's piecewise polynomial with the held axes as constant ones (``cellsim plan``)
+    def segment_variable(self, s: int) -> str:
+        return str(self.robot.segment_variable(s))
+
+    def _with_constants(self, coefficients: Any, real: bool) -> list[list[NDArray[np.float64]]]:
+        out = []
+        for s, seg in enumerate(coefficients):
+            seg = [np.asarray(c, dtype=float) for c in seg]
+            k = len(seg[0]) if seg else 1
+            held = []
+            for value in self.qe:
+                c = np.zeros(k)
+                c[0] = value
+                held.append(c)
+            out.append(seg + held)
+        return out
+
+    @property
+    def normalized_coefficients(self) -> list[list[NDArray[np.float64]]]:
+        return self._with_constants(self.robot.normalized_coefficients, False)
+
+    @property
+    def real_coefficients(self) -> list[list[NDArray[np.float64]]]:
+        return self._with_constants(self.robot.real_coefficients, True)
+
     def at(self, t: Any) -> Any:
         st = self.robot.at(t)
         shape = np.shape(st.q)[:-1] + (self.qe.size,)
