@@ -3,6 +3,8 @@
 :func:`check_scenario` builds the cell, plans every phase (inverse kinematics for the poses and
 the Cartesian paths) and checks the reference motion for:
 
+* ``payload``: a turntable, positioner or track carrying more than its rating (a static
+  load: the objects mounted on it, or the robot on a track, from the compiled cell);
 * ``reach``: a target or a path out of reach, or reachable only outside the joint ranges (the
   planning stops there: nothing after it can be checked);
 * ``limit``: a joint past its range, speed or acceleration limit (:func:`limit_violations`);
@@ -70,6 +72,12 @@ def check_scenario(scenario: Scenario, *, dt: float = CHECK_DT_S) -> CheckResult
     t0 = time.perf_counter()
     built = build(scenario)
     res.timings["build_s"] = time.perf_counter() - t0
+    for pm in built.cell.mechanisms:  # a static load over the rating needs no motion
+        carried = float(built.model.body(pm.mount_body).subtreemass[0])
+        if pm.spec.payload_kg > 0 and carried > pm.spec.payload_kg * (1 + 1e-9):
+            res.findings.append(Finding("payload", (
+                f"{pm.spec.kind} {pm.name!r} ({pm.spec.name}) carries {carried:.4g} kg, over "
+                f"its rated {pm.spec.payload_kg:g} kg")))
     t0 = time.perf_counter()
     try:
         motion = build_motion(scenario, built.context)

@@ -143,7 +143,7 @@ class FrameRenderer:
         self.data = mujoco.MjData(model)
         self.width, self.height = int(width), int(height)
         self.interp = QposInterpolator(model, self.record.t, qpos)
-        self.overlay = PathOverlay(self.record, style) if overlay else None
+        self.overlay = PathOverlay(self.record, style, model) if overlay else None
         self.caption = caption
         extra = self.overlay.max_geoms if self.overlay else 0
         max_geom = 10000 + extra
@@ -290,7 +290,7 @@ class FrameRenderer:
             self._update_scene(k)
             self.painter.paint(r.scene, time)
             if self.overlay is not None:
-                self.overlay.add_to_scene(r.scene, time, self.height, self._geoms)
+                self.overlay.add_to_scene(r.scene, time, self.height, self._geoms, self.data)
             if single:
                 r.render(out=out)
             else:

@@ -122,8 +122,15 @@ class PathOverlay:
         style: Colours and sizes.
     """
 
-    def __init__(self, record: RunRecord, style: OverlayStyle | None = None) -> None:
+    def __init__(self, record: RunRecord, style: OverlayStyle | None = None,
+                 model: Any = None) -> None:
         self.style = style or OverlayStyle()
+        # a bead laid on a part a positioner turns rides on the part: its points are kept in the
+        # frame of the body the part is mounted on (``<mechanism>_mount``), posed from the
+        # recorded qpos (``model``: the run's model), and drawn where that body is at the
+        # frame's time (:meth:`add_to_scene`'s ``data``)
+        self.bead_body: list[int | None] = []
+        carriers = _bead_carriers(record, model)
         self.t = record.t
         n_max = self.style.max_segments + 1
         self.reference: np.ndarray | None = None
@@ -148,9 +155,19 @@ class PathOverlay:
                 total = sum(lengths) or 1.0
                 for (a, b), length in zip(runs, lengths):
                     share = max(2, int(n_max * length / total))
-                    sub = a + simplify_polyline(act[a:b], self.style.tolerance, share)
                     t_end = float(self.t[b]) if b < len(self.t) else float(self.t[-1])
-                    self.bead_runs.append((act[sub], self.t[sub], float(self.t[a]), t_end))
+                    body = carriers.get(int(a)) if carriers else None
+                    if body is None:
+                        sub = a + simplify_polyline(act[a:b], self.style.tolerance, share)
+                        pts = act[sub]
+                    else:  # simplified where it lies: on the part (in the world it barely moves)
+                        idx = np.unique(np.append(np.arange(a, b, max(1, (b - a) // 4000)),
+                                                  b - 1))
+                        local = _in_body(model, record, body, idx, act[idx])
+                        keep = simplify_polyline(local, self.style.tolerance, share)
+                        sub, pts = idx[keep], local[keep]
+                    self.bead_runs.append((pts, self.t[sub], float(self.t[a]), t_end))
+                    self.bead_body.append(body)
 
     @property
     def max_geoms(self) -> int:
@@ -163,7 +180,8 @@ class PathOverlay:
         n += sum(len(p) + 1 for p, _, _, _ in self.bead_runs)
         return n
 
-    def add_to_scene(self, scene: Any, time: float, height: int, geoms: Any = None) -> int:
+    def add_to_scene(self, scene: Any, time: float, height: int, geoms: Any = None,
+                     data: Any = None) -> int:
         """Appends the overlay at ``time`` to ``scene`` (after ``mjv_updateScene``).
 
         Args:
@@ -171,6 +189,8 @@ class PathOverlay:
             time: Frame time, s.
             height: Image height, pixels (line widths and the bead's smallest size).
             geoms: ``scene.geoms`` cached by the caller (building it is costly), or None.
+            data: The ``mujoco.MjData`` posed at ``time`` (a bead on a turning part is drawn
+                where the part is); None: every bead where it was laid.
 
         Returns:
             Number of geoms added (stops silently at ``scene.maxgeom``).
@@ -214,11 +234,15 @@ class PathOverlay:
                 added += 1
 
         # Weld bead: a wide line along the actual path where the arc was on, up to `time`.
-        for pts, pts_t, t_start, t_end in self.bead_runs:
+        for (pts, pts_t, t_start, t_end), body in zip(self.bead_runs, self.bead_body,
+                                                       strict=True):
             if time < t_start:
                 continue
             k = int(np.searchsorted(pts_t, time, side="right"))
             path = pts[:k]
+            if body is not None and data is not None:  # on the part, where it is now
+                R, p = data.xmat[body].reshape(3, 3), data.xpos[body]
+                path = path @ R.T + p
             if time < t_end and self._actual_full is not None:
                 path = np.vstack([path, interp_rows(self.t, self._actual_full, time)])
             if len(path) < 2:
@@ -243,6 +267,42 @@ class PathOverlay:
             polyline(lifted(path, st.lift_actual), mujoco.mjtGeom.mjGEOM_LINE, st.actual_rgba,
                      line_px, 1.0)
         return added
+
+
+def _bead_carriers(record: RunRecord, model: Any) -> dict[int, int]:
+    """The body carrying each arc-on run's seam, by the run's first sample: the mount of the
+    mechanism the summary's weld entry names (``carried_by``); empty without a model."""
+    if model is None or not record.summary or not record.has("phase"):
+        return {}
+    carried = {w["phase"]: w.get("carried_by") for w in record.summary.get("weld", ())}
+    names = [p["name"] if isinstance(p, dict) else str(p)
+             for p in record.summary.get("phases", ())]
+    if not any(carried.values()) or not record.has("arc_on"):
+        return {}
+    phase = record.get("phase")
+    out = {}
+    for a, _ in true_runs(record.get("arc_on").astype(bool)):
+        k = int(phase[a])
+        mech = carried.get(names[k]) if k < len(names) else None
+        if mech:
+            out[int(a)] = int(model.body(f"{mech}_mount").id)
+    return out
+
+
+def _in_body(model: Any, record: RunRecord, body: int, samples: np.ndarray,
+             points: np.ndarray) -> np.ndarray:
+    """World points laid at recorded samples, in the frame the body had at each."""
+    import mujoco
+
+    data = mujoco.MjData(model)
+    qpos = record.get("qpos")
+    out = np.empty_like(points)
+    for i, (s, x) in enumerate(zip(samples, points, strict=True)):
+        data.qpos[:] = qpos[s]
+        mujoco.mj_kinematics(model, data)
+        R, p = data.xmat[body].reshape(3, 3), data.xpos[body]
+        out[i] = R.T @ (x - p)
+    return out
 
 
 # ----------------------------------------------------------------------------------------

@@ -159,14 +159,16 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
     cell_axes = {} if cell is None else {
         n: (a.kind, a.range) for pm in cell.mechanisms
         for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)}
-    tracks = {pm.name for pm in (() if cell is None else cell.mechanisms)
-              if pm.spec.kind == "track"}
+    kinds = {pm.name: pm.spec.kind for pm in (() if cell is None else cell.mechanisms)}
+    tracks = {name for name, kind in kinds.items() if kind == "track"}
     for i, pspec in enumerate(spec.phases):
         if isinstance(pspec, JointPhaseSpec):
             check_axes(pspec.axes, cell_axes, f"{where}: phases[{i}]")
         elif isinstance(pspec, (LinearPhaseSpec, CircularPhaseSpec)):
             if pspec.follow is not None and pspec.follow not in tracks:
-                what = (UnknownNameError('track', pspec.follow, sorted(tracks)) if tracks
+                what = (f"{pspec.follow!r} is a {kinds[pspec.follow]}; a robot follows a seam on "
+                        "a track" if pspec.follow in kinds
+                        else UnknownNameError('track', pspec.follow, sorted(tracks)) if tracks
                         else f"no track {pspec.follow!r}: the cell has none")
                 raise ScenarioError(f"{where}: phases[{i}].follow: {what}")
     try:

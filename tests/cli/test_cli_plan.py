@@ -4,6 +4,7 @@ the command line, and one-line errors with exit code 2."""
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 
@@ -118,7 +119,7 @@ def test_list_shows_each_cells_objects_seams_and_cameras(capsys):
     arc_mm = 1000.0 * weld_table.ARC_R * math.radians(weld_table.ARC_DEG[1] - weld_table.ARC_DEG[0])
     assert f"seams: line (line, {line_mm:.0f} mm), arc (arc, {arc_mm:.0f} mm)" in table
     assert "cameras: overview, tool" in table
-    pick = blocks.split("  pick ", 1)[1].split("\n  weld_", 1)[0]
+    pick = re.split(r"\n  (?=\S)", blocks.split("  pick ", 1)[1], maxsplit=1)[0]  # its block
     assert "parts: part0, part1, part2, part3" in pick and "seams:" not in pick
 
 

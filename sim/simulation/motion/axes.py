@@ -181,7 +181,7 @@ def _downhand_law(ctx: CartesianContext, seam: Any, mech: Any, qe0: NDArray[np.f
     bad = np.nonzero(tilt > DOWNHAND_RESIDUAL_DEG)[0]
     if bad.size:
         k = int(bad[0])
-        raise ScenarioError(f"{label}.downhand: positioner {mech.name!r} cannot turn seam "
+        raise ScenarioError(f"{label}.downhand: {mech.spec.kind} {mech.name!r} cannot turn seam "
                             f"{seam.name!r}'s normal up at {s[k] * 1e3:.1f} mm from its start "
                             f"(it stays {tilt[k]:.2f} deg from vertical)")
     return q
@@ -301,7 +301,7 @@ def plan_coordinated(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
         if np.any(gap > START_TOLERANCE_RAD):
             want = ", ".join(f"{nm}_deg = {np.degrees(v):.4f}"
                              for nm, v in zip(pm_d.joint_names, law[0], strict=True))
-            raise ScenarioError(f"{label}.downhand: positioner {pm_d.name!r} is "
+            raise ScenarioError(f"{label}.downhand: {pm_d.spec.kind} {pm_d.name!r} is "
                                 f"{np.degrees(gap.max()):.3f} deg from the downhand pose at seam "
                                 f"{phase.seam!r}'s start; end the previous phase there (axes: "
                                 f"{want}, or downhand = true with to_seam)")
