@@ -153,7 +153,7 @@ class PathOverlay:
                     float(np.linalg.norm(np.diff(act[a:b], axis=0), axis=1).sum()) for a, b in runs
                 ]
                 total = sum(lengths) or 1.0
-                for (a, b), length in zip(runs, lengths):
+                for (a, b), length in zip(runs, lengths, strict=True):
                     share = max(2, int(n_max * length / total))
                     t_end = float(self.t[b]) if b < len(self.t) else float(self.t[-1])
                     body = carriers.get(int(a)) if carriers else None

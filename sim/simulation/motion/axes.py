@@ -111,10 +111,10 @@ class HeldAxes:
     def segment_variable(self, s: int) -> str:
         return str(self.robot.segment_variable(s))
 
-    def _with_constants(self, coefficients: Any, real: bool) -> list[list[NDArray[np.float64]]]:
+    def _with_constants(self, coefficients: Any) -> list[list[NDArray[np.float64]]]:
         out = []
-        for s, seg in enumerate(coefficients):
-            seg = [np.asarray(c, dtype=float) for c in seg]
+        for segment in coefficients:
+            seg = [np.asarray(c, dtype=float) for c in segment]
             k = len(seg[0]) if seg else 1
             held = []
             for value in self.qe:
@@ -126,11 +126,11 @@ class HeldAxes:
 
     @property
     def normalized_coefficients(self) -> list[list[NDArray[np.float64]]]:
-        return self._with_constants(self.robot.normalized_coefficients, False)
+        return self._with_constants(self.robot.normalized_coefficients)
 
     @property
     def real_coefficients(self) -> list[list[NDArray[np.float64]]]:
-        return self._with_constants(self.robot.real_coefficients, True)
+        return self._with_constants(self.robot.real_coefficients)
 
     def at(self, t: Any) -> Any:
         st = self.robot.at(t)
