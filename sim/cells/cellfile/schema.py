@@ -159,4 +159,5 @@ class CellFileSpec(Strict):
     mechanisms: list[MechanismBlock] = []
 
 
-__all__ = ["CameraBlock", "CellFileSpec", "MechanismBlock", "ObjectBlock", "RobotBlock", "SeamBlock", "SlotBlock"]
+__all__ = ["CameraBlock", "CellFileSpec", "MechanismBlock", "ObjectBlock", "RobotBlock", "SeamBlock",
+           "SlotBlock"]
