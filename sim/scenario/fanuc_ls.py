@@ -35,7 +35,9 @@ silently; a malformed line is a one-line error with its line number):
 * ``DEFAULT_GROUP = 1,1,*,*,*;`` (``/ATTR``): the motion groups the program moves, which every
   position holds (``LSProgram.groups``);
 * the motion options ``COORD``, ``PTH``, ``Wjnt``, ``INC`` are kept as flags of the motion
-  (``LSMotion.options``) and are warnings while not simulated (:data:`UNSIMULATED_OPTIONS`).
+  (``LSMotion.options``); ``COORD`` runs (:mod:`sim.scenario.program`: an L or C move that
+  moves external axes), the others are warnings while not simulated
+  (:data:`UNSIMULATED_OPTIONS`).
 
 :func:`parse_ls` gives a :class:`LSProgram`; :func:`write_ls` writes one, and
 :func:`write_weave_schedules` its schedule table.
@@ -72,8 +74,9 @@ class LSMotion:
         ``"cm/min"``, ``"inch/min"`` or ``"sec"``. cnt: None for FINE, else 0..100.
         arc: ``"start"`` / ``"end"`` option on the line, or None. line: line number.
         options: The motion options kept as flags, as written canonically, in order:
-        ``"COORD"`` (coordinated motion with another group), ``"PTH"``, ``"Wjnt"``, ``"INC"``
-        (:data:`FLAG_OPTIONS`); each is also a warning while in :data:`UNSIMULATED_OPTIONS`.
+        ``"COORD"`` (coordinated motion with another group: run), ``"PTH"``, ``"Wjnt"``,
+        ``"INC"`` (:data:`FLAG_OPTIONS`); each is also a warning while in
+        :data:`UNSIMULATED_OPTIONS`.
     """
 
     kind: str
@@ -170,8 +173,8 @@ MAX_PROGRAM_LINES = 200_000
 MAX_WARNINGS = 500
 #: Motion options kept as flags of :class:`LSMotion` (``options``), by their upper-case form.
 FLAG_OPTIONS = {"COORD": "COORD", "PTH": "PTH", "WJNT": "Wjnt", "INC": "INC"}
-#: The flags that are still warnings: program.py does not run them.
-UNSIMULATED_OPTIONS = frozenset({"COORD", "PTH", "Wjnt", "INC"})
+#: The flags that are still warnings: program.py does not run them (it runs ``COORD``).
+UNSIMULATED_OPTIONS = frozenset({"PTH", "Wjnt", "INC"})
 
 
 def _speed(value: str, unit: str, path, line: int) -> tuple[float, str]:

@@ -159,6 +159,29 @@ class LSPosition:
         return self.group(2)
 
 
+def extended_values(pos: LSPosition) -> tuple[tuple[str, float, str], ...]:
+    """A position's values of axes other than GP1's robot joints, in the order a program's
+    extended values map onto a cell's external axes: GP1's ``E1 .. En``, then each further
+    group's ``J1 .. Jk`` and its own ``E1 ..`` (groups in order); each ``(label, SI value,
+    unit)``, the label as the program writes it (``"E2"``, ``"GP2 J1"``). A Cartesian group
+    (a second robot) gives no joint values: :func:`cartesian_group` finds it."""
+    out = [(f"E{j + 1}", v, u) for j, (v, u) in enumerate(zip(pos.ext, pos.ext_units,
+                                                               strict=True))]
+    for g in pos.groups:
+        if g.joints is not None:
+            out += [(f"GP{g.number} J{j + 1}", v, u)
+                    for j, (v, u) in enumerate(zip(g.joints, g.joint_units, strict=True))]
+        out += [(f"GP{g.number} E{j + 1}", v, u)
+                for j, (v, u) in enumerate(zip(g.ext, g.ext_units, strict=True))]
+    return tuple(out)
+
+
+def cartesian_group(pos: LSPosition) -> LSGroup | None:
+    """The first of a position's further groups held as a Cartesian position (a second robot),
+    or None."""
+    return next((g for g in pos.groups if g.joints is None), None)
+
+
 def _err(path, line: int, text: str) -> ScenarioError:
     return ScenarioError(f"{path}: line {line}: {text}")
 
@@ -445,5 +468,6 @@ def format_position(k: int, p: LSPosition) -> list[str]:
 
 
 __all__ = ["AXIS_KIND", "MAX_EXT_AXES", "MAX_GROUPS", "MAX_GROUP_JOINTS", "LSGroup", "LSPosition",
-           "check_groups", "format_default_group", "format_position", "from_si",
+           "cartesian_group", "check_groups", "extended_values", "format_default_group",
+           "format_position", "from_si",
            "parse_default_group", "parse_position", "to_si"]

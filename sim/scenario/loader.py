@@ -202,7 +202,8 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
         # motion is planned: CartesianContext.home_q); the robot's own home keyframe until then
         phases, actions, warns = program_phases(
             prog, robot, np.full(robot.n_joints, np.nan), frames, registers, where,
-            has_tool=tool_kind == "torch", weld_speed=spec.program_weld_speed_mm_s)
+            has_tool=tool_kind == "torch", weld_speed=spec.program_weld_speed_mm_s,
+            mechanisms=() if cell is None else cell.mechanisms)
         program_warnings = tuple(warns)
         seen = {ph.name: k for k, ph in enumerate(phases)}
     phases = with_ctwd(phases, spec, tool, where)

@@ -43,10 +43,31 @@
   (cellsim's weave holds one dwell at both extremes). J moves in between do not weave, and the
   other patterns (``Figure 8``, ``Sine 2``, ``L``) are not run; a warning says so.
 
+Extended axes (``E1= ..`` after GP1's values, a ``GP2:`` group's ``J1= ..``): a program's
+extended values -- GP1's ``E1 .. En``, then each further group's ``J1 .. Jk`` (and its own
+``E1 ..``) -- map in that order onto the cell's external axes (its mechanisms' axes in cell
+order, ``Cell.axis_names``), each in ``deg`` on a revolute axis and ``mm`` on a prismatic one
+(:func:`sim.scenario.fanuc_pos.extended_values`). A position without any leaves the axes where
+they are. A position with another count than the cell has axes, a unit that does not fit its
+axis's kind, a value outside the axis's range, a Cartesian group (a second robot), or extended
+values in a cell without mechanisms is one line naming the program file and the position's
+line.
+
+* ``J``: the axes move to the position's values with the robot (``JointPhase.axes``).
+* ``L`` / ``C``: values equal to where the axes are (within 1e-9) move nothing; other values
+  move the axes only with ``COORD`` (a coordinated move, ``CartesianPhase.axes``: the axes go
+  to the values in proportion to the path, the points and orientation relative to the user
+  frame the program runs, :func:`sim.simulation.motion.axes.plan_coordinated`); that frame is
+  a cell object (``program_frames``) carried by a mechanism that moves, or, where the robot
+  stands on a track that moves, any cell object. Without ``COORD`` it is one line ("an L move
+  that moves external axes needs COORD").
+* CNT does not blend in a cell with external axes where axes move: a J move's CNT, and a CNT on
+  or into an L or C move that moves axes, run as FINE (a warning says so).
+
 CONFIG: ``N``/``F`` the sign of the controller's J5 (``F``: J5 < 0), ``U``/``D`` the elbow up
 or down, ``T``/``B`` the wrist centre in front of J1 or behind (the branch labels of
-:mod:`sim.robots.kinematics.ik`), and the turn numbers of J4, J5, J6 (the controller's joint value is its
-value in (-180, 180] deg plus 360 deg times the turn number).
+:mod:`sim.robots.kinematics.ik`), and the turn numbers of J4, J5, J6 (the controller's joint
+value is its value in (-180, 180] deg plus 360 deg times the turn number).
 """
 
 from __future__ import annotations
@@ -66,6 +87,7 @@ from sim.scenario.fanuc_ls import (
     LSWeave,
     weave_table_path,
 )
+from sim.scenario.fanuc_pos import AXIS_KIND, cartesian_group, extended_values, from_si
 from sim.scenario.model import Action, CartesianPhase, HoldPhase, JointPhase, PoseTarget
 
 #: Speed units of L and C moves in m/s per unit.
@@ -74,6 +96,10 @@ SPEED_UNITS = {"mm/sec": 1e-3, "cm/min": 1e-2 / 60.0, "inch/min": 0.0254 / 60.0}
 CNT_SHARE = 0.45
 #: ArcTool weave patterns cellsim runs, as the TP instruction writes them -> cellsim's pattern.
 TP_WEAVE_PATTERNS = {"Sine": "sine", "Circle": "circle"}
+#: Extended values this close to the axes' values (rad or m) move nothing.
+AXES_EQUAL = 1e-9
+#: The unit a program writes an axis of each kind in.
+KIND_UNIT = {kind: unit for unit, kind in AXIS_KIND.items()}
 
 
 def home_keyframe(robot) -> NDArray[np.float64]:
@@ -94,9 +120,11 @@ def rotation_wpr(w: float, p: float, r: float) -> NDArray[np.float64]:
 
 def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                    frames: dict[int, str], registers: dict[int, LSPosition], where: str,
-                   has_tool: bool, weld_speed: float | None = None
-                   ) -> tuple[list, list[Action], list[str]]:
-    """The phases, tool actions and warnings of a TP program (module docstring).
+                   has_tool: bool, weld_speed: float | None = None,
+                   mechanisms: tuple = ()) -> tuple[list, list[Action], list[str]]:
+    """The phases, tool actions and warnings of a TP program (module docstring);
+    ``mechanisms``: the cell's (:class:`sim.cells.mechanisms.PlacedMechanism`, in cell order),
+    whose axes the program's extended values drive, starting at their home.
 
     Raises:
         ScenarioError: One line naming the program file and line.
@@ -131,6 +159,15 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
             raise err(line, f"{kind}[{k}] was taught with UF {pos.uf}, UT {pos.ut} but the "
                       f"program runs UFRAME_NUM = {uf}, UTOOL_NUM = {ut}")
         return pos
+
+    cell_axes = _CellAxes(mechanisms)
+
+    def axes_of(pos: LSPosition) -> dict[str, float]:
+        """The position's extended values on the cell's axes (SI), {} when it has none."""
+        try:
+            return cell_axes.values(pos)
+        except ValueError as exc:
+            raise err(pos.line, str(exc)) from None
 
     def frame_name(line: int) -> str:
         if uf == 0:
@@ -180,6 +217,8 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
     if not motions:
         raise err(1, "no motion instruction")
     index = 0
+    lines: dict[int, int] = {}  # phase index -> its motion's line
+    coord: set[int] = set()  # the phases of L and C moves that move the axes
     for pos_i, ins in enumerate(prog.instructions):
         if isinstance(ins, LSOther):
             if ins.what == "uframe":
@@ -239,6 +278,10 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                 warnings.append(f"{src}: line {mo.line}: CNT{mo.cnt} between a {mo.kind} and "
                                 f"a {nxt.kind} move runs as FINE")
                 cnt = None
+            elif mo.kind == "J" and cell_axes.names:
+                warnings.append(f"{src}: line {mo.line}: CNT{mo.cnt} between J moves runs as "
+                                "FINE in a cell with external axes")
+                cnt = None
         fraction = 0.0 if not cnt else cnt / 100.0
         if mo.kind == "J":
             if weave is not None:
@@ -263,9 +306,11 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                                      config=target.config, flange=ut == 0)
             if times is not None and move_time is not None:
                 times = np.array([0.0, move_time / 2, move_time])
+            moved = axes_of(target)
+            cell_axes.current.update(moved)
             phase = JointPhase(index=index, name=name, planner="434", times=times,
                                durations=durations, q=q, target=ptarget,
-                               speed_pct=pct, blend_fraction=fraction)
+                               speed_pct=pct, blend_fraction=fraction, axes=moved)
         else:
             if not phases:
                 raise err(mo.line, "the program's first motion must be a J move (it leaves "
@@ -282,13 +327,29 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                 speed = weld_speed * 1e-3
             else:
                 speed = mo.speed * SPEED_UNITS[mo.unit]
+            moved = axes_of(target)
+            moving = cell_axes.moving(moved)
+            if moving and "COORD" not in mo.options:
+                first = next(k for k in cell_axes.names if k in moving)
+                raise err(mo.line, f"an {mo.kind} move that moves external axes needs COORD "
+                          f"(P[{target.index}] moves {first} from "
+                          f"{cell_axes.written(first, cell_axes.current[first])} to "
+                          f"{cell_axes.written(first, moved[first])})")
+            if moving:
+                msg = cell_axes.frame_fault(moving, uf, frame_name(mo.line))
+                if msg:
+                    raise err(mo.line, msg)
+                cell_axes.current.update(moved)
+                coord.add(index)
             common = dict(index=index, name=name, kind="linear" if mo.kind == "L" else "circular",
                           planner="434", speed=speed, sample_period=0.1, ramp=None,
                           orientation="euler", to=p, frame=frame_name(mo.line),
                           euler_zyx=_zyx(R), blend_fraction=fraction, move_time=move_time,
-                          flange=ut == 0, weave=weave, config=target.config)
+                          flange=ut == 0, weave=weave, config=target.config,
+                          axes=moved if moving else {})
             if mo.kind == "C":
                 via = position(mo.via, mo.line)
+                axes_of(via)  # checked; the axes follow the path to the end point
                 pv, Rv = cart(via, mo.line)
                 prev_end = _last_point(phases)
                 if prev_end is not None and np.linalg.norm(prev_end - p) < 1e-3:
@@ -298,6 +359,7 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
             else:
                 phase = CartesianPhase(**common)
         phases.append(phase)
+        lines[index] = mo.line
         index += 1
         if pending_start:
             actions.append(Action("arc_on", None, phase.name, "start"))
@@ -310,7 +372,102 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
         actions.append(Action("arc_on", None, phases[-1].name, "end"))
     if not isinstance(phases[0], JointPhase):
         raise err(motions[0].line, "the program's first motion must be a J move")
-    return phases, actions, warnings
+    return _unblend_coordinated(phases, coord, lines, src, warnings), actions, warnings
+
+
+def _unblend_coordinated(phases: list, coord: set[int], lines: dict[int, int], src: str,
+                         warnings: list[str]) -> list:
+    """The phases with no CNT on or into an L or C move that moves the axes (phase indices
+    ``coord``; such a move is planned on its own: it ends at rest), a warning for each naming
+    its motion's line (``lines``)."""
+    import dataclasses
+
+    out = list(phases)
+    for k in sorted(coord):
+        for j in (k - 1, k):
+            ph = out[j] if j >= 0 else None
+            if isinstance(ph, CartesianPhase) and ph.blend_fraction > 0:
+                warnings.append(f"{src}: line {lines[j]}: CNT on or into a move that moves "
+                                "external axes (COORD) runs as FINE")
+                out[j] = dataclasses.replace(ph, blend_fraction=0.0)
+    return out
+
+
+class _CellAxes:
+    """The cell's external axes as a program drives them: names, kinds, ranges, carriers, and
+    where the axes are (``current``, from their home)."""
+
+    def __init__(self, mechanisms: tuple) -> None:
+        self.names = tuple(n for pm in mechanisms for n in pm.joint_names)
+        self.kinds = {n: a.kind for pm in mechanisms
+                      for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)}
+        self.ranges = {n: a.range for pm in mechanisms
+                       for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)}
+        self.mechanism = {n: pm.name for pm in mechanisms for n in pm.joint_names}
+        self.carrier = {obj: pm.name for pm in mechanisms for obj in pm.carries if obj != "robot"}
+        self.robot_on = next((pm.name for pm in mechanisms if "robot" in pm.carries), None)
+        self.current = {n: float(v) for pm in mechanisms
+                        for n, v in zip(pm.joint_names, pm.home, strict=True)}
+
+    def written(self, name: str, value: float) -> str:
+        """An axis value as a program writes it (``12.5 deg``, ``1500.000 mm``)."""
+        unit = KIND_UNIT[self.kinds[name]]
+        return f"{from_si(value, unit):.3f} {unit}"
+
+    def values(self, pos: LSPosition) -> dict[str, float]:
+        """``pos``'s extended values by axis name (SI); {} for none.
+
+        Raises:
+            ValueError: The fault, as one line's text (module docstring).
+        """
+        vals = extended_values(pos)
+        cart = cartesian_group(pos)
+        if cart is not None:
+            raise ValueError(f"P[{pos.index}]: GP{cart.number} is a Cartesian position (a second "
+                             "robot); cellsim maps a group's joint values (J1 ..) onto the "
+                             "cell's external axes")
+        if not vals:
+            return {}
+        labels = ", ".join(v[0] for v in vals)
+        if not self.names:
+            raise ValueError(f"P[{pos.index}] has extended axis values ({labels}), but the cell "
+                             "has no external axes (no [[mechanisms]])")
+        if len(vals) != len(self.names):
+            raise ValueError(f"P[{pos.index}] has {len(vals)} extended axis values ({labels}); "
+                             f"the cell has {len(self.names)} external axes "
+                             f"({', '.join(self.names)}, in this order)")
+        out = {}
+        for (label, value, unit), name in zip(vals, self.names, strict=True):
+            kind = self.kinds[name]
+            if AXIS_KIND[unit] != kind:
+                raise ValueError(f"P[{pos.index}]: {label} is in {unit}, but it maps onto "
+                                 f"{name}, a {kind} axis (in {KIND_UNIT[kind]})")
+            lo, hi = self.ranges[name]
+            if not lo - AXES_EQUAL <= value <= hi + AXES_EQUAL:
+                raise ValueError(f"P[{pos.index}]: {label} = {from_si(value, unit):.3f} {unit} is "
+                                 f"outside the range of {name}, [{from_si(lo, unit):g}, "
+                                 f"{from_si(hi, unit):g}] {unit}")
+            out[name] = value
+        return out
+
+    def moving(self, values: dict[str, float]) -> dict[str, float]:
+        """The values that differ from where the axes are (by more than :data:`AXES_EQUAL`)."""
+        return {n: v for n, v in values.items() if abs(v - self.current[n]) > AXES_EQUAL}
+
+    def frame_fault(self, moving: dict[str, float], uf: int, frame: str) -> str | None:
+        """Why a move's points cannot be in ``frame`` (UF ``uf``) while ``moving`` axes move,
+        or None (module docstring)."""
+        mechs = {self.mechanism[n] for n in moving}
+        if uf == 0:
+            return ("a COORD move that moves external axes has its points in a user frame of "
+                    "the part (UFRAME_NUM = n, program_frames = { \"n\" = \"<cell object>\" }), "
+                    "not UF 0")
+        if self.carrier.get(frame) in mechs or self.robot_on in mechs:
+            return None
+        held_by = self.carrier.get(frame)
+        what = f"carried by {held_by!r}, which does not move" if held_by else "fixed"
+        return (f"UF {uf} is {frame!r}, {what}; a COORD move that moves "
+                f"{', '.join(sorted(mechs))} has its points in the frame of a part it carries")
 
 
 def _last_point(phases: list) -> NDArray[np.float64] | None:
