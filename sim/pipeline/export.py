@@ -21,6 +21,22 @@ that :mod:`sim.scenario.program` reads back to the same tool path at every progr
 * a hold phase: ``WAIT t(sec)``;
 * ``arc_on`` / ``arc_off`` actions at phase starts and ends: ``Arc Start[1]`` / ``Arc End[1]``
   (other tool actions are written as comments).
+
+In a cell with external axes (positioners, tracks) every position holds the axes' values where
+it is, as GP1's extended axes ``E1 .. En`` in the cell's axis order (``deg`` on a revolute
+axis, ``mm`` on a prismatic one: what :mod:`sim.scenario.program` maps back). A joint phase's
+``J`` carries its end values. A Cartesian phase whose axes move (a coordinated weld:
+``downhand``, ``follow``; a move with ``axes``) is written as ``COORD`` moves in a user frame of
+the part (the seam's object, or the phase's frame object), ``UFRAME_NUM = k`` before them and
+``UFRAME_NUM = 0`` after: the phase sampled into pieces (:func:`coordinated_pieces`), each an
+``L`` (a line) or ``C`` (an arc, through its middle) ``FINE`` to the pose the planned motion has
+relative to the part there, with the axes' values there. Relative to the part, a piece's path is
+the original's (a line or arc of the part frame) and its orientation turns evenly; the axes go
+linearly in the path between the pieces' ends, so a piece is split until the original axes'
+law deviates from that by at most :data:`LAW_TOL_RAD` / :data:`LAW_TOL_M` and its orientation
+from the even turn by at most :data:`TURN_TOL_DEG` (an arc's pieces span at most
+:data:`MAX_PIECE_DEG`). The user frames' cell objects are a note (``program_frames = { "1" =
+"head" }``: the scenario that runs the program gives it) and a comment in the program.
 """
 
 from __future__ import annotations
@@ -44,6 +60,17 @@ from sim.scenario.fanuc_ls import (
 )
 from sim.scenario.model import CartesianPhase, HoldPhase, JointPhase
 
+#: The axes' law of a coordinated phase may deviate this far from linear in the path within a
+#: written piece, rad (revolute) and m (prismatic).
+LAW_TOL_RAD = np.radians(0.05)
+LAW_TOL_M = 0.05e-3
+#: Its orientation relative to the part may deviate this far from an even turn, deg.
+TURN_TOL_DEG = 0.1
+#: An arc's pieces span at most this much of it, deg.
+MAX_PIECE_DEG = 30.0
+#: Most pieces a coordinated phase is written in.
+MAX_PIECES = 256
+
 
 def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
     """The TP program text of ``scenario``, notes on what it leaves out, and the text of its
@@ -62,12 +89,17 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
     built = build(scenario)
     motion = build_motion(scenario, built.context)
     check_motion_limits(scenario, motion)
-    kin = built.context.kinematics
+    ctx = built.context
+    kin = ctx.kinematics
     robot = scenario.robot
+    n = robot.n_joints
     notes: list[str] = []
     ins: list = [LSOther("uframe", 0), LSOther("utool", 1)]
     positions: dict[int, LSPosition] = {}
-    vmax = np.asarray(robot.max_speed, dtype=float)
+    vmax = np.asarray(scenario.system.max_speed, dtype=float)
+    units = tuple("deg" if a.kind == "revolute" else "mm"
+                  for pm in ctx.mechanisms for a in pm.spec.axes)
+    user_frames: dict[str, int] = {}  # cell object -> its user frame number
 
     schedules: dict[int, WeaveSchedule] = {}
     tp_pattern = {v: k for k, v in TP_WEAVE_PATTERNS.items()}
@@ -81,12 +113,16 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
         schedules[len(schedules) + 1] = sch
         return len(schedules)
 
-    def add_pos(**kw) -> int:
+    def add_pos(qe: np.ndarray, uf: int = 0, **kw) -> int:
         k = len(positions) + 1
-        positions[k] = LSPosition(k, 0, 1, **kw)
+        positions[k] = LSPosition(k, uf, 1, ext=tuple(float(v) for v in qe), ext_units=units,
+                                  **kw)
         return k
 
-    def cart_pos(T: np.ndarray, q_near: np.ndarray, what: str) -> int:
+    def cart_pos(T: np.ndarray, q_near: np.ndarray, what: str, qe: np.ndarray, uf: int = 0,
+                 T_written: np.ndarray | None = None) -> int:
+        """A Cartesian position: ``T`` the tool in frame 0 (its CONFIG), written as
+        ``T_written`` (in user frame ``uf``) when given."""
         try:
             sols = [s for s in solve_ik(kin, T, current=q_near) if s.within_limits]
         except CellsimError as exc:
@@ -95,9 +131,41 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
             raise ScenarioError(f"{scenario.source.name}: export: {what}: no IK solution in the "
                                 "joint ranges")
         best = min(sols, key=lambda s: float(np.abs(s.q - q_near).max()))
-        a, b, g = (math.degrees(v) for v in matrix_to_euler_zyx(T[:3, :3]))
-        x, y, z = (float(v) * 1e3 for v in T[:3, 3])
-        return add_pos(xyzwpr=(x, y, z, g, b, a), config=config_of(robot, best.q, best.branch))
+        W = T if T_written is None else T_written
+        a, b, g = (math.degrees(v) for v in matrix_to_euler_zyx(W[:3, :3]))
+        x, y, z = (float(v) * 1e3 for v in W[:3, 3])
+        return add_pos(qe, uf, xyzwpr=(x, y, z, g, b, a),
+                       config=config_of(robot, best.q, best.branch))
+
+    def coordinated(pm, ph: CartesianPhase) -> None:
+        """A phase whose axes move, as COORD moves in its part's user frame (module
+        docstring)."""
+        part = _part_of(ph, built.cell, ctx)
+        if part is None:
+            raise ScenarioError(f"{scenario.source.name}: export: {ph.name}: its axes move, "
+                                "but its points are in no cell object's frame (a COORD move's "
+                                "user frame)")
+        uf = user_frames.setdefault(part, len(user_frames) + 1)
+        ins.append(LSOther("uframe", uf))
+        pieces = coordinated_pieces(motion, pm, ctx, part)
+        if len(pieces) > 1:
+            notes.append(f"{ph.name}: written as {len(pieces)} COORD moves (FINE) in user frame "
+                         f"{uf} ({part})")
+        speed = round(pm.cartesian.speed * 1e3, 3)
+        for t_mid, t_end in pieces:
+            ks = []
+            for t in ((t_mid, t_end) if ph.kind == "circular" else (t_end,)):
+                q = np.asarray(motion.at(t).q[0], dtype=float)
+                T0 = np.asarray(kin.fk(q[:n]), dtype=float)
+                ks.append(cart_pos(T0, q[:n], f"{ph.name} at {t:.3f} s", q[n:], uf,
+                                   part_pose(ctx, part, q[n:], T0)))
+            if ph.kind == "circular":
+                ins.append(LSMotion("C", ("P", ks[1]), speed, "mm/sec", None, via=("P", ks[0]),
+                                    options=("COORD",)))
+            else:
+                ins.append(LSMotion("L", ("P", ks[0]), speed, "mm/sec", None,
+                                    options=("COORD",)))
+        ins.append(LSOther("uframe", 0))
 
     acts = [(t, a) for t, a in motion.actions]
     bounds = [pm.t0 for pm in motion.phases] + [motion.t1]
@@ -125,12 +193,15 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
                 notes.append(f"{ph.name}: peak joint speed {pct:.1f} % of the limit written as "
                              "100 %")
             pct = min(100, max(1, math.ceil(pct - 1e-9)))
-            k = add_pos(joints_deg=tuple(float(v) for v in np.rad2deg(to_maker(robot, q_end))))
+            k = add_pos(q_end[n:], joints_deg=tuple(
+                float(v) for v in np.rad2deg(to_maker(robot, q_end[:n]))))
             if ph.blend > 0 or ph.blend_fraction > 0:
                 notes.append(f"{ph.name}: its joint blend is written as FINE")
             if len(ph.q) > 3 or (len(ph.q) == 3 and ph.target is None):
                 notes.append(f"{ph.name}: its via knots are not written (J to the end point)")
             ins.append(LSMotion("J", ("P", k), float(pct), "%", None, line=0))
+        elif isinstance(ph, CartesianPhase) and ctx.mechanisms and _axes_move(motion, pm, n):
+            coordinated(pm, ph)
         elif isinstance(ph, CartesianPhase):
             k_weave = None
             if ph.weave is not None and ph.weave.pattern not in tp_pattern:
@@ -139,16 +210,17 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
             elif ph.weave is not None:
                 k_weave = schedule_of(ph.weave)
                 ins.append(LSOther("weave", LSWeave(tp_pattern[ph.weave.pattern], k_weave)))
-            q_near = np.asarray(motion.at(pm.t0).q[0], dtype=float)
-            for j, mv in enumerate(pm.programmed):
-                k = cart_pos(mv.end, q_end if mv.blend == 0 else q_near, f"{ph.name} end")
+            q_near = np.asarray(motion.at(pm.t0).q[0], dtype=float)[:n]
+            for mv in pm.programmed:
+                k = cart_pos(mv.end, q_end[:n] if mv.blend == 0 else q_near, f"{ph.name} end",
+                             q_end[n:])
                 cnt = None
                 if mv.blend > 0:
                     share = mv.blend / (CNT_SHARE * min(mv.length, mv.next_length))
                     cnt = int(min(100, max(1, round(100 * share))))
                 speed = round(mv.speed * 1e3, 3)
                 if mv.kind == "circular":
-                    kv = cart_pos(mv.via, q_near, f"{ph.name} via")
+                    kv = cart_pos(mv.via, q_near, f"{ph.name} via", q_end[n:])
                     ins.append(LSMotion("C", ("P", k), speed, "mm/sec", cnt, via=("P", kv)))
                 else:
                     ins.append(LSMotion("L", ("P", k), speed, "mm/sec", cnt))
@@ -157,9 +229,91 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
         for t, a in acts:
             if abs(t - pm.t1) < 1e-9 and a == "arc_off":
                 ins.append(LSOther("arc", "end"))
+    if user_frames:
+        frames = ", ".join(f'"{k}" = "{obj}"' for obj, k in user_frames.items())
+        notes.append(f"program_frames = {{ {frames} }}: the user frames of the COORD moves; "
+                     "give it in the scenario that runs the program")
+        ins[0:0] = [LSOther("comment", f"UF {k} = {obj} (program_frames)")
+                    for obj, k in user_frames.items()]
     name = "".join(c if c.isalnum() else "_" for c in scenario.name)[:36] or "PROG"
     table = write_weave_schedules(schedules, name.upper()) if schedules else None
     return write_ls(name, ins, positions, comment=scenario.name), notes, table
+
+
+def _axes_move(motion, pm, n: int) -> bool:
+    """Whether the external axes move during planned phase ``pm``."""
+    ts = np.linspace(pm.t0, pm.t1, 65)
+    qe = np.asarray(motion.at(ts).q, dtype=float)[:, n:]
+    return bool(qe.size) and float(np.ptp(qe, axis=0).max()) > 1e-9
+
+
+def _part_of(ph: CartesianPhase, cell, ctx) -> str | None:
+    """The cell object a coordinated phase's points are relative to: its seam's object, or its
+    frame when that is a cell object; None otherwise."""
+    if ph.seam is not None:
+        objs = cell.seam_objects.get(ph.seam, ())
+        if objs and objs[0] in ctx.frames:
+            return objs[0]
+    return ph.frame if ph.frame in ctx.frames else None
+
+
+def part_pose(ctx, part: str, qe: np.ndarray, T0: np.ndarray) -> np.ndarray:
+    """A tool pose ``T0`` in frame 0 (the robot's, carried by its track at axes ``qe``) in the
+    frame of cell object ``part`` (carried by its mechanism at ``qe``), (4, 4)."""
+    from sim.simulation.motion.axes import displacement, world_from_frame0
+
+    F = displacement(ctx, ctx.frame_mechanism.get(part), qe) @ ctx.frames[part]
+    return np.linalg.inv(F) @ world_from_frame0(ctx, qe) @ T0
+
+
+def coordinated_pieces(motion, pm, ctx, part: str) -> list[tuple[float, float]]:
+    """The pieces a coordinated phase (``pm`` of ``motion``) is written in, relative to cell
+    object ``part``: ``(t_mid, t_end)`` for each, the times at the middle of its path and at
+    its end (module docstring)."""
+    from scipy.spatial.transform import Rotation, Slerp
+
+    kin = ctx.kinematics
+    n = kin.n_joints
+    cart = pm.cartesian
+    tau = np.linspace(0.0, cart.duration, 4001)
+    s_of = np.asarray(cart.at(tau).path_length, dtype=float)
+    length = float(s_of[-1])
+
+    def t_at(s: float) -> float:
+        return pm.t0 + float(np.interp(s, s_of, tau))
+
+    kinds = [a.kind for m in ctx.mechanisms for a in m.spec.axes]
+    tol = np.array([LAW_TOL_RAD if k == "revolute" else LAW_TOL_M for k in kinds])
+
+    def state(s: float) -> tuple[np.ndarray, np.ndarray]:
+        q = np.asarray(motion.at(t_at(s)).q[0], dtype=float)
+        T0 = np.asarray(kin.fk(q[:n]), dtype=float)
+        return q[n:], part_pose(ctx, part, q[n:], T0)[:3, :3]
+
+    def fine(sa: float, sb: float) -> bool:
+        qa, Ra = state(sa)
+        qb, Rb = state(sb)
+        turn = Slerp([0.0, 1.0], Rotation.from_matrix([Ra, Rb]))
+        for u in (0.25, 0.5, 0.75):
+            qe, R = state(sa + u * (sb - sa))
+            if np.any(np.abs(qe - (qa + u * (qb - qa))) > tol):
+                return False
+            off = (turn([u]).inv() * Rotation.from_matrix(R)).magnitude()[0]
+            if np.degrees(off) > TURN_TOL_DEG:
+                return False
+        return True
+
+    sweep = float(getattr(cart.path, "sweep", 0.0)) if pm.phase.kind == "circular" else 0.0
+    first = max(1, int(np.ceil(np.degrees(sweep) / MAX_PIECE_DEG - 1e-9)))
+    todo = [(length * k / first, length * (k + 1) / first) for k in range(first)]
+    done: list[tuple[float, float]] = []
+    while todo:
+        sa, sb = todo.pop(0)
+        if len(done) + len(todo) + 1 < MAX_PIECES and not fine(sa, sb):
+            todo[0:0] = [(sa, 0.5 * (sa + sb)), (0.5 * (sa + sb), sb)]
+        else:
+            done.append((sa, sb))
+    return [(t_at(0.5 * (sa + sb)), t_at(sb) if sb < length else pm.t1) for sa, sb in done]
 
 
 def write_program(scenario: Scenario, out: str | Path) -> tuple[list[str], list[Path]]:
@@ -215,4 +369,5 @@ def _write_new(path: Path, text: str) -> None:
         os.unlink(tmp)
 
 
-__all__ = ["export_fanuc_ls", "write_program"]
+__all__ = ["LAW_TOL_M", "LAW_TOL_RAD", "MAX_PIECES", "MAX_PIECE_DEG", "TURN_TOL_DEG",
+           "coordinated_pieces", "export_fanuc_ls", "part_pose", "write_program"]
