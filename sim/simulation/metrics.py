@@ -244,9 +244,14 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
         if not np.any(arrays["arc_on"][inside]):
             continue
         cart = pm.cartesian
+        set_speed = float(cart.speed)
+        if pm.seam is not None and abs(cart.length / pm.seam.length() - 1.0) > 1e-4:
+            # an arc's tool point off the seam by a stand-off runs faster or slower than the
+            # seam's travel (motion.cartesian): the set speed is the seam's
+            set_speed *= pm.seam.length() / cart.length
         entry: dict[str, Any] = {
             "phase": pm.name, "seam": None if pm.seam is None else pm.seam.name,
-            "set_speed_mm_s": float(cart.speed * 1e3),
+            "set_speed_mm_s": set_speed * 1e3,
             "constant_speed_share": float(cart.constant_speed_fraction.time)}
         if k in measured:
             m = measured[k]
