@@ -169,7 +169,8 @@ durations_s = [3.0]
 to_seam = "circumferential"
 approach_mm = 200
 downhand = true
-axes = {{ positioner_tilt_deg = 63.0, positioner_rotate_deg = -180.0 }}  # the branch facing the robot
+# the positioner's branch that turns the seam's start towards the robot
+axes = {{ positioner_tilt_deg = 63.0, positioner_rotate_deg = -180.0 }}
 
 [[phases]]
 name = "touch"
