@@ -121,6 +121,19 @@ def measure_seam_phases(arrays: Mapping[str, NDArray[Any]], motion: Motion,
     return out
 
 
+def _carrier(context: Any, pm: Any) -> str | None:
+    """The mechanism carrying what a Cartesian phase's path is relative to: its seam's part,
+    or, for a coordinated move in a frame (``phase.axes``, a TP program's COORD), the object
+    its points are given in; None for a fixed one (or a context without mechanisms)."""
+    if context is None or not context.mechanisms:
+        return None
+    if pm.seam is not None:
+        return context.seam_mechanism.get(pm.seam.name)
+    if getattr(pm.phase, "axes", None):
+        return context.frame_mechanism.get(getattr(pm.phase, "frame", ""))
+    return None
+
+
 def _in_part_frame(context: Any, pm: Any, q: NDArray[np.float64], pos: NDArray[np.float64],
                    rot: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Recorded tool frames (world) in the frame the phase's seam was placed in (``pm.seam``:
@@ -129,7 +142,7 @@ def _in_part_frame(context: Any, pm: Any, q: NDArray[np.float64], pos: NDArray[n
     from sim.simulation.motion.axes import displacement
 
     n = context.kinematics.n_joints
-    mech = context.seam_mechanism[pm.seam.name]
+    mech = _carrier(context, pm)
     qe0 = np.asarray(pm.trajectory.at(pm.t0).q, dtype=float)[n:]
     back = displacement(context, mech, qe0) @ np.linalg.inv(displacement(context, mech, q[:, n:]))
     return (np.einsum("nij,nj->ni", back[:, :3, :3], pos) + back[:, :3, 3],
@@ -277,6 +290,15 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
             continue
         p = arrays["tcp_pos"][sel]
         ts = t[sel]
+        T = built.context.world_from_frame0
+        R_act = Rotation.from_quat(arrays["tcp_quat"][sel], scalar_first=True).as_matrix()
+        if _carrier(built.context, pm) is not None:  # a coordinated move: in the part's frame
+            from sim.simulation.motion.axes import world_from_frame0
+
+            n = built.context.kinematics.n_joints
+            p, R_act = _in_part_frame(built.context, pm, arrays["q"][sel], p, R_act)
+            T = world_from_frame0(built.context,
+                                  np.asarray(pm.trajectory.at(pm.t0).q, dtype=float)[n:])
         lo, hi = _cruise_window(cart)
         cs = (ts >= pm.t0 + lo + 1e-9) & (ts <= pm.t0 + hi - 1e-9)
         if isinstance(cart, WeavingTrajectory):
@@ -289,12 +311,16 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
             v = np.linalg.norm(np.gradient(p, ts, axis=0), axis=1)
             vc = v[cs] if np.count_nonzero(cs) > 2 else v
         dev = _distance_to_path(p, cart, T)
-        R_act = Rotation.from_quat(arrays["tcp_quat"][sel], scalar_first=True).as_matrix()
         ref = cart.at(np.clip(ts - pm.t0, 0.0, cart.duration))
         R_ref = T[:3, :3] @ ref.rotation
         ang = angle_deg(R_act[:, :, torch_axis], R_ref[:, :, torch_axis])
         ends = cart.at(np.array([0.0, cart.duration])).position @ T[:3, :3].T + T[:3, 3]
-        first, last = arrays["tcp_pos"][_phase_samples(arrays, pm)[[0, -1]]]
+        ends_idx = _phase_samples(arrays, pm)[[0, -1]]
+        first, last = arrays["tcp_pos"][ends_idx]
+        if _carrier(built.context, pm) is not None:
+            (first, last), _ = _in_part_frame(built.context, pm, arrays["q"][ends_idx],
+                                              arrays["tcp_pos"][ends_idx],
+                                              np.broadcast_to(np.eye(3), (2, 3, 3)))
         entry.update({
             "seam_length_mm": float(cart.length * 1e3),
             "travel_speed_mm_s": float(np.mean(vc) * 1e3),
@@ -443,8 +469,7 @@ def cartesian_speeds(arrays: Mapping[str, NDArray[Any]], motion: Motion,
         sel = _phase_samples(arrays, pm)
         if sel.size < 3:
             speed = 0.0
-        elif pm.seam is not None and context is not None and \
-                context.seam_mechanism.get(pm.seam.name):
+        elif pm.seam is not None and _carrier(context, pm) is not None:
             rel, _ = _in_part_frame(context, pm, arrays["q_ref"][sel], p[sel],
                                     np.broadcast_to(np.eye(3), (sel.size, 3, 3)))
             speed = _seam_cruise(pm, t[sel], rel)
@@ -452,15 +477,19 @@ def cartesian_speeds(arrays: Mapping[str, NDArray[Any]], motion: Motion,
             speed = _seam_cruise(pm, t[sel], p[sel])
         else:
             steady = getattr(pm.cartesian, "steady", None)
+            ps = p[sel]
+            if _carrier(context, pm) is not None:  # a coordinated move: relative to the part
+                ps, _ = _in_part_frame(context, pm, arrays["q_ref"][sel], ps,
+                                       np.broadcast_to(np.eye(3), (sel.size, 3, 3)))
             if isinstance(pm.cartesian, WeavingTrajectory):
-                speed = _woven_cruise(pm.cartesian, t[sel] - pm.t0, p[sel], T)
+                speed = _woven_cruise(pm.cartesian, t[sel] - pm.t0, ps, T)
             elif steady is not None:  # a blended phase: its speed between its corners
                 tl = t[sel] - pm.t0
-                v = np.linalg.norm(np.gradient(p[sel], t[sel], axis=0), axis=1)
+                v = np.linalg.norm(np.gradient(ps, t[sel], axis=0), axis=1)
                 mid = (tl >= steady[0] - 1e-9) & (tl <= steady[1] + 1e-9)
                 speed = float(np.median(v[mid] if np.count_nonzero(mid) > 2 else v))
             else:
-                v = np.linalg.norm(np.diff(p[sel], axis=0), axis=1) / np.diff(t[sel])
+                v = np.linalg.norm(np.diff(ps, axis=0), axis=1) / np.diff(t[sel])
                 cruise = v[v >= 0.95 * v.max()] if v.max() > 0 else v
                 speed = float(np.median(cruise))
         want = float(pm.phase.speed)

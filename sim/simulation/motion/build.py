@@ -166,8 +166,8 @@ def _robot_part(pm: PhaseMotion, n: int) -> PhaseMotion:
 
 def _no_coordination(group: list, labels: list[str]) -> None:
     for ph, lb in zip(group, labels, strict=True):
-        if ph.downhand or ph.follow is not None:
-            key = "downhand" if ph.downhand else "follow"
+        if ph.downhand or ph.follow is not None or ph.axes:
+            key = "downhand" if ph.downhand else "follow" if ph.follow is not None else "axes"
             raise ScenarioError(f"{lb}.{key}: not with blend_mm or a polyline seam (coordinated "
                                 "motion welds one line or arc seam per phase)")
 
