@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
+from support.part_frame import in_body_frame
 
 #: The run-back's tool path relative to the part stays this close to the original's, m.
 PATH_TOL = 0.1e-3
@@ -41,25 +42,6 @@ def run(scenario_path: Path | str, out: Path) -> tuple[dict, dict]:
     run_scenario(load_scenario(scenario_path), RunOptions(out_dir=out, video=False, plots=False,
                                                           progress=False))
     return json.loads((out / "summary.json").read_text()), dict(np.load(out / "trajectory.npz"))
-
-
-def in_body_frame(run_dir: Path, body: str | None, qpos: np.ndarray, p: np.ndarray
-                  ) -> np.ndarray:
-    """World points ``p`` (N, 3) in the frame of ``body`` (None: the world) at each recorded
-    ``qpos``, posed by MuJoCo in the run's own model."""
-    if body is None:
-        return p.copy()
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_path(str(run_dir / "model.xml"))
-    data = mujoco.MjData(model)
-    b = model.body(body).id
-    out = np.zeros_like(p)
-    for i, (q, x) in enumerate(zip(qpos, p, strict=True)):
-        data.qpos[:] = q
-        mujoco.mj_kinematics(model, data)
-        out[i] = data.xmat[b].reshape(3, 3).T @ (x - data.xpos[b])
-    return out
 
 
 def weld_path(run_dir: Path, a: dict, body: str | None, stride: int = 5) -> np.ndarray:

@@ -8,10 +8,10 @@ simulated vs inverse-dynamics torque, parts placed in their slots.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support.part_frame import in_body_frame
 
 from sim.core.resources import shipped_scenarios
 
@@ -28,21 +28,6 @@ def test_scenario_runs_and_tracks(name, scenario_run):
     # phases recorded in order, covering the whole run
     assert np.all(np.diff(a["phase"]) >= 0)
     assert a["phase"][-1] == len(summary["phases"]) - 1
-
-
-def _in_body_frame(run: Path, body: str, qpos: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """World points ``p`` (N, 3) in the frame of ``body`` at each recorded ``qpos``."""
-    import mujoco
-
-    model = mujoco.MjModel.from_xml_path(str(run / "model.xml"))
-    data = mujoco.MjData(model)
-    b = model.body(body).id
-    out = np.zeros_like(p)
-    for i, (q, x) in enumerate(zip(qpos, p, strict=True)):
-        data.qpos[:] = q
-        mujoco.mj_kinematics(model, data)
-        out[i] = data.xmat[b].reshape(3, 3).T @ (x - data.xpos[b])
-    return out
 
 
 @pytest.mark.parametrize("name", WELD)
@@ -70,7 +55,7 @@ def test_weld_seams_path_speed_and_torch(name, scenario_run):
             continue
         p = a["tcp_pos"][sel][::50]  # 50 ms chords: sub-micrometre servo jitter averages out
         if carried.get(ph["name"]):
-            p = _in_body_frame(out, f"{carried[ph['name']]}_mount", a["qpos"][sel][::50], p)
+            p = in_body_frame(out, f"{carried[ph['name']]}_mount", a["qpos"][sel][::50], p)
         length += np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))
     seam_total = sum(w["seam_length_mm"] for w in welds)
     assert length * 1e3 == pytest.approx(seam_total, rel=0.01)
