@@ -44,6 +44,9 @@ SIZE_MM = Quantity("a size of a solid", "mm", MIN_SIZE_MM, MAX_MM)
 INNER_RADIUS_MM = Quantity("an inner radius", "mm", 0.0, MAX_MM)
 #: A part's mass, kg.
 PART_MASS_KG = Quantity("a part's mass", "kg", 1e-6, 1000.0)
+#: An object's mass: a part's (at most :data:`PART_MASS_KG`'s 1000 kg, checked by the reader) or
+#: a workpiece's on a mechanism (heavy positioners carry tonnes).
+OBJECT_MASS_KG = Quantity("an object's mass", "kg", 1e-6, 1e5)
 #: A sliding friction coefficient.
 FRICTION = Quantity("a friction coefficient", "", 1e-6, 5.0)
 #: A colour component (RGB(A)).
@@ -90,7 +93,7 @@ class ObjectBlock(Strict):
     pos_mm: list[Mm] = _vec3([0.0, 0.0, 0.0])
     euler_zyx_deg: list[Deg] = _vec3([0.0, 0.0, 0.0])
     role: Literal["fixture", "workpiece", "part"] = "fixture"
-    mass_kg: PART_MASS_KG.type | None = None
+    mass_kg: OBJECT_MASS_KG.type | None = None
     color: list[COLOR.type] | None = Field(None, min_length=3, max_length=4)
     material: Literal[MATERIALS] | None = None  # type: ignore[valid-type]
     friction: FRICTION.type | None = None

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.cells import meshes
-from sim.cells.cellfile.schema import ObjectBlock
+from sim.cells.cellfile.schema import PART_MASS_KG, ObjectBlock
 from sim.core.rotations import euler_zyx_to_matrix
 from sim.errors import CellError
 
@@ -147,6 +147,9 @@ def read_solid(block: ObjectBlock, index: int, base: Path, where: str) -> Solid:
                         "cylinder, sphere or mesh)")
     if block.role == "part" and block.mass_kg is None:
         raise CellError(f"{key}.mass_kg: required for a part (a free body)")
+    if block.role == "part" and block.mass_kg > PART_MASS_KG.hi:
+        raise CellError(f"{key}.mass_kg: must be between {PART_MASS_KG.lo:g} and "
+                        f"{PART_MASS_KG.hi:g} kg (a part's mass), got {block.mass_kg!r}")
     if block.role != "part" and block.mass_kg is not None and block.on is None:
         raise CellError(f"{key}.mass_kg: only parts and objects on a mechanism have a mass "
                         f"(role = \"part\", or on = ...); {block.role}s are static")
