@@ -216,6 +216,7 @@ def downhand_round_trip(tmp: Path, sweep_deg: float, speed: float) -> float:
                             ["deg", "deg"])
 
 
+@pytest.mark.slow  # two runs of a positioner cell: 30-60 s (the suite's ten minutes)
 @settings(RUN_SETTINGS, max_examples=1)
 @given(sweep=st.floats(32.0, 40.0), speed=st.floats(40.0, 55.0))
 def test_a_short_downhand_arc_runs_back_relative_to_the_part(sweep, speed, tmp_path_factory):
