@@ -40,6 +40,10 @@ INPUT = {"side_mm": _RNG.uniform(200, 400), "thick_mm": _RNG.uniform(5, 30),
 REL = 6e-4
 
 
+# one generated run with plots and report (about 20 s): in the slow share (the fast share's
+# ten minutes)
+pytestmark = pytest.mark.slow
+
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory):
     folder = tmp_path_factory.mktemp("axes")

@@ -30,6 +30,7 @@ def example(tmp_path_factory):
     return folder, tomllib.loads(cell)
 
 
+@pytest.mark.slow  # a check and a run of a positioner cell (the fast share's ten minutes)
 def test_the_documented_downhand_example_checks_clean_and_passes(example):
     import sim
     from sim.pipeline.check import check_scenario

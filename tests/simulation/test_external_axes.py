@@ -116,6 +116,7 @@ def test_a_coordinated_downhand_weld_holds_the_seam_in_the_parts_frame(case, tmp
     assert w["torch_angle_error_deg"] <= ANGLE_TOL_DEG
 
 
+@pytest.mark.slow  # one more positioner run (the fast share's ten minutes)
 def test_a_coordinated_weld_passes_the_runs_own_speed_check(tmp_path):
     """The run's verdict judges the travel speed where the oracle does, relative to the part:
     a downhand weld on a turning part, correct to 1e-4 in the part's frame, does not fail
@@ -216,6 +217,7 @@ def test_the_oracles_forward_kinematics_is_the_file_at_hand_poses():
 
 
 # ------------------------------------------------------------------ 3. track
+@pytest.mark.slow  # a 2-3.5 m seam at 35-50 mm/s: a long cycle (the campaign has 3 more)
 @settings(FAST, max_examples=1)
 @given(case=track_cases())
 def test_a_robot_on_a_track_welds_a_seam_longer_than_its_reach_in_one_pass(case,
