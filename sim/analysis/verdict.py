@@ -105,7 +105,7 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                                subject=f"tool {tool:g} kg + payload {payload:g} kg on the "
                                f"{spec.name}, rated {spec.payload_kg:g} kg"))
     # a linear axis (a track's) in mm, N; a joint in deg, N m
-    linear = np.array([False] * spec.n_arm + [a.kind == "prismatic" for _, a in spec.external])
+    linear = np.array(spec.linear)
     scale = np.where(linear, 1e3, np.degrees(1.0))
     track = scale * np.max(np.abs(np.asarray(arrays["q"]) - arrays["q_ref"]), axis=0)
     speed = scale * np.max(np.abs(np.asarray(arrays["qd"])), axis=0)

@@ -119,16 +119,21 @@ def build_cell(cell: CellSpec | None, robot: RobotSpec, *,
     rig = prepare_robot(spec_r, tool_spec, payload)
     layout = cspec.build(rig, mount)
     home_q = layout.home_q if layout.home_q is not None else rig.home_q
-    compiled = add_home_keyframe(layout.world, rig, home_q, layout.mechanisms)
+    compiled = add_home_keyframe(layout.world, rig, home_q, layout.mechanisms, layout.partners)
     if layout.mechanisms:
         tune_gains(layout.world, layout.mechanisms, compiled)
     p = ROBOT_PREFIX
     axes = [n for pm in layout.mechanisms for n in pm.joint_names]
     friction = [a.friction for pm in layout.mechanisms for a in pm.spec.axes]
+    for cr in layout.partners:  # the other robots' joints after the axes
+        axes += list(cr.placed.joint_names)
+        friction += list(cr.rig.statics.frictionloss)
+    actuators = axes[:len(axes) - sum(cr.robot.n_joints for cr in layout.partners)] + [
+        a for cr in layout.partners for a in cr.placed.actuator_names]
     return Cell(
         name=cspec.name, robot=spec_r, tool=tool_spec, mount=mount, mjcf=layout.world,
         joint_names=[f"{p}/{j}" for j in spec_r.joints] + axes,
-        actuator_names=[f"{p}/a{i + 1}" for i in range(spec_r.n_joints)] + axes,
+        actuator_names=[f"{p}/a{i + 1}" for i in range(spec_r.n_joints)] + actuators,
         tcp_site=f"{p}/tcp", frame0_site=f"{p}/frame0", flange_site=f"{p}/flange",
         seams=layout.seams, parts=layout.parts, slots=layout.slots, cameras=layout.cameras,
         world_from_frame0=layout.world_from_frame0,
@@ -141,7 +146,8 @@ def build_cell(cell: CellSpec | None, robot: RobotSpec, *,
         seam_objects=dict(layout.seam_objects), frames=dict(layout.frames),
         source=cspec.source, _rig=rig,
         rings={name: dict(geoms.params) for name, geoms in layout.objects.items()
-               if isinstance(geoms, Ring)}, mechanisms=layout.mechanisms)
+               if isinstance(geoms, Ring)}, mechanisms=layout.mechanisms,
+        partners=layout.partners)
 
 
 __all__ = ["CELL_DEFAULT", "build_cell", "resolve_tool"]

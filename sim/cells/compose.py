@@ -56,6 +56,7 @@ if TYPE_CHECKING:  # MuJoCo and dm_control are imported where a model is made or
     from dm_control import mjcf
 
     from sim.cells.mechanisms import PlacedMechanism
+    from sim.cells.partners import CellRobot
 
 ROBOT_PREFIX = "robot"
 #: Name prefix of the robot's friction actuators (``robot/friction_j1``, ...).
@@ -249,6 +250,7 @@ class RobotRig:
     payload_kg: float = 0.0
     home_q: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     tcp_local: NDArray[np.float64] | None = None
+    prefix: str = ROBOT_PREFIX
 
     @property
     def frame0_height(self) -> float:
@@ -290,15 +292,19 @@ def payload_radius(mass_kg: float) -> float:
     return float((3.0 * mass_kg / (4.0 * np.pi * STEEL_DENSITY)) ** (1.0 / 3.0))
 
 
-def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.0) -> RobotRig:
-    """Load the robot, attach the tool at its flange, move its tcp, add the payload."""
+def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.0,
+                  prefix: str = ROBOT_PREFIX) -> RobotRig:
+    """Load the robot, attach the tool at its flange, move its tcp, add the payload.
+
+    ``prefix`` names the robot's model (its names become ``<prefix>/<name>``): ``robot`` for a
+    cell's robot, the cell file's name for each of its other robots (``[[robots]]``)."""
     from dm_control import mjcf
 
     st = robot_statics(spec)
     robot = mjcf.from_path(str(spec.robot_path))
     for key in robot.find_all("key"):
         key.remove()
-    robot.model = ROBOT_PREFIX
+    robot.model = prefix
     # the arm makes no contact in the simulation (module docstring): its collision geoms are
     # checked geometrically by sim.simulation.collisions
     for geom in robot.find_all("geom"):
@@ -362,7 +368,8 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
                  group=1, rgba=(0.9, 0.8, 0.1, 0.35))
     return RobotRig(spec=spec, tool=tool, model=robot, statics=st,
                     tcp_from_flange=tcp_from_flange, tool_body=tool_body,
-                    payload_kg=payload_kg, home_q=st.home_q.copy(), tcp_local=tcp_local)
+                    payload_kg=payload_kg, home_q=st.home_q.copy(), tcp_local=tcp_local,
+                    prefix=prefix)
 
 
 # ---------------------------------------------------------------------------- world
@@ -522,6 +529,7 @@ class Layout:
     seam_objects: dict[str, tuple[str, ...]] = field(default_factory=dict)
     frames: dict[str, NDArray[np.float64]] = field(default_factory=dict)
     mechanisms: tuple[PlacedMechanism, ...] = ()
+    partners: tuple[CellRobot, ...] = ()
 
 
 def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
@@ -537,9 +545,10 @@ def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
 
 
 def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np.float64],
-                      mechanisms: tuple[PlacedMechanism, ...] = ()) -> mujoco.MjModel:
-    """Add keyframe ``home``: robot at ``home_q``, the mechanisms at their home, free bodies
-    where built, suction off."""
+                      mechanisms: tuple[PlacedMechanism, ...] = (),
+                      partners: tuple[CellRobot, ...] = ()) -> mujoco.MjModel:
+    """Add keyframe ``home``: robot at ``home_q``, the mechanisms at their home, the other
+    robots at theirs, free bodies where built, suction off."""
     import mujoco
 
     m = compile_model(world)
@@ -548,6 +557,8 @@ def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np
     values = [(f"{ROBOT_PREFIX}/{j}", qj) for j, qj in zip(rig.spec.joints, home_q, strict=True)]
     for pm in mechanisms:
         values += list(zip(pm.joint_names, pm.home, strict=True))
+    for cr in partners:
+        values += list(zip(cr.placed.joint_names, cr.home_q, strict=True))
     for name, qj in values:
         jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
         qpos[m.jnt_qposadr[jid]] = qj

@@ -144,7 +144,8 @@ def load_cell(path: str | Path) -> CellSpec:
                     default_tool, tools, (spec.robot.mount,), make_builder(cf), needs_tool=needs,
                     source=path.resolve(), any_tool=spec.tools is None,
                     any_robot=spec.robot.model is None,
-                    mechanisms=tuple(cf.mechanisms.values()))
+                    mechanisms=tuple(cf.mechanisms.values()),
+                    partners=tuple(cf.partners.values()))
 
 
 def resolve_cell(ref: str, base: Path | None = None) -> CellSpec:

@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from sim.cells.compose import Layout, RobotRig, compile_model
 from sim.cells.mechanisms import PlacedMechanism
+from sim.cells.partners import CellRobot, PlacedRobot
 from sim.cells.seam import Seam
 from sim.cells.tools import ToolSpec
 from sim.robots.kinematics.model import KinematicModel
@@ -47,6 +48,8 @@ class CellSpec:
             scene, a cell file without ``[robot] model``).
         mechanisms: Its turntables, positioners and tracks (their axes are driven joints after
             the robot's).
+        partners: Its other robots (:class:`sim.cells.partners.PlacedRobot`; their joints
+            follow the axes).
     """
 
     name: str
@@ -61,6 +64,7 @@ class CellSpec:
     any_tool: bool = False
     any_robot: bool = False
     mechanisms: tuple[PlacedMechanism, ...] = ()
+    partners: tuple[PlacedRobot, ...] = ()
 
     @property
     def axis_names(self) -> tuple[str, ...]:
@@ -105,6 +109,8 @@ class Cell:
         rings: Parameters of each object that is a ring of staves (:class:`compose.Ring`).
         mechanisms: The cell's turntables, positioners and tracks (their axes follow the
             robot's joints in :attr:`joint_names`).
+        partners: The cell's other robots (:class:`sim.cells.partners.CellRobot`; their joints
+            follow the axes in :attr:`joint_names`, ``<name>/j1``, ...).
     """
 
     name: str
@@ -136,6 +142,7 @@ class Cell:
     source: Path | None = None
     rings: dict[str, dict] = field(default_factory=dict)
     mechanisms: tuple[PlacedMechanism, ...] = ()
+    partners: tuple[CellRobot, ...] = ()
     _rig: RobotRig | None = field(default=None, repr=False)
 
     @property

@@ -54,6 +54,8 @@ class RobotSpec:
         external: The cell's external axes after the arm's joints, ``(name, axis)`` each
             (:meth:`with_axes`): the joint names, limits and drives above then cover them too;
             the kinematics (``family``, the model files) stay the arm's (:attr:`arm`).
+        partners: The cell's other robots after the external axes, ``(name, robot)`` each
+            (:meth:`with_partners`): their joints are named ``<name>_<joint>``.
     """
 
     name: str
@@ -71,6 +73,7 @@ class RobotSpec:
     maker_matrix: tuple[tuple[float, ...], ...] = ()
     estimated_links: tuple[bool, ...] = ()
     external: tuple[tuple[str, AxisSpec], ...] = ()
+    partners: tuple[tuple[str, RobotSpec], ...] = ()
 
     def with_axes(self, axes: Sequence[tuple[str, AxisSpec]]) -> RobotSpec:
         """The arm with a cell's external axes after its joints (a cell's driven joints):
@@ -89,21 +92,50 @@ class RobotSpec:
             estimated_links=(arm.estimated_links + (False,) * k) if arm.estimated_links else (),
             external=tuple(axes))
 
+    def with_partners(self, partners: Sequence[tuple[str, RobotSpec]]) -> RobotSpec:
+        """This system (the arm and its cell's axes) with the cell's other robots' joints
+        after it (``<name>_<joint>``: names, limits, drives); itself when there are none."""
+        if not partners:
+            return self
+        names = list(self.joints)
+        speed, accel = list(self.max_speed), list(self.max_accel or (np.inf,) * self.n_joints)
+        drives: list[Drive] | None = list(self.drives) if self.drives else None
+        est = list(self.estimated_links or (False,) * self.n_joints)
+        for name, r in partners:
+            names += [f"{name}_{j}" for j in r.joints]
+            speed += list(r.max_speed)
+            accel += list(r.max_accel or (np.inf,) * r.n_joints)
+            drives = drives + list(r.drives) if drives is not None and r.drives else None
+            est += list(r.estimated_links or (False,) * r.n_joints)
+        return dataclasses.replace(
+            self, joint_names=tuple(names), max_speed=tuple(speed), max_accel=tuple(accel),
+            drives=tuple(drives or ()),
+            estimated_links=tuple(est) if any(est) else (),
+            partners=self.partners + tuple(partners))
+
     @property
     def n_arm(self) -> int:
-        """The arm's joints (without external axes)."""
-        return self.n_joints - len(self.external)
+        """The arm's joints (without external axes and other robots)."""
+        return self.n_joints - len(self.external) - sum(r.n_joints for _, r in self.partners)
+
+    @property
+    def linear(self) -> tuple[bool, ...]:
+        """Whether each joint of the system is linear (a track's travel: m, N)."""
+        k = self.n_joints - self.n_arm - len(self.external)
+        return ((False,) * self.n_arm + tuple(a.kind == "prismatic" for _, a in self.external)
+                + (False,) * k)
 
     @property
     def arm(self) -> RobotSpec:
-        """The robot without external axes."""
-        if not self.external:
+        """The robot without external axes and other robots."""
+        if not self.external and not self.partners:
             return self
         n = self.n_arm
         return dataclasses.replace(
             self, joint_names=self.joints[:n], max_speed=self.max_speed[:n],
             max_accel=self.max_accel[:n] if np.all(np.isfinite(self.max_accel[:n])) else (),
-            drives=self.drives[:n], estimated_links=self.estimated_links[:n], external=())
+            drives=self.drives[:n], estimated_links=self.estimated_links[:n], external=(),
+            partners=())
 
     @property
     def joints_on_estimates(self) -> tuple[str, ...]:

@@ -19,6 +19,7 @@ from sim.scenario.model import (
     JointPhase,
     Phase,
     PoseTarget,
+    RobotWork,
     Scenario,
 )
 from sim.scenario.planning import PlannedPhase, plan_phase, plan_scenario
@@ -40,7 +41,7 @@ from sim.scenario.schema import (
 __all__ = [
     "Action", "ActionSpec", "CartesianPhase", "CircularPhaseSpec", "DriveOverrideSpec",
     "ExpectSpec", "HoldPhase", "HoldPhaseSpec", "JointPhase", "JointPhaseSpec", "LinearPhaseSpec",
-    "Phase", "PlannedPhase", "PoseTarget", "Scenario", "ScenarioSpec", "SimulationSpec",
-    "SizingSpec", "VideoSpec", "WeaveSpec", "load_scenario", "parse_scenario", "plan_phase",
-    "plan_scenario", "resolve_scenario",
+    "Phase", "PlannedPhase", "PoseTarget", "RobotWork", "Scenario", "ScenarioSpec",
+    "SimulationSpec", "SizingSpec", "VideoSpec", "WeaveSpec", "load_scenario", "parse_scenario",
+    "plan_phase", "plan_scenario", "resolve_scenario",
 ]

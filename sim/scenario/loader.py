@@ -19,7 +19,7 @@ from __future__ import annotations
 import difflib
 import tomllib
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from pydantic import BaseModel, ValidationError
@@ -31,7 +31,7 @@ from sim.core.tomlschema import describe
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.robots.registry import resolve_robot
 from sim.scenario.fanuc_ls import read_ls
-from sim.scenario.model import Action, HoldPhase, JointPhase, Phase, Scenario
+from sim.scenario.model import Action, HoldPhase, JointPhase, Phase, RobotWork, Scenario
 from sim.scenario.phases import (
     build_cartesian_phase,
     build_joint_phase,
@@ -52,10 +52,16 @@ from sim.scenario.schema import (
     ExpectSpec,
     JointPhaseSpec,
     LinearPhaseSpec,
+    RobotWorkSpec,
     ScenarioSpec,
     SimulationSpec,
     VideoSpec,
 )
+
+if TYPE_CHECKING:
+    from sim.cells import CellSpec
+    from sim.cells.tools import ToolSpec
+    from sim.robots.spec import RobotSpec
 
 
 def resolve_scenario(ref: str | Path) -> Path:
@@ -102,6 +108,87 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
     except CellsimError as exc:  # unknown name, or a robot folder's own error
         raise ScenarioError(f"{where}: robot: {exc}") from None
 
+    base = Path(source).parent if str(source) != "<scenario>" else Path.cwd()
+    try:
+        cell = None if spec.cell is None else resolve_cell(spec.cell, base)
+    except CellsimError as exc:  # a cell file's own error names its file and key
+        raise ScenarioError(f"{where}: cell: {exc}") from None
+    mount = spec.mount
+    if cell is not None and cell.source is not None:
+        file_mount = cell.mounts[0]
+        if "mount" in spec.model_fields_set and spec.mount != file_mount:
+            raise ScenarioError(f"{where}: mount: {spec.mount!r}, but cell file {cell.source.name} "
+                                f"mounts the robot on the {file_mount} ([robot] mount); leave "
+                                "mount out or make the two agree")
+        mount = file_mount
+        if not cell.any_robot and robot.name not in cell.robots:
+            raise ScenarioError(f"{where}: robot: cell file {cell.source.name} is laid out for "
+                                f"{cell.robots[0]} ([robot] model), not {robot.name}")
+    cell_axes = {} if cell is None else {
+        n: (a.kind, a.range) for pm in cell.mechanisms
+        for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)}
+    kinds = {pm.name: pm.spec.kind for pm in (() if cell is None else cell.mechanisms)}
+    tracks = {name for name, kind in kinds.items() if kind == "track"}
+    for i, pspec in enumerate(spec.phases):
+        if isinstance(pspec, JointPhaseSpec):
+            check_axes(pspec.axes, cell_axes, f"{where}: phases[{i}]")
+        elif isinstance(pspec, (LinearPhaseSpec, CircularPhaseSpec)):
+            if pspec.follow is not None and pspec.follow not in tracks:
+                what = (f"{pspec.follow!r} is a {kinds[pspec.follow]}; a robot follows a seam on "
+                        "a track" if pspec.follow in kinds
+                        else UnknownNameError('track', pspec.follow, sorted(tracks)) if tracks
+                        else f"no track {pspec.follow!r}: the cell has none")
+                raise ScenarioError(f"{where}: phases[{i}].follow: {what}")
+    try:
+        tool = resolve_tool(BARE if cell is None else cell, spec.tool, base)
+    except CellsimError as exc:
+        raise ScenarioError(f"{where}: tool: {exc}") from None
+    drives: dict[str, dict[str, float]] = {}
+    others = () if cell is None else tuple(n for p in cell.partners for n in p.system_names)
+    joints = robot.joints + tuple(cell_axes) + others
+    for joint, override in spec.drives.items():
+        if joint not in joints:
+            close = difflib.get_close_matches(joint, joints, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            axes = f" and the cell's axes {', '.join(cell_axes)}" if cell_axes else ""
+            axes += f" and the other robots' {', '.join(others)}" if others else ""
+            raise ScenarioError(f"{where}: drives.{joint}: unknown joint{hint}; robot "
+                                f"{robot.name} has {', '.join(robot.joints)}{axes}")
+        drives[joint] = {k: v for k, v in override.model_dump().items() if v is not None}
+    phases, actions, program_warnings = _work(spec, robot, tool, cell, base, where)
+    partners = _partners(spec, cell, base, where)
+    _check_expect(spec.expect, where)
+    return Scenario(
+        name=spec.name,
+        description=spec.description,
+        robot=robot,
+        phases=tuple(phases),
+        source=Path(source),
+        text=text,
+        cell=cell,
+        tool=tool,
+        mount=mount,
+        payload_kg=spec.payload_kg,
+        simulation=spec.simulation,
+        video=spec.video,
+        drives=drives,
+        program_warnings=program_warnings,
+        actions=tuple(actions),
+        sizing=spec.sizing,
+        expect=spec.expect,
+        partners=partners,
+    )
+
+
+def _work(spec: ScenarioSpec | RobotWorkSpec, robot: RobotSpec, tool: ToolSpec | None,
+          cell: CellSpec | None, base: Path, where: str
+          ) -> tuple[list[Phase], list[Action], tuple[str, ...]]:
+    """One robot's work: its phases (or its TP program's) and its tool actions.
+
+    ``where`` starts every error (``file.toml`` for the first robot, ``file.toml: robots.r2``
+    for another).
+    """
+    tool_kind = None if tool is None else tool.kind
     phases: list[Phase] = []
     seen: dict[str, int] = {}
     if (spec.program is None) == (not spec.phases):
@@ -140,52 +227,6 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
             phase = HoldPhase(index=i, name=pspec.name, duration=pspec.duration_s)
         phases.append(phase)
 
-    base = Path(source).parent if str(source) != "<scenario>" else Path.cwd()
-    try:
-        cell = None if spec.cell is None else resolve_cell(spec.cell, base)
-    except CellsimError as exc:  # a cell file's own error names its file and key
-        raise ScenarioError(f"{where}: cell: {exc}") from None
-    mount = spec.mount
-    if cell is not None and cell.source is not None:
-        file_mount = cell.mounts[0]
-        if "mount" in spec.model_fields_set and spec.mount != file_mount:
-            raise ScenarioError(f"{where}: mount: {spec.mount!r}, but cell file {cell.source.name} "
-                                f"mounts the robot on the {file_mount} ([robot] mount); leave "
-                                "mount out or make the two agree")
-        mount = file_mount
-        if not cell.any_robot and robot.name not in cell.robots:
-            raise ScenarioError(f"{where}: robot: cell file {cell.source.name} is laid out for "
-                                f"{cell.robots[0]} ([robot] model), not {robot.name}")
-    cell_axes = {} if cell is None else {
-        n: (a.kind, a.range) for pm in cell.mechanisms
-        for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)}
-    kinds = {pm.name: pm.spec.kind for pm in (() if cell is None else cell.mechanisms)}
-    tracks = {name for name, kind in kinds.items() if kind == "track"}
-    for i, pspec in enumerate(spec.phases):
-        if isinstance(pspec, JointPhaseSpec):
-            check_axes(pspec.axes, cell_axes, f"{where}: phases[{i}]")
-        elif isinstance(pspec, (LinearPhaseSpec, CircularPhaseSpec)):
-            if pspec.follow is not None and pspec.follow not in tracks:
-                what = (f"{pspec.follow!r} is a {kinds[pspec.follow]}; a robot follows a seam on "
-                        "a track" if pspec.follow in kinds
-                        else UnknownNameError('track', pspec.follow, sorted(tracks)) if tracks
-                        else f"no track {pspec.follow!r}: the cell has none")
-                raise ScenarioError(f"{where}: phases[{i}].follow: {what}")
-    try:
-        tool = resolve_tool(BARE if cell is None else cell, spec.tool, base)
-    except CellsimError as exc:
-        raise ScenarioError(f"{where}: tool: {exc}") from None
-    tool_kind = None if tool is None else tool.kind
-    drives: dict[str, dict[str, float]] = {}
-    joints = robot.joints + tuple(cell_axes)
-    for joint, override in spec.drives.items():
-        if joint not in joints:
-            close = difflib.get_close_matches(joint, joints, n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
-            axes = f" and the cell's axes {', '.join(cell_axes)}" if cell_axes else ""
-            raise ScenarioError(f"{where}: drives.{joint}: unknown joint{hint}; robot "
-                                f"{robot.name} has {', '.join(robot.joints)}{axes}")
-        drives[joint] = {k: v for k, v in override.model_dump().items() if v is not None}
     program_warnings: tuple[str, ...] = ()
     actions = []
     if spec.program is not None:
@@ -220,26 +261,42 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
             raise ScenarioError(f"{where}: actions[{i}].action: {a.action} needs a {need} tool "
                                 f"(the tool is {'none' if tool is None else tool.name})")
         actions.append(Action(a.action, a.time_s, a.phase, a.at))
-    _check_expect(spec.expect, where)
-    return Scenario(
-        name=spec.name,
-        description=spec.description,
-        robot=robot,
-        phases=tuple(phases),
-        source=Path(source),
-        text=text,
-        cell=cell,
-        tool=tool,
-        mount=mount,
-        payload_kg=spec.payload_kg,
-        simulation=spec.simulation,
-        video=spec.video,
-        drives=drives,
-        program_warnings=program_warnings,
-        actions=tuple(actions),
-        sizing=spec.sizing,
-        expect=spec.expect,
-    )
+    return phases, actions, program_warnings
+
+
+def _partners(spec: ScenarioSpec, cell: CellSpec | None, base: Path, where: str
+              ) -> tuple[RobotWork, ...]:
+    """The work of the cell's other robots (``[robots.<name>]``); one not named stays at its
+    home all cycle."""
+    placed = {} if cell is None else {p.name: p for p in cell.partners}
+    for name in spec.robots:
+        if name not in placed:
+            what = (UnknownNameError("robot", name, list(placed)) if placed
+                    else "the cell has no other robots (a cell file's [[robots]])")
+            raise ScenarioError(f"{where}: robots.{name}: {what}")
+    out = []
+    for name, pr in placed.items():
+        ws = spec.robots.get(name)
+        if ws is None:
+            out.append(RobotWork(name, pr.robot, pr.tool))
+            continue
+        key = f"{where}: robots.{name}"
+        for i, ph in enumerate(ws.phases):
+            moved = [k for k in ("axes", "downhand", "follow") if getattr(ph, k, None)]
+            if moved:
+                raise ScenarioError(f"{key}: phases[{i}].{moved[0]}: the cell's axes move with "
+                                    "its first robot's phases (a second robot's phases move "
+                                    "its own joints)")
+        try:
+            tool = pr.tool if ws.tool is None else resolve_tool(BARE, ws.tool, base)
+        except CellsimError as exc:
+            raise ScenarioError(f"{key}.tool: {exc}") from None
+        if tool is not None and tool.suction_gain_n > 0.0:
+            raise ScenarioError(f"{key}.tool: {tool.name!r} is a suction gripper; a cell's "
+                                "other robots carry torches or tools without suction")
+        phases, actions, warns = _work(ws, pr.robot, tool, None, base, key)
+        out.append(RobotWork(name, pr.robot, tool, tuple(phases), tuple(actions), warns))
+    return tuple(out)
 
 
 def _check_expect(expect: ExpectSpec, where: str) -> None:

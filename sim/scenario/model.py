@@ -242,6 +242,27 @@ Phase = JointPhase | CartesianPhase | HoldPhase
 
 
 @dataclass(frozen=True)
+class RobotWork:
+    """The work of one of a cell's other robots (``[robots.<name>]``).
+
+    Attributes:
+        name: The robot's name in the cell.
+        robot: Its registry entry.
+        tool: Its tool, or None.
+        phases: Its phases in order (empty: it stays at its home all cycle).
+        actions: Its tool actions in file order.
+        program_warnings: As :attr:`Scenario.program_warnings`, for its TP program.
+    """
+
+    name: str
+    robot: RobotSpec
+    tool: ToolSpec | None = None
+    phases: tuple[Phase, ...] = ()
+    actions: tuple[Action, ...] = ()
+    program_warnings: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A validated scenario (SI units).
 
@@ -263,6 +284,8 @@ class Scenario:
             not simulated, one line each with its line number.
         expect: What a run is expected to give (``[expect]``: verdict, failed checks,
             ``cellsim check`` findings, reason); it changes no verdict.
+        partners: The work of the cell's other robots, in the cell's order (every one of them:
+            one the file gives no work stays at home).
     """
 
     name: str
@@ -282,6 +305,7 @@ class Scenario:
     sizing: SizingSpec = SizingSpec()
     program_warnings: tuple[str, ...] = ()
     expect: ExpectSpec = ExpectSpec()
+    partners: tuple[RobotWork, ...] = ()
 
     @property
     def sha256(self) -> str:
@@ -310,7 +334,18 @@ class Scenario:
         without mechanisms."""
         mechanisms = () if self.cell is None else self.cell.mechanisms
         return self.robot.with_axes([(n, a) for pm in mechanisms
-                                     for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)])
+                                     for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)]
+                                    ).with_partners([(w.name, w.robot) for w in self.partners])
+
+    def partner_scenario(self, work: RobotWork) -> Scenario:
+        """One of the other robots' work as a scenario of its own (no cell: its motion is
+        planned with its own :class:`~sim.simulation.motion.CartesianContext`)."""
+        import dataclasses
+
+        return dataclasses.replace(
+            self, name=f"{self.name}.{work.name}", robot=work.robot, tool=work.tool,
+            phases=work.phases, actions=work.actions, program_warnings=work.program_warnings,
+            cell=None, drives={}, payload_kg=0.0, partners=())
 
     def scaled(self, speed_scale: float = 1.0, payload_kg: float | None = None) -> "Scenario":
         """This scenario run ``speed_scale`` times faster, optionally with another payload.

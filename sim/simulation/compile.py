@@ -9,7 +9,7 @@ actuators, suction actuator, part free joints), resolved here and nowhere else.
 from __future__ import annotations
 
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -48,6 +48,8 @@ class BuiltCell:
             +-inf when unlimited), N m, (n, 2).
         friction_act: Ids of the robot joints' friction actuators (joints without friction
             have none).
+        partner_cols: The cell's other robots' columns in the joint vector, by name.
+        partner_tcp: Ids of their ``tcp`` sites, by name.
     """
 
     cell: Cell
@@ -65,6 +67,8 @@ class BuiltCell:
     frame0_site: int
     force_limits: NDArray[np.float64]
     friction_act: NDArray[np.int64]
+    partner_cols: dict[str, slice] = field(default_factory=dict)
+    partner_tcp: dict[str, int] = field(default_factory=dict)
 
 
 # --------------------------------------------------------------------------------------------
@@ -102,6 +106,13 @@ def build(scenario: Scenario) -> BuiltCell:
     root.sensor.add("framepos", name="cellsim_tcp_pos", objtype="site", objname=tcp)
     root.sensor.add("framequat", name="cellsim_tcp_quat", objtype="site", objname=tcp)
     sensors += [("tcp_pos", 3), ("tcp_quat", 4)]
+    for cr in cell.partners:  # each other robot's tool point
+        tcp_p = root.find("site", cr.tcp_site)
+        root.sensor.add("framepos", name=f"cellsim_{cr.name}_tcp_pos", objtype="site",
+                        objname=tcp_p)
+        root.sensor.add("framequat", name=f"cellsim_{cr.name}_tcp_quat", objtype="site",
+                        objname=tcp_p)
+        sensors += [(f"{cr.name}_tcp_pos", 3), (f"{cr.name}_tcp_quat", 4)]
     xml = root.to_xml_string()
     try:
         model = mujoco.MjModel.from_xml_string(xml, root.get_assets())
@@ -145,14 +156,32 @@ def build(scenario: Scenario) -> BuiltCell:
                            frames=dict(cell.frames), home_q=np.asarray(cell.home_q, float),
                            flange_to_tcp=np.linalg.inv(site_T(fl)) @ site_T(tcp_site),
                            robot=scenario.robot, **_mechanism_context(cell))
+    cols, start_col = {}, len(cell.joint_names) - sum(cr.robot.n_joints for cr in cell.partners)
+    for cr in cell.partners:  # each other robot plans with its own kinematics and seams
+        t_p, f0_p = model.site(cr.tcp_site).id, model.site(cr.frame0_site).id
+        kin_p = _tool_kinematics(closed_form_model(cr.robot), model, f0_p, t_p, robot_qpos,
+                                 None if cr.tool is None or cr.tool.straight
+                                 else model.site(cr.flange_site).id)
+        ctx.partners[cr.name] = CartesianContext(
+            kinematics=kin_p, seams=dict(cr.seams),
+            world_from_frame0=np.asarray(cr.world_from_frame0, dtype=float),
+            frames=dict(cell.frames), home_q=np.asarray(cr.home_q, float),
+            flange_to_tcp=np.linalg.inv(site_T(model.site(cr.flange_site).id)) @ site_T(t_p),
+            robot=cr.robot, seam_mechanism=dict(ctx.seam_mechanism),
+            frame_mechanism=dict(ctx.frame_mechanism))
+        cols[cr.name] = slice(start_col, start_col + cr.robot.n_joints)
+        start_col += cr.robot.n_joints
     limits = np.where(model.actuator_forcelimited[robot_act, None].astype(bool),
                       model.actuator_forcerange[robot_act] * model.actuator_gear[robot_act, :1],
                       np.array([-np.inf, np.inf]))
+    prefixes = ("robot", *(cr.name for cr in cell.partners))
     friction = np.array([a for a in range(model.nu)
-                         if model.actuator(a).name.startswith((f"robot/{FRICTION_PREFIX}",
-                                                               FRICTION_PREFIX))], dtype=int)
+                         if model.actuator(a).name.startswith(
+                             (*(f"{p}/{FRICTION_PREFIX}" for p in prefixes), FRICTION_PREFIX))],
+                        dtype=int)
     return BuiltCell(cell, model, saved_xml, robot_qpos, robot_dof, robot_act, suction, slices,
-                     part_qpos, ctx, jids, tcp_site, frame0_site, limits, friction)
+                     part_qpos, ctx, jids, tcp_site, frame0_site, limits, friction, cols,
+                     {cr.name: model.site(cr.tcp_site).id for cr in cell.partners})
 
 
 def _mechanism_context(cell: Cell) -> dict[str, Any]:

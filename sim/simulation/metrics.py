@@ -361,8 +361,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
     sim_time = rec.steps * rec.timestep
     track = np.max(np.abs(a["q"] - a["q_ref"]), axis=0)
     system = scenario.system  # a linear axis's (a track's) tracking error in m, shown in mm
-    units = ["deg"] * system.n_arm + ["mm" if ax.kind == "prismatic" else "deg"
-                                      for _, ax in system.external]
+    units = ["mm" if lin else "deg" for lin in system.linear]
     dev = np.linalg.norm(a["tcp_pos"] - a["tcp_pos_ref"], axis=1)
     peak_id = np.max(np.abs(a["tau_id"]), axis=0)
     rms_diff = np.sqrt(np.mean((a["tau"] - a["tau_id"]) ** 2, axis=0))

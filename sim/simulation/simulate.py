@@ -427,11 +427,12 @@ def _arrays(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
     tau = np.where(saturated, tau_act, tau_act - h * kv * qdd_sim)
     kin = built.context.kinematics
     nr = kin.n_joints  # the arm's joints; the external axes follow them
+    na = built.context.n_axes
     poses = np.asarray(kin.fk(ref.q[:n, :nr]), dtype=float).reshape(n, 4, 4)
-    if nj > nr:  # a track carries frame 0
+    if na:  # a track carries frame 0
         from sim.simulation.motion.axes import world_from_frame0
 
-        W = world_from_frame0(built.context, ref.q[:n, nr:])
+        W = world_from_frame0(built.context, ref.q[:n, nr:nr + na])
         tcp_ref = np.einsum("nij,nj->ni", W[:, :3, :3], poses[:, :3, 3]) + W[:, :3, 3]
     else:
         T0 = built.context.world_from_frame0
@@ -453,6 +454,15 @@ def _arrays(built: BuiltCell, motion: Motion, t: NDArray[np.float64], ref: Any,
         "suction": motion.tool_state(t, "suction"),
         "knot_t": motion.knot_times(),
     }
+    for (name, lane), cols in zip(motion.lanes, built.partner_cols.values(), strict=True):
+        # each other robot's tool point, recorded and as its reference puts it
+        ctx = built.context.partners[name]
+        T0 = ctx.world_from_frame0
+        p_ref = np.asarray(ctx.kinematics.fk(ref.q[:n, cols]), dtype=float).reshape(n, 4, 4)
+        out[f"{name}_tcp_pos"] = sens[:, built.sensor_slices[f"{name}_tcp_pos"]]
+        out[f"{name}_tcp_quat"] = sens[:, built.sensor_slices[f"{name}_tcp_quat"]]
+        out[f"{name}_tcp_pos_ref"] = p_ref[:, :3, 3] @ T0[:3, :3].T + T0[:3, 3]
+        out[f"{name}_arc_on"] = lane.tool_state(t, "arc")
     if built.part_qpos:
         out["part_pos"] = np.stack([qpos[:, a[:3]] for a in built.part_qpos], axis=1)
         out["part_quat"] = np.stack([qpos[:, a[3:]] for a in built.part_qpos], axis=1)

@@ -19,9 +19,11 @@ from sim.cells.compose import (
     look_at_xyaxes,
     matrix_from_quat,
     new_world,
+    prepare_robot,
     quat_from_matrix,
 )
 from sim.cells.mechanisms import CONTACT_MOVING, add_mechanism
+from sim.cells.partners import CellRobot
 from sim.cells.seam import Seam
 from sim.cells.tools import CONTACT_FIXTURE, CONTACT_PART_AFFINITY, CONTACT_PART_TYPE
 from sim.errors import CellError, CellsimError
@@ -166,11 +168,13 @@ def _add_part(world, b: ObjectBlock, solid: Solid) -> None:
 
 
 def _default_cameras(world, rig: RobotRig, T0: NDArray[np.float64], cf: CellFile,
-                     taken: set[str]) -> list[str]:
-    """``overview`` framing the robot's work envelope and every object, and ``tool`` (a fixed
-    camera aiming at the tool)."""
+                     taken: set[str], others: tuple[CellRobot, ...] = ()) -> list[str]:
+    """``overview`` framing the robots' work envelopes and every object, and ``tool`` (a fixed
+    camera aiming at the first robot's tool)."""
     reach = rig.max_distance_from_frame0()
     spheres = [(T0[:3, 3], reach)] + [(s.pose[:3, 3], s.radius) for s in cf.solids.values()]
+    spheres += [(cr.world_from_frame0[:3, 3], cr.rig.max_distance_from_frame0())
+                for cr in others]
     lo = np.min([p - r for p, r in spheres], axis=0)
     hi = np.max([p + r for p, r in spheres], axis=0)
     lo[2] = max(lo[2], 0.0)  # nothing below the floor is seen
@@ -213,6 +217,15 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
                                        quat=quat_from_matrix(L[:3, :3]), size=[0.01], group=4)
         site.attach(rig.model)
     T0 = T_base @ rig.statics.base_from_frame0
+    others = []
+    for pr in cf.partners.values():  # the cell's other robots, on the floor or the ceiling
+        rig_p = prepare_robot(pr.robot, pr.tool, 0.0, prefix=pr.name)
+        frame = world.worldbody.attach(rig_p.model)
+        frame.pos = pr.base_pose[:3, 3]
+        frame.quat = quat_from_matrix(pr.base_pose[:3, :3])
+        others.append(CellRobot(pr, rig_p, pr.base_pose @ rig_p.statics.base_from_frame0,
+                                home_q=(rig_p.home_q.copy() if pr.home_q is None
+                                        else pr.home_q.copy())))
     objects: dict[str, list] = {}
     parts: list[str] = []
     frames: dict[str, NDArray[np.float64]] = {}
@@ -241,6 +254,13 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
         for sg in ([seam] if seam.kind != "polyline" else [seam, *seam.segments()]):
             seams[sg.name] = sg
             seam_objects[sg.name] = joined
+        for cr in others:  # each other robot's tool point on the seam (its tool's stand-off)
+            seam_p = seam_in_world(
+                sb, obj.pose, seam_points(sb, f"seams[{i}]"),
+                tool_axis=cr.robot.family.approach_column, world_from_frame0=cr.world_from_frame0,
+                standoff=seam_standoff(sb, i, cr.tool, cf.where))
+            for sg in ([seam_p] if seam_p.kind != "polyline" else [seam_p, *seam_p.segments()]):
+                cr.seams[sg.name] = sg
     slots = []
     for sl in spec.slots:
         p = np.asarray(sl.pos_mm, dtype=float) * 1e-3
@@ -259,7 +279,7 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
             world.worldbody.add("camera", name=c.name, pos=pos,
                                 xyaxes=look_at_xyaxes(pos, at), fovy=c.fovy_deg)
         cams.append(c.name)
-    cams = _default_cameras(world, rig, T0, cf, set(cams)) + cams
+    cams = _default_cameras(world, rig, T0, cf, set(cams), tuple(others)) + cams
     rb = spec.robot
     n = rig.spec.n_joints
     home_q = rig.home_q.copy()
@@ -306,7 +326,7 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
                   slots=np.array(slots).reshape(-1, 3), cameras=cams, start_q=start_q,
                   home_q=home_q, dims=dims, objects=objects,
                   seam_objects=seam_objects, frames=frames,
-                  mechanisms=tuple(cf.mechanisms.values()))
+                  mechanisms=tuple(cf.mechanisms.values()), partners=tuple(others))
 
 
 class FileBuilder:

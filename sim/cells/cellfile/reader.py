@@ -21,6 +21,7 @@ from sim.cells.cellfile.schema import (
 from sim.cells.cellfile.seams import ctwd_key, seam_in_world, seam_points
 from sim.cells.cellfile.solids import Solid, geom_names, object_pose, read_solid
 from sim.cells.mechanisms import PlacedMechanism
+from sim.cells.partners import PlacedRobot
 from sim.core.tomlschema import load_toml
 from sim.errors import CellError, CellsimError, UnknownNameError
 
@@ -39,6 +40,7 @@ class CellFile:
         mounted: Objects on a mechanism: ``name -> (mechanism, pose in its mount frame)``.
         robot_on: The mechanism the robot's base stands on (a track), or None.
         robot_local: The robot base frame in that mechanism's mount frame, (4, 4).
+        partners: The cell's other robots (``[[robots]]``) by name, in the file's order.
     """
 
     path: Path
@@ -50,6 +52,7 @@ class CellFile:
     mounted: dict[str, tuple[str, NDArray[np.float64]]] = field(default_factory=dict)
     robot_on: str | None = None
     robot_local: NDArray[np.float64] | None = None
+    partners: dict[str, PlacedRobot] = field(default_factory=dict)
 
     @property
     def where(self) -> str:
@@ -209,8 +212,53 @@ def read_cell_file(path: str | Path) -> CellFile:
         carried[rb.on].append("robot")
     mechanisms = {name: dataclasses.replace(pm, carries=tuple(carried[name]))
                   for name, pm in mechanisms.items()}
+    partners = read_partners(spec, path, set(solids) | set(mechanisms))
     return CellFile(path=path, spec=spec, solids=solids, base_pose=base, mechanisms=mechanisms,
-                    mounted=mounted, robot_on=rb.on, robot_local=robot_local)
+                    mounted=mounted, robot_on=rb.on, robot_local=robot_local, partners=partners)
+
+
+def read_partners(spec: CellFileSpec, path: Path, taken: set[str]) -> dict[str, PlacedRobot]:
+    """The cell file's other robots (``[[robots]]``): model, tool and home resolved.
+
+    Raises:
+        CellError: One line naming the file and the key (a name taken or reserved, an unknown
+            robot or tool, a suction gripper, home values that do not fit the robot).
+    """
+    from sim.cells.registry import tool_from_ref
+    from sim.robots.registry import resolve_robot
+
+    where = path.name
+    out: dict[str, PlacedRobot] = {}
+    for i, rb in enumerate(spec.robots):
+        key = f"{where}: robots[{i}]"
+        if rb.name in out or rb.name in RESERVED or rb.name in taken:
+            what = ("is already another robot's name" if rb.name in out else "is reserved"
+                    if rb.name in RESERVED else "is an object's or mechanism's name")
+            raise CellError(f"{key}.name: {rb.name!r} {what}")
+        try:
+            robot = resolve_robot(rb.model, path.parent)
+        except CellsimError as exc:
+            raise CellError(f"{key}.model: {exc}") from None
+        ref = rb.tool if rb.tool is not None else spec.tool
+        try:
+            tool = None if ref is None or ref == "none" else tool_from_ref(ref, path.parent)
+        except CellsimError as exc:
+            raise CellError(f"{key}.tool: {exc}") from None
+        if tool is not None and tool.suction_gain_n > 0.0:
+            raise CellError(f"{key}.tool: {tool.name!r} is a suction gripper; a cell's other "
+                            "robots carry torches or tools without suction (the first robot "
+                            "picks)")
+        home = None
+        if rb.home_deg is not None:
+            if len(rb.home_deg) != robot.n_joints:
+                raise CellError(f"{key}.home_deg: {len(rb.home_deg)} values; robot "
+                                f"{robot.name} has {robot.n_joints} joints")
+            home = np.deg2rad(np.asarray(rb.home_deg, dtype=float))
+        base = object_pose(rb.base_pos_mm, rb.base_euler_zyx_deg)
+        if rb.mount == "ceiling":
+            base[:3, :3] = base[:3, :3] @ np.diag([1.0, -1.0, -1.0])
+        out[rb.name] = PlacedRobot(rb.name, robot, tool, base, home, i)
+    return out
 
 
 def read_mechanisms(spec: CellFileSpec, path: Path) -> dict[str, PlacedMechanism]:
@@ -258,4 +306,4 @@ def read_mechanisms(spec: CellFileSpec, path: Path) -> dict[str, PlacedMechanism
     return out
 
 
-__all__ = ["CellFile", "read_cell_file", "read_mechanisms"]
+__all__ = ["CellFile", "read_cell_file", "read_mechanisms", "read_partners"]

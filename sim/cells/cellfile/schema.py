@@ -146,6 +146,19 @@ class MechanismBlock(Strict):
     home: dict[str, float] = {}
 
 
+class OtherRobotBlock(Strict):
+    """``[[robots]]``: another robot in the cell, with its own tool, base and home (its work is
+    the scenario's ``[robots.<name>]``)."""
+
+    name: str = Field(pattern=_NAME)
+    model: str
+    tool: str | None = None
+    base_pos_mm: list[Mm] = _vec3([0.0, 0.0, 0.0])
+    base_euler_zyx_deg: list[Deg] = _vec3([0.0, 0.0, 0.0])
+    mount: Literal["floor", "ceiling"] = "floor"
+    home_deg: list[float] | None = None
+
+
 class CellFileSpec(Strict):
     """Top level of a cell file."""
 
@@ -160,7 +173,8 @@ class CellFileSpec(Strict):
     cameras: list[CameraBlock] = []
     dims: dict[str, float] = {}
     mechanisms: list[MechanismBlock] = []
+    robots: list[OtherRobotBlock] = Field([], max_length=8)
 
 
-__all__ = ["CameraBlock", "CellFileSpec", "MechanismBlock", "ObjectBlock", "RobotBlock", "SeamBlock",
-           "SlotBlock"]
+__all__ = ["CameraBlock", "CellFileSpec", "MechanismBlock", "ObjectBlock", "OtherRobotBlock",
+           "RobotBlock", "SeamBlock", "SlotBlock"]

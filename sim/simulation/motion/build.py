@@ -152,9 +152,45 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
         phases.append(pm)
         t = pm.t1
         q = pm.trajectory.at(pm.t1).q
-    motion = Motion(phases=phases, actions=[], n_joints=system.n_joints)
+    n_lead = system.n_joints - sum(w.robot.n_joints for w in scenario.partners)
+    motion = Motion(phases=phases, actions=[], n_joints=n_lead)
     motion.actions = _resolve_actions(scenario, motion)
+    if scenario.partners:
+        motion.lanes = _plan_partners(scenario, context, motion.t0)
+        motion.n_joints = system.n_joints
     return motion
+
+
+def _plan_partners(scenario: Scenario, context: CartesianContext | None, t0: float
+                   ) -> list[tuple[str, Motion]]:
+    """The cell's other robots' motions, each planned alone with its own kinematics and seams
+    on the cycle's clock (from ``t0``); one without work holds its home."""
+    if context is None:
+        raise ScenarioError(f"{scenario.source.name}: robots: a cell's other robots need the "
+                            "compiled cell")
+    lanes = []
+    for work in scenario.partners:
+        ctx = context.partners[work.name]
+        assert ctx.home_q is not None
+        if not work.phases:
+            hold = HoldPhase(index=0, name="home", duration=0.0)
+            lane = Motion([PhaseMotion(hold, t0, t0, HoldTrajectory(t0, 0.0, ctx.home_q),
+                                       knot_times=np.array([t0]))], [], work.robot.n_joints)
+        else:
+            sub = scenario.partner_scenario(work)
+            for ph in work.phases:
+                seam = getattr(ph, "seam", None)
+                if seam is not None and seam in context.seam_mechanism:
+                    raise ScenarioError(
+                        f"{scenario.source.name}: robots.{work.name}: phases[{ph.index}].seam: "
+                        f"{seam!r} is carried by {context.seam_mechanism[seam]!r}; a cell's "
+                        "other robots weld seams that stand still (the first robot welds with "
+                        "the cell's axes)")
+            lane = build_motion(dataclasses.replace(
+                sub, source=scenario.source.with_name(
+                    f"{scenario.source.name}: robots.{work.name}")), ctx)
+        lanes.append((work.name, lane))
+    return lanes
 
 
 def _robot_part(pm: PhaseMotion, n: int) -> PhaseMotion:

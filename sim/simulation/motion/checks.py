@@ -10,6 +10,8 @@ in the CONFIG its position names).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from sim.errors import ReachError, ScenarioError
@@ -59,6 +61,7 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
     system = scenario.system  # the robot's joints and the cell's external axes
     rng = joint_ranges(system)
     where = scenario.source.name
+    k = motion.n_lead  # the other robots' joints follow: their lanes are checked below
     # blended phases share one trajectory: each trajectory is checked once (once per phase
     # made the check grow as the square of the number of blended moves) and a violation is
     # named after the phase whose window holds its time
@@ -69,15 +72,20 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
     out = []
     for group in groups.values():
         found = find_limit_violations(
-            group[0].trajectory, lower=rng[:, 0], upper=rng[:, 1],
-            max_velocity=np.asarray(system.max_speed) if speed else None,
-            max_acceleration=(np.asarray(system.max_accel)
+            group[0].trajectory, lower=rng[:k, 0], upper=rng[:k, 1],
+            max_velocity=np.asarray(system.max_speed[:k]) if speed else None,
+            max_acceleration=(np.asarray(system.max_accel[:k])
                               if accel and system.max_accel else None),
-            joint_names=system.joints,
-            linear=[False] * system.n_arm + [a.kind == "prismatic" for _, a in system.external])
+            joint_names=system.joints[:k],
+            linear=list(system.linear[:k]))
         for v in found:
             pm = next((p for p in group if p.t0 <= v.time <= p.t1), group[0])
             out.append(f"{where}: phases[{pm.phase.index}] ({pm.name}): {v.message()}")
+    for work, (name, lane) in zip(scenario.partners, motion.lanes, strict=True):
+        sub = scenario.partner_scenario(work)
+        sub = dataclasses.replace(sub, source=scenario.source.with_name(
+            f"{where}: robots.{name}"))
+        out += limit_violations(sub, lane, speed=speed, accel=accel)
     return out
 
 

@@ -39,6 +39,8 @@ class CartesianContext:
         robot_on: The mechanism (a track) carrying the robot's base, or None.
         moving: For a context posed at some axis values (:func:`~sim.simulation.motion.axes.posed`):
             the cell's own context (at home, with its mechanisms); None otherwise.
+        partners: The cell's other robots' contexts (their kinematics, frame 0, home and the
+            seams as their tools follow them), by name; their motion is planned with them.
     """
 
     kinematics: Any
@@ -53,6 +55,7 @@ class CartesianContext:
     frame_mechanism: dict[str, str] = field(default_factory=dict)
     robot_on: str | None = None
     moving: Any = None
+    partners: dict[str, CartesianContext] = field(default_factory=dict)
 
     @property
     def n_axes(self) -> int:

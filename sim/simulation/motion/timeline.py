@@ -95,12 +95,18 @@ class Motion:
     Attributes:
         phases: Planned phases in order; ``phases[k].t1 == phases[k+1].t0``.
         actions: ``(time, action)`` pairs sorted by time (``arc_on``, ``suction_off``, ...).
-        n_joints: Number of robot joints.
+        n_joints: Number of driven joints (the robot's and the cell's axes; with other robots,
+            theirs too: see :attr:`lanes`).
+        lanes: The cell's other robots' motions on the same clock, ``(name, motion)`` each, in
+            the cell's order: their joints follow the first robot's (and the axes') in
+            :meth:`at`; each holds its last pose once it ends. :attr:`phases` and
+            :attr:`actions` are the first robot's.
     """
 
     phases: list[PhaseMotion]
     actions: list[tuple[float, str]]
     n_joints: int
+    lanes: list[tuple[str, Motion]] = field(default_factory=list)
 
     @property
     def t0(self) -> float:
@@ -108,24 +114,33 @@ class Motion:
 
     @property
     def t1(self) -> float:
-        return self.phases[-1].t1
+        """The cycle's end: the last of the robots' motions ends."""
+        return max([self.phases[-1].t1] + [m.t1 for _, m in self.lanes])
 
     @property
     def duration(self) -> float:
         return self.t1 - self.t0
 
     @property
+    def n_lead(self) -> int:
+        """The first robot's and the axes' joints (the columns :attr:`phases` give)."""
+        return self.n_joints - sum(m.n_joints for _, m in self.lanes)
+
+    @property
     def boundaries(self) -> NDArray[np.float64]:
-        return np.array([p.t0 for p in self.phases] + [self.t1])
+        return np.array([p.t0 for p in self.phases] + [self.phases[-1].t1])
 
     def phase_index(self, t: ArrayLike) -> NDArray[np.int64]:
-        """Index of the phase each time belongs to (a boundary belongs to the later phase)."""
+        """Index of the phase each time belongs to (a boundary belongs to the later phase;
+        past the first robot's last phase: that phase)."""
         idx = np.searchsorted(self.boundaries, np.asarray(t, dtype=float), side="right") - 1
         return np.clip(idx, 0, len(self.phases) - 1)
 
     def at(self, t: ArrayLike) -> JointState:
-        """Reference joint state at time(s) ``t``, s; times past the end hold the last pose."""
+        """Reference joint state at time(s) ``t``, s; times past a robot's end hold its last
+        pose."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
+        nl = self.n_lead
         out = [np.zeros((t.size, self.n_joints)) for _ in range(4)]
         idx = self.phase_index(t)
         for k, pm in enumerate(self.phases):
@@ -135,10 +150,16 @@ class Motion:
             ts = np.clip(t[sel], pm.t0, pm.t1)
             st = pm.trajectory.at(ts)
             for arr, val in zip(out, (st.q, st.qd, st.qdd, st.qddd)):
-                arr[sel] = val
-        past = t > self.t1
+                arr[sel, :nl] = val
+        past = t > self.phases[-1].t1
         for arr in out[1:]:
-            arr[past] = 0.0
+            arr[past, :nl] = 0.0
+        col = nl
+        for _, lane in self.lanes:
+            st = lane.at(t)
+            for arr, val in zip(out, (st.q, st.qd, st.qdd, st.qddd)):
+                arr[:, col:col + lane.n_joints] = val
+            col += lane.n_joints
         return JointState(*out)
 
     def tool_state(self, t: ArrayLike, tool: str) -> NDArray[np.bool_]:
@@ -153,6 +174,7 @@ class Motion:
         return on
 
     def knot_times(self) -> NDArray[np.float64]:
-        """All knot times of all phases, sorted, s."""
-        ts = np.concatenate([pm.knot_times for pm in self.phases] or [np.zeros(0)])
+        """All knot times of all phases (the other robots' too), sorted, s."""
+        ts = np.concatenate([pm.knot_times for pm in self.phases]
+                            + [m.knot_times() for _, m in self.lanes] or [np.zeros(0)])
         return np.unique(ts)
