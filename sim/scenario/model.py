@@ -369,24 +369,13 @@ class Scenario:
             raise ScenarioError(f"payload_kg must be 0 to {MAX_PAYLOAD_KG:g} kg, got "
                                 f"{payload_kg!r}")
         s = float(speed_scale)
-        order = {"v": 1, "a": 2, "j": 3}
-        phases: list[Phase] = []
-        for p in self.phases:
-            if isinstance(p, JointPhase):
-                phases.append(dataclasses.replace(
-                    p, times=None if p.times is None else p.times / s,
-                    durations=p.durations / s,
-                    boundary={k: v * s ** order[k[0]] for k, v in p.boundary.items()}))
-            elif isinstance(p, CartesianPhase):
-                phases.append(dataclasses.replace(
-                    p, speed=p.speed * s, sample_period=p.sample_period / s,
-                    ramp=None if p.ramp is None else p.ramp / s))
-            else:
-                phases.append(dataclasses.replace(p, duration=p.duration / s))
-        actions = tuple(dataclasses.replace(a, time=None if a.time is None else a.time / s)
-                        for a in self.actions)
+        phases, actions = _scaled(self.phases, self.actions, s)
+        partners = []
+        for w in self.partners:  # the other robots' work runs faster too
+            ph, ac = _scaled(w.phases, w.actions, s)
+            partners.append(dataclasses.replace(w, phases=ph, actions=ac))
         return dataclasses.replace(
-            self, phases=tuple(phases), actions=actions,
+            self, phases=phases, actions=actions, partners=tuple(partners),
             payload_kg=self.payload_kg if payload_kg is None else float(payload_kg))
 
     @property
@@ -402,3 +391,27 @@ class Scenario:
                 and first.times is not None and last.times is not None):
             raise UsageError("duration depends on Cartesian planning; plan the motion first")
         return last.t1 - first.t0
+
+
+def _scaled(phases: tuple[Phase, ...], actions: tuple[Action, ...], s: float
+            ) -> tuple[tuple[Phase, ...], tuple[Action, ...]]:
+    """Phases and actions ``s`` times faster (:meth:`Scenario.scaled`)."""
+    import dataclasses
+
+    order = {"v": 1, "a": 2, "j": 3}
+    out: list[Phase] = []
+    for p in phases:
+        if isinstance(p, JointPhase):
+            out.append(dataclasses.replace(
+                p, times=None if p.times is None else p.times / s,
+                durations=p.durations / s,
+                boundary={k: v * s ** order[k[0]] for k, v in p.boundary.items()}))
+        elif isinstance(p, CartesianPhase):
+            out.append(dataclasses.replace(
+                p, speed=p.speed * s, sample_period=p.sample_period / s,
+                ramp=None if p.ramp is None else p.ramp / s))
+        else:
+            out.append(dataclasses.replace(p, duration=p.duration / s))
+    return tuple(out), tuple(dataclasses.replace(a, time=None if a.time is None else a.time / s)
+                             for a in actions)
+
