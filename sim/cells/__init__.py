@@ -39,7 +39,9 @@ drives) and ``robot/friction_j1..`` (each joint's Coulomb friction, :mod:`sim.ce
 ``robot/frame0``, ``robot/flange``, ``robot/tcp`` (moved onto the tool tip), tool elements
 ``robot/tool/...`` (tip site ``robot/tool/tip``, suction ``robot/tool/suction``), payload body
 ``robot/payload``; cell elements keep their plain names (``part0``, cameras ``overview`` and
-``tool``).
+``tool``). A cell file's other robots (``[[robots]]``, :mod:`~sim.cells.partners`) have the same
+names under their own name (``r2/j1``, ``r2/a1``, ``r2/tcp``, ``r2/tool/...``); their joints
+follow the first robot's and the mechanisms' axes in :attr:`Cell.joint_names`.
 """
 
 from sim.cells.builder import CELL_DEFAULT, build_cell, resolve_tool
@@ -52,9 +54,10 @@ from sim.cells.registry import (
     resolve_cell,
     tool_from_ref,
 )
+from sim.cells.partners import CellRobot, PlacedRobot
 from sim.cells.seam import Seam
 from sim.cells.spec import MOUNTS, NO_TOOL, Cell, CellSpec
 
-__all__ = ["BARE", "CELLS", "CELL_DEFAULT", "DERIVED", "MOUNTS", "NO_TOOL", "Cell", "CellSpec",
-           "Seam", "build_cell", "is_file_ref", "load_cell", "resolve_cell", "resolve_tool",
-           "tool_from_ref"]
+__all__ = ["BARE", "CELLS", "CELL_DEFAULT", "DERIVED", "MOUNTS", "NO_TOOL", "Cell", "CellRobot",
+           "CellSpec", "PlacedRobot", "Seam", "build_cell", "is_file_ref", "load_cell",
+           "resolve_cell", "resolve_tool", "tool_from_ref"]

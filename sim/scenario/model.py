@@ -325,7 +325,10 @@ class Scenario:
         from sim.robots.drives import apply_overrides
 
         system = self.system
-        return apply_overrides(system.drives, self.drives, system.joints)
+        try:
+            return apply_overrides(system.drives, self.drives, system.joints)
+        except ScenarioError as exc:  # a bad value: the file's name first
+            raise ScenarioError(f"{self.source.name}: {exc}") from None
 
     @property
     def system(self) -> RobotSpec:
