@@ -153,10 +153,14 @@ def _independent(traj, model, k: int, motor: dict, reducer: dict) -> dict[str, b
         weights[1:] += dt / 2
         weights[:-1] += dt / 2
         s1 = float(np.sum(weights * n))
-        t_av = (float(np.sum(weights * n * np.abs(tau_l) ** 3)) / s1) ** (1 / 3)
-        n_av = s1 / duty
-        life = reducer["rated_life_h"] * (reducer["rated_torque_nm"] / t_av) ** 3 * (
-            reducer["rated_input_speed_rpm"] / n_av)
+        s3 = float(np.sum(weights * n * np.abs(tau_l) ** 3))
+        if s1 > 0 and s3 > 0:
+            t_av = (s3 / s1) ** (1 / 3)
+            n_av = s1 / duty
+            life = reducer["rated_life_h"] * (reducer["rated_torque_nm"] / t_av) ** 3 * (
+                reducer["rated_input_speed_rpm"] / n_av)
+        else:  # a joint that never turns (its reference holds still) wears nothing
+            life = math.inf
         out["motor_rms"] &= rms <= motor["rated_torque_nm"] * (1 + 1e-9)
         # the simulated source's peaks are of the torques sustained over 5 ms (window_oracle)
         peak_m = np.abs(tau_m if w == 0.0 else window_mean(t, tau_m, w)).max()
