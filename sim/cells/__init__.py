@@ -45,6 +45,7 @@ follow the first robot's and the mechanisms' axes in :attr:`Cell.joint_names`.
 """
 
 from sim.cells.builder import CELL_DEFAULT, build_cell, resolve_tool
+from sim.cells.partners import CellRobot, PlacedRobot
 from sim.cells.registry import (
     BARE,
     CELLS,
@@ -54,7 +55,6 @@ from sim.cells.registry import (
     resolve_cell,
     tool_from_ref,
 )
-from sim.cells.partners import CellRobot, PlacedRobot
 from sim.cells.seam import Seam
 from sim.cells.spec import MOUNTS, NO_TOOL, Cell, CellSpec
 

@@ -34,7 +34,7 @@ import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -56,7 +56,6 @@ if TYPE_CHECKING:  # MuJoCo and dm_control are imported where a model is made or
     from dm_control import mjcf
 
     from sim.cells.mechanisms import PlacedMechanism
-    from sim.cells.partners import CellRobot
 
 ROBOT_PREFIX = "robot"
 #: Name prefix of the robot's friction actuators (``robot/friction_j1``, ...).
@@ -529,7 +528,7 @@ class Layout:
     seam_objects: dict[str, tuple[str, ...]] = field(default_factory=dict)
     frames: dict[str, NDArray[np.float64]] = field(default_factory=dict)
     mechanisms: tuple[PlacedMechanism, ...] = ()
-    partners: tuple[CellRobot, ...] = ()
+    partners: tuple[Any, ...] = ()  # sim.cells.partners.CellRobot (which imports this module)
 
 
 def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
@@ -546,7 +545,7 @@ def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
 
 def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np.float64],
                       mechanisms: tuple[PlacedMechanism, ...] = (),
-                      partners: tuple[CellRobot, ...] = ()) -> mujoco.MjModel:
+                      partners: tuple[Any, ...] = ()) -> mujoco.MjModel:
     """Add keyframe ``home``: robot at ``home_q``, the mechanisms at their home, the other
     robots at theirs, free bodies where built, suction off."""
     import mujoco

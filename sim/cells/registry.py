@@ -15,6 +15,7 @@ from pathlib import Path
 from planners.registry import Registry
 from sim.cells import bare, pick, weld_cylinder, weld_table
 from sim.cells.cellfile import CellFile, make_builder, read_cell_file
+from sim.cells.cellfile.reader import partner_tool
 from sim.cells.compose import Layout, RobotRig
 from sim.cells.spec import MOUNTS, CellSpec
 from sim.cells.toolfile import load_tool_file
@@ -79,6 +80,8 @@ def _shipped_cells() -> Iterator[tuple[str, CellSpec]]:
     for name, files in groups.items():
         for cf in files:
             cf.default_tool = None if cf.spec.tool is None else TOOLS[cf.spec.tool]
+            cf.partners = {n: partner_tool(cf.spec, cf.path, pr, tool_from_ref)
+                           for n, pr in cf.partners.items()}
         build = _Variants(name, {(cf.spec.robot.model, cf.spec.robot.mount): make_builder(cf)
                                  for cf in files})
         first = files[0].spec
@@ -89,7 +92,8 @@ def _shipped_cells() -> Iterator[tuple[str, CellSpec]]:
         yield name, CellSpec(name, first.description, robots,
                              None if first.tool is None else TOOLS[first.tool], tools, mounts,
                              build, any_tool=first.tools is None,
-                             mechanisms=tuple(files[0].mechanisms.values()))
+                             mechanisms=tuple(files[0].mechanisms.values()),
+                             partners=tuple(files[0].partners.values()))
 
 
 #: The shipped cells by name, read from ``models/cells/*.toml`` on first use.
@@ -140,6 +144,8 @@ def load_cell(path: str | Path) -> CellSpec:
             raise CellError(f"{path}: tools[{i}]: {exc}") from None
     needs = bool(spec.seams) or any(o.role == "part" for o in spec.objects)
     cf.default_tool = default_tool
+    cf.partners = {name: partner_tool(spec, path, pr, tool_from_ref)
+                   for name, pr in cf.partners.items()}
     return CellSpec(spec.name, spec.description or f"cell file {path.name}", robots,
                     default_tool, tools, (spec.robot.mount,), make_builder(cf), needs_tool=needs,
                     source=path.resolve(), any_tool=spec.tools is None,

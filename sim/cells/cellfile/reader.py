@@ -5,8 +5,10 @@ every problem is one line naming the file and the key."""
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -218,13 +220,13 @@ def read_cell_file(path: str | Path) -> CellFile:
 
 
 def read_partners(spec: CellFileSpec, path: Path, taken: set[str]) -> dict[str, PlacedRobot]:
-    """The cell file's other robots (``[[robots]]``): model, tool and home resolved.
+    """The cell file's other robots (``[[robots]]``): model and home resolved; their tools are
+    resolved with the cell's (:func:`sim.cells.registry.load_cell`, :func:`partner_tool`).
 
     Raises:
         CellError: One line naming the file and the key (a name taken or reserved, an unknown
-            robot or tool, a suction gripper, home values that do not fit the robot).
+            robot, home values that do not fit the robot).
     """
-    from sim.cells.registry import tool_from_ref
     from sim.robots.registry import resolve_robot
 
     where = path.name
@@ -239,15 +241,6 @@ def read_partners(spec: CellFileSpec, path: Path, taken: set[str]) -> dict[str, 
             robot = resolve_robot(rb.model, path.parent)
         except CellsimError as exc:
             raise CellError(f"{key}.model: {exc}") from None
-        ref = rb.tool if rb.tool is not None else spec.tool
-        try:
-            tool = None if ref is None or ref == "none" else tool_from_ref(ref, path.parent)
-        except CellsimError as exc:
-            raise CellError(f"{key}.tool: {exc}") from None
-        if tool is not None and tool.suction_gain_n > 0.0:
-            raise CellError(f"{key}.tool: {tool.name!r} is a suction gripper; a cell's other "
-                            "robots carry torches or tools without suction (the first robot "
-                            "picks)")
         home = None
         if rb.home_deg is not None:
             if len(rb.home_deg) != robot.n_joints:
@@ -257,8 +250,29 @@ def read_partners(spec: CellFileSpec, path: Path, taken: set[str]) -> dict[str, 
         base = object_pose(rb.base_pos_mm, rb.base_euler_zyx_deg)
         if rb.mount == "ceiling":
             base[:3, :3] = base[:3, :3] @ np.diag([1.0, -1.0, -1.0])
-        out[rb.name] = PlacedRobot(rb.name, robot, tool, base, home, i)
+        out[rb.name] = PlacedRobot(rb.name, robot, None, base, home, i)
     return out
+
+
+def partner_tool(spec: CellFileSpec, path: Path, placed: PlacedRobot,
+                 load: Callable[[str, Path], Any]) -> PlacedRobot:
+    """A placed robot with its tool: its ``tool``, else the cell's (``load`` reads a tool
+    reference relative to the cell file's folder: :func:`sim.cells.registry.tool_from_ref`).
+
+    Raises:
+        CellError: An unknown tool or a suction gripper (one line naming the file and key).
+    """
+    key = f"{path.name}: robots[{placed.index}].tool"
+    ref = spec.robots[placed.index].tool
+    ref = spec.tool if ref is None else ref
+    try:
+        tool = None if ref is None or ref == "none" else load(ref, path.parent)
+    except CellsimError as exc:
+        raise CellError(f"{key}: {exc}") from None
+    if tool is not None and tool.suction_gain_n > 0.0:
+        raise CellError(f"{key}: {tool.name!r} is a suction gripper; a cell's other robots "
+                        "carry torches or tools without suction (the first robot picks)")
+    return dataclasses.replace(placed, tool=tool)
 
 
 def read_mechanisms(spec: CellFileSpec, path: Path) -> dict[str, PlacedMechanism]:
@@ -306,4 +320,4 @@ def read_mechanisms(spec: CellFileSpec, path: Path) -> dict[str, PlacedMechanism
     return out
 
 
-__all__ = ["CellFile", "read_cell_file", "read_mechanisms", "read_partners"]
+__all__ = ["CellFile", "partner_tool", "read_cell_file", "read_mechanisms", "read_partners"]
