@@ -37,6 +37,11 @@ is per joint:
   to slot k) ends from it, mm, against 5 mm (``summary["place_tolerance_mm"]``): a pick cycle
   that drops a part or never lifts it fails.
 
+In a cell with other robots (``[[robots]]``) every check covers them too: their joints
+(``r2_j1``...: tracking, saturation, speed, acceleration, sizing) and their Cartesian phases,
+weld torch angles and weaves (``summary["weld"]`` etc. entries with ``"robot"``; the check's
+subject starts with the robot's name).
+
 ``summary.json`` holds ``"checks"`` (each ``name``, ``joint`` ("" when the check is not a
 joint's), ``subject``, ``value``, ``limit``, ``unit``, ``pass``, ``severity``) and
 ``"verdict"``: ``"pass"`` when every check of severity ``error`` passed, else ``"fail"``. A
@@ -139,8 +144,8 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
     for c in summary.get("cartesian_speed", ()):
         dev = abs(float(c["deviation_pct"]))
         checks.append(RunCheck("cartesian_speed", "", dev, 1.0, "% off the set speed",
-                               dev <= 1.0, subject=f"{c['phase']}: {c['cruise_mm_s']:.4g} mm/s "
-                               f"for {c['set_mm_s']:.4g} mm/s"))
+                               dev <= 1.0, subject=f"{_who(c)}{c['phase']}: "
+                               f"{c['cruise_mm_s']:.4g} mm/s for {c['set_mm_s']:.4g} mm/s"))
     checks += torch_angle_checks(summary, torch_angle_tolerance_deg)
     checks += placement_checks(summary)
     for w in summary.get("weave", ()):
@@ -150,7 +155,7 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                               ("weave_frequency", w["frequency_error_pct"], WEAVE_FREQUENCY_PCT)):
             checks.append(RunCheck(key, "", abs(float(err)), lim, "% off the set value",
                                    abs(float(err)) <= lim, severity="warning",
-                                   subject=f"{w['phase']}: {w['amplitude_mm']:.3f} mm at "
+                                   subject=f"{_who(w)}{w['phase']}: {w['amplitude_mm']:.3f} mm at "
                                    f"{w['frequency_hz']:.3f} Hz for {w['set_amplitude_mm']:.3f} "
                                    f"mm at {w['set_frequency_hz']:.3f} Hz"))
     if selection is not None:
@@ -226,7 +231,7 @@ def mechanism_checks(summary: Mapping[str, Any]) -> list[RunCheck]:
             err = float(w["normal_from_vertical_deg"])
             checks.append(RunCheck("downhand", "", err, DOWNHAND_TOLERANCE_DEG, "deg",
                                    err <= DOWNHAND_TOLERANCE_DEG,
-                                   subject=f"{w['phase']}: seam {w['seam']} turned by "
+                                   subject=f"{_who(w)}{w['phase']}: seam {w['seam']} turned by "
                                    f"{w['carried_by']}"))
     return checks
 
@@ -242,10 +247,16 @@ def torch_angle_checks(summary: Mapping[str, Any], tolerance_deg: float) -> list
         at = "" if w["t_worst_angle_s"] is None else f" at {w['t_worst_angle_s']:.3f} s"
         checks.append(RunCheck(
             "torch_angle", "", err, float(tolerance_deg), "deg", err <= tolerance_deg,
-            subject=f"{w['phase']}: seam {w['seam']}, worst{at}; work angle up to "
+            subject=f"{_who(w)}{w['phase']}: seam {w['seam']}, worst{at}; work angle up to "
             f"{w['work_angle_error_deg']:.3g} deg off, travel angle up to "
             f"{w['travel_angle_error_deg']:.3g} deg off"))
     return checks
+
+
+def _who(entry: Mapping[str, Any]) -> str:
+    """``"<robot>: "`` for a summary entry of a cell with other robots (its ``"robot"``: the
+    checks of every robot's welds, speeds and weaves name it), else ``""``."""
+    return f"{entry['robot']}: " if entry.get("robot") else ""
 
 
 def verdict(checks: Sequence[RunCheck]) -> str:

@@ -107,12 +107,17 @@ def run(args: argparse.Namespace) -> int:
     print(line)
     for line in summary.get("program_warnings", []):
         print(f"  program: {line}")
+    for name, r in list(summary.get("robots", {}).items())[1:]:
+        print(f"  {name} ({r['model']}): cycle end {r['t_end_s']:.3f} s, max tcp deviation "
+              f"{r['max_tcp_deviation_mm']:.3f} mm")
+        for line in r.get("program_warnings", []):
+            print(f"  {name}: program: {line}")
     for w in summary.get("weave", []):
-        print(f"  weave {w['phase']} ({w['pattern']}): {w['amplitude_mm']:.3f} mm at "
+        print(f"  {_who(w)}weave {w['phase']} ({w['pattern']}): {w['amplitude_mm']:.3f} mm at "
               f"{w['frequency_hz']:.3f} Hz (set {w['set_amplitude_mm']:.3f} mm at "
               f"{w['set_frequency_hz']:.3f} Hz), centre line {w['centre_line_mm']:+.4f} mm")
     for weld in summary.get("weld", []):
-        print(f"  weld {weld['phase']}: {weld['seam_length_mm']:.1f} mm at "
+        print(f"  {_who(weld)}weld {weld['phase']}: {weld['seam_length_mm']:.1f} mm at "
               f"{weld['travel_speed_mm_s']:.2f} mm/s (cv {weld['travel_speed_cv']:.4f}), path "
               f"deviation {weld['max_path_deviation_mm']:.3f} mm, torch angle error "
               f"{weld['torch_angle_error_deg']:.3f} deg")
@@ -164,6 +169,11 @@ def run(args: argparse.Namespace) -> int:
         print("  " + timings_line(timings, summary.get("total_wall_s", sum(timings.values()))))
     print(f"  results in {out}/")
     return 1 if args.strict and summary.get("verdict") == "fail" else 0
+
+
+def _who(entry: dict) -> str:
+    """``"<robot>: "`` for an entry of a cell with other robots (its ``"robot"``), else ``""``."""
+    return f"{entry['robot']}: " if entry.get("robot") else ""
 
 
 def _expectation(expect: ExpectSpec, verdict: str | None) -> str | None:

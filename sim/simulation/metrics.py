@@ -196,8 +196,14 @@ def weave_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltC
     :func:`planners.weave.measure_weave`), centre line (mean offset over whole cycles), against
     the set values. Along a seam the offset is from the seam's nearest tool point
     (:func:`measure_seam`, corner zones left out); without one, from the phase's own path."""
+    return _weave_entries(arrays, motion, built.context, measured)
+
+
+def _weave_entries(arrays: Mapping[str, NDArray[Any]], motion: Motion, context: Any,
+                   measured: Mapping[int, SeamMeasurement]) -> list[dict[str, Any]]:
+    """:func:`weave_metrics` of one robot's ``motion`` with its own ``context``."""
     t = arrays["t"]
-    T = built.context.world_from_frame0
+    T = context.world_from_frame0
     out = []
     for k, pm in enumerate(motion.phases):
         cart = pm.cartesian
@@ -246,8 +252,16 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
     ``t_worst_angle_s`` the time of the worst axis error), the corner zones left out;
     ``start_error_mm`` / ``end_error_mm`` are the first and last samples' distances from the
     seam's ends. A phase without a seam is measured against its programmed path."""
+    return _weld_entries(arrays, motion, built.context, torch_axis, measured)
+
+
+def _weld_entries(arrays: Mapping[str, NDArray[Any]], motion: Motion, context: Any,
+                  torch_axis: int, measured: Mapping[int, SeamMeasurement]
+                  ) -> list[dict[str, Any]]:
+    """:func:`weld_metrics` of one robot's ``motion`` (its recorded ``tcp_pos``/``tcp_quat``,
+    ``arc_on`` and ``phase`` in ``arrays``) with its own ``context``."""
     t = arrays["t"]
-    T = built.context.world_from_frame0
+    T = context.world_from_frame0
     out = []
     for k, pm in enumerate(motion.phases):
         if pm.cartesian is None:
@@ -280,7 +294,7 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
                 "travel_angle_error_deg": m.travel_angle_error_deg,
                 "t_worst_angle_s": m.t_worst_angle,
                 "start_error_mm": m.start_error * 1e3, "end_error_mm": m.end_error * 1e3})
-            ctx = built.context
+            ctx = context
             if ctx.seam_mechanism.get(pm.seam.name):
                 entry["carried_by"] = ctx.seam_mechanism[pm.seam.name]
                 entry["normal_from_vertical_deg"] = _normal_from_vertical(
@@ -290,14 +304,14 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
             continue
         p = arrays["tcp_pos"][sel]
         ts = t[sel]
-        T = built.context.world_from_frame0
+        T = context.world_from_frame0
         R_act = Rotation.from_quat(arrays["tcp_quat"][sel], scalar_first=True).as_matrix()
-        if _carrier(built.context, pm) is not None:  # a coordinated move: in the part's frame
+        if _carrier(context, pm) is not None:  # a coordinated move: in the part's frame
             from sim.simulation.motion.axes import world_from_frame0
 
-            n = built.context.kinematics.n_joints
-            p, R_act = _in_part_frame(built.context, pm, arrays["q"][sel], p, R_act)
-            T = world_from_frame0(built.context,
+            n = context.kinematics.n_joints
+            p, R_act = _in_part_frame(context, pm, arrays["q"][sel], p, R_act)
+            T = world_from_frame0(context,
                                   np.asarray(pm.trajectory.at(pm.t0).q, dtype=float)[n:])
         lo, hi = _cruise_window(cart)
         cs = (ts >= pm.t0 + lo + 1e-9) & (ts <= pm.t0 + hi - 1e-9)
@@ -317,8 +331,8 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
         ends = cart.at(np.array([0.0, cart.duration])).position @ T[:3, :3].T + T[:3, 3]
         ends_idx = _phase_samples(arrays, pm)[[0, -1]]
         first, last = arrays["tcp_pos"][ends_idx]
-        if _carrier(built.context, pm) is not None:
-            (first, last), _ = _in_part_frame(built.context, pm, arrays["q"][ends_idx],
+        if _carrier(context, pm) is not None:
+            (first, last), _ = _in_part_frame(context, pm, arrays["q"][ends_idx],
                                               arrays["tcp_pos"][ends_idx],
                                               np.broadcast_to(np.eye(3), (2, 3, 3)))
         entry.update({
@@ -402,11 +416,103 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         summary["mechanisms"] = mechanism_summary(a, built)
     summary["saturation"] = saturation_intervals(a, motion, built, feedforward=feedforward)
     summary["singularity"] = singularity_summary(a, motion, built, rec.timestep)
+    if motion.lanes:
+        _add_partners(summary, scenario, built, motion, rec)
     pick = pick_metrics(a, built)
     if pick is not None:
         summary.update(pick)
     return summary
 
+
+
+#: The first robot's name in a cell with other robots (its MJCF prefix): the ``"robot"`` of
+#: its entries in ``summary["weld"]``, ``["cartesian_speed"]``, ``["weave"]`` and its key in
+#: ``summary["robots"]``.
+FIRST_ROBOT = "robot"
+
+
+def robot_arrays(arrays: Mapping[str, NDArray[Any]], built: BuiltCell, name: str,
+                 lane: Motion) -> dict[str, NDArray[Any]]:
+    """One of a cell's other robots' recorded arrays as a run's own (what the first robot's
+    measurements read): ``t``, its joints' columns of ``q``, ``q_ref``, ``qd``, ``qd_ref``,
+    ``qdd_ref``, its ``<name>_tcp_pos``/``_tcp_quat``/``_tcp_pos_ref``/``_arc_on`` as
+    ``tcp_pos``... and ``phase``, the index of its own phase (``lane``'s) at each sample."""
+    cols = built.partner_cols[name]
+    t = np.asarray(arrays["t"])
+    out: dict[str, NDArray[Any]] = {"t": t, "phase": lane.phase_index(t).astype(np.int32)}
+    for key in ("q", "q_ref", "qd", "qd_ref", "qdd_ref"):
+        if key in arrays:
+            out[key] = np.asarray(arrays[key])[:, cols]
+    for key in ("tcp_pos", "tcp_quat", "tcp_pos_ref", "arc_on"):
+        out[key] = np.asarray(arrays[f"{name}_{key}"])
+    return out
+
+
+def _add_partners(summary: dict[str, Any], scenario: Scenario, built: BuiltCell,
+                  motion: Motion, rec: SimulationRecord) -> None:
+    """A cell with other robots: each robot's weld phases, Cartesian speeds and weaves
+    measured as the first robot's are (its own recorded tool frames, seams as its tool follows
+    them, its own phases), appended to ``summary["weld"]``, ``["cartesian_speed"]`` and
+    ``["weave"]`` with ``"robot"`` naming the robot (the first robot's entries get
+    ``"robot": "robot"``), and ``summary["robots"]``: per robot its model, tool, frame 0,
+    joints (their names in the joint vector), phases, cycle end, largest tool point deviation
+    from its reference, tracking errors and closest approach to a singularity."""
+    a = rec.arrays
+    keys = ("weld", "cartesian_speed", "weave")
+    for key in keys:
+        for e in summary[key]:
+            e["robot"] = FIRST_ROBOT
+    n_lead = motion.n_lead
+    track = summary["max_tracking_error_deg"]
+    robots: dict[str, Any] = {FIRST_ROBOT: {
+        "model": scenario.robot.name,
+        "tool": None if scenario.tool is None else scenario.tool.name,
+        **_frame0(built.context.world_from_frame0),
+        "joints": list(scenario.system.joints[:scenario.system.n_arm]),
+        "phases": summary["phases"],
+        "t_end_s": float(motion.phases[-1].t1),
+        "max_tcp_deviation_mm": summary["max_tcp_deviation_mm"],
+        "max_tracking_error_deg": track[:scenario.system.n_arm],
+        "singularity": summary["singularity"]}}
+    col = n_lead
+    for cr, work, (name, lane) in zip(built.cell.partners, scenario.partners, motion.lanes,
+                                      strict=True):
+        sub = robot_arrays(a, built, name, lane)
+        ctx = built.context.partners[name]
+        axis = cr.robot.family.approach_column
+        measured = measure_seam_phases(sub, lane, ctx.world_from_frame0, axis, ctx)
+        summary["weld"] += [{**e, "robot": name}
+                            for e in _weld_entries(sub, lane, ctx, axis, measured)]
+        summary["cartesian_speed"] += [{**e, "robot": name} for e in cartesian_speeds(
+            sub, lane, ctx.world_from_frame0, ctx)]
+        summary["weave"] += [{**e, "robot": name}
+                             for e in _weave_entries(sub, lane, ctx, measured)]
+        n = cr.robot.n_joints
+        dev = np.linalg.norm(sub["tcp_pos"] - sub["tcp_pos_ref"], axis=1)
+        robots[name] = {
+            "model": cr.robot.name, "tool": None if cr.tool is None else cr.tool.name,
+            **_frame0(ctx.world_from_frame0),
+            "base_pos_mm": [float(x) for x in np.asarray(cr.placed.base_pose)[:3, 3] * 1e3],
+            "joints": list(scenario.system.joints[col:col + n]),
+            "phases": [{"name": pm.name, "kind": pm.kind, "t0": pm.t0, "t1": pm.t1}
+                       for pm in lane.phases],
+            "t_end_s": float(lane.t1),
+            "max_tcp_deviation_mm": float(np.max(dev) * 1e3),
+            "max_tracking_error_deg": track[col:col + n],
+            "actions": [{"t": t, "action": act} for t, act in lane.actions],
+            "program_warnings": list(work.program_warnings),
+            "singularity": _singularity(sub["t"], sub["q_ref"], lane, ctx.kinematics,
+                                        rec.timestep)}
+        col += n
+    summary["robots"] = robots
+
+
+def _frame0(T: NDArray[np.float64]) -> dict[str, Any]:
+    """A robot's frame 0 in world: position, mm, and ZYX Euler angles, deg."""
+    T = np.asarray(T, dtype=float)
+    zyx = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
+    return {"frame0_pos_mm": [float(x) for x in T[:3, 3] * 1e3],
+            "frame0_euler_zyx_deg": [float(x) for x in zyx]}
 
 
 #: A Cartesian phase keeps its set speed when its reference tool point's cruise speed is within
@@ -516,15 +622,28 @@ def saturation_intervals(arrays: dict[str, NDArray[Any]], motion: Motion, built:
         demand = demand + kv * arrays["qd_ref"] + arrays["tau_ff"]
     excess = np.abs(demand) - arrays["tau_limit"]
     t = arrays["t"]
-    joints = built.cell.robot.joints + built.cell.axis_names
+    joints = list(built.cell.robot.joints + built.cell.axis_names)
+    # each joint's phases: the first robot's (and the axes'), or its own robot's lane's
+    lanes: list[Motion] = [motion] * len(joints)
+    robots = [""] * len(joints)
+    for cr, (name, lane) in zip(built.cell.partners, motion.lanes, strict=True):
+        joints += [f"{name}_{j}" for j in cr.robot.joints]
+        lanes += [lane] * cr.robot.n_joints
+        robots += [name] * cr.robot.n_joints
     out = []
     for j, name in enumerate(joints):
         tol = 1e-9 * max(1.0, float(built.force_limits[j, 1]))
         for i0, stop in true_runs(excess[:, j] > tol):
             i1 = stop - 1
-            out.append({"joint": name, "t0": float(t[i0]), "t1": float(t[i1]),
-                        "phase": motion.phases[int(arrays["phase"][i0])].name,
-                        "worst_excess_nm": float(np.max(excess[i0:i1 + 1, j]))})
+            own = lanes[j]
+            k = (int(arrays["phase"][i0]) if own is motion
+                 else int(np.atleast_1d(own.phase_index(t[i0]))[0]))
+            entry = {"joint": name, "t0": float(t[i0]), "t1": float(t[i1]),
+                     "phase": own.phases[k].name,
+                     "worst_excess_nm": float(np.max(excess[i0:i1 + 1, j]))}
+            if own is not motion:
+                entry["robot"] = robots[j]
+            out.append(entry)
     return sorted(out, key=lambda s: (s["t0"], s["joint"]))
 
 
@@ -538,12 +657,18 @@ def singularity_summary(arrays: dict[str, NDArray[Any]], motion: Motion, built: 
     theta5, ``elbow``, ``shoulder`` = wrist-centre distance from the J1 axis in m; 5R:
     ``elbow`` = cos q3, ``shoulder`` = reach in m).
     """
+    return _singularity(arrays["t"], arrays["q_ref"], motion, built.context.kinematics, dt)
+
+
+def _singularity(t: NDArray[np.float64], q_ref: NDArray[np.float64], motion: Motion,
+                 kin: Any, dt: float) -> dict[str, Any]:
+    """:func:`singularity_summary` of one robot: its reference joints ``q_ref`` (its arm's
+    first), its ``motion`` and kinematics."""
     from sim.robots.kinematics.jacobian import singularity_measures
 
     step = max(1, int(round(0.01 / dt)))
-    t = arrays["t"][::step]
-    kin = built.context.kinematics
-    m = singularity_measures(kin, arrays["q_ref"][::step, :kin.n_joints])  # the arm's joints
+    t = t[::step]
+    m = singularity_measures(kin, q_ref[::step, :kin.n_joints])  # the arm's joints
     i = int(np.argmin(m["sigma_min"]))
     out: dict[str, Any] = {"min_sigma": float(m["sigma_min"][i]), "t": float(t[i]),
                            "phase": motion.phases[int(np.atleast_1d(motion.phase_index(t[i]))[0])].name,
