@@ -1,0 +1,200 @@
+"""A two-robot cell's outputs measure every robot (issue 28): the other robot's weld, speeds,
+joints and checks in the summary, against oracles that do not use cellsim's kinematics or
+metrics: the tool point from the LR Mate's link product (support.two_robots) at the recorded
+joint columns, on the seam the generated cell file writes, progressing at the set speed.
+
+One generated cell is simulated once (session-scoped) for the fast tests; the independence of
+the second robot's physics (its torques equal the same robot's alone in an equivalent cell) runs
+two more simulations and is slow.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from support.two_robots import TwoCell, generate, line_distance, tool_points, write_alone, write_two
+
+SEED = 28
+
+
+@pytest.fixture(scope="session")
+def two_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[TwoCell, Any]:
+    from sim.pipeline.run import RunOptions, evaluate_scenario
+    from sim.scenario import load_scenario
+
+    cell = generate(SEED)
+    path = write_two(cell, tmp_path_factory.mktemp("two") / "gen")
+    ev = evaluate_scenario(load_scenario(path),
+                           RunOptions(video=False, plots=False, progress=False))
+    return cell, ev
+
+
+def _cols(summary: dict[str, Any], name: str) -> list[int]:
+    joints = summary["joints"]
+    return [joints.index(j) for j in summary["robots"][name]["joints"]]
+
+
+def _weld_window(arrays: dict[str, Any], summary: dict[str, Any], name: str) -> Any:
+    """Samples of the robot's weld phase with its arc on (from its own phases' times)."""
+    ph = next(p for p in summary["robots"][name]["phases"] if p["name"] == "weld")
+    t = arrays["t"]
+    arc = np.asarray(arrays[f"{name}_arc_on"] if name != "robot" else arrays["arc_on"], bool)
+    return arc & (t >= ph["t0"]) & (t <= ph["t1"])
+
+
+def _oracle(cell: TwoCell, arrays: dict[str, Any], summary: dict[str, Any], *,
+            cols: list[int], seam: tuple[Any, Any], base: Any) -> dict[str, float]:
+    """The r2 weld's figures from the link product at the recorded joints: largest distance
+    from the seam line, mm; progress at start and end, mm; cruise travel speed, mm/s (the
+    middle 60 % of the weld, a least-squares slope of progress over time)."""
+    sel = _weld_window(arrays, summary, "r2")
+    q = np.asarray(arrays["q"])[sel][:, cols]
+    t = np.asarray(arrays["t"])[sel]
+    p = tool_points(base, q)
+    dist, s = line_distance(p, *seam)
+    n = len(t)
+    mid = slice(int(0.2 * n), int(0.8 * n))
+    speed = np.polyfit(t[mid], s[mid], 1)[0]
+    return {"max_dev_mm": float(dist.max() * 1e3), "s0_mm": float(s[0] * 1e3),
+            "s1_mm": float(s[-1] * 1e3), "speed_mm_s": float(speed * 1e3),
+            "tcp_err_mm": float(np.abs(p - np.asarray(arrays["r2_tcp_pos"])[sel]).max() * 1e3)}
+
+
+def test_r2_tool_point_on_its_seam_at_its_speed(two_run):
+    """The second robot's tool point, from the link product at its recorded joints, lies on
+    the seam the file writes (0.1 mm), covers it end to end and progresses within 1 % of the
+    set speed; the recorded ``r2_tcp_pos`` is that point."""
+    cell, ev = two_run
+    a, s = ev.record.arrays, ev.summary
+    o = _oracle(cell, a, s, cols=_cols(s, "r2"), seam=cell.right, base=cell.r2_base)
+    assert o["max_dev_mm"] < 0.1
+    assert abs(o["s0_mm"]) < 0.1 and abs(o["s1_mm"] - cell.length) < 0.1
+    assert abs(o["speed_mm_s"] / cell.speed2 - 1.0) < 0.01
+    assert o["tcp_err_mm"] < 1e-6
+
+
+def test_planted_faults_are_caught(two_run):
+    """The oracle fails a seam shifted by 1 mm and the first robot's joint columns."""
+    cell, ev = two_run
+    a, s = ev.record.arrays, ev.summary
+    a0, b0 = cell.right
+    shift = np.array([0.0, 1e-3, 0.0])
+    o = _oracle(cell, a, s, cols=_cols(s, "r2"), seam=(a0 + shift, b0 + shift),
+                base=cell.r2_base)
+    assert o["max_dev_mm"] > 0.9
+    o = _oracle(cell, a, s, cols=_cols(s, "robot"), seam=cell.right, base=cell.r2_base)
+    assert o["max_dev_mm"] > 1.0 or o["tcp_err_mm"] > 1.0
+
+
+def test_summary_measures_r2_weld_like_the_oracle(two_run):
+    """summary["weld"]'s r2 entry (robot "r2", seam "right") gives the oracle's seam length,
+    set and travel speed and path deviation; the first robot's entry is its own (seam
+    "left", its set speed)."""
+    cell, ev = two_run
+    a, s = ev.record.arrays, ev.summary
+    o = _oracle(cell, a, s, cols=_cols(s, "r2"), seam=cell.right, base=cell.r2_base)
+    welds = {w["robot"]: w for w in s["weld"]}
+    assert set(welds) == {"robot", "r2"}
+    w2, w1 = welds["r2"], welds["robot"]
+    assert w2["seam"] == "right" and w1["seam"] == "left"
+    assert w2["seam_length_mm"] == pytest.approx(cell.length, abs=1e-6)
+    assert w2["set_speed_mm_s"] == pytest.approx(cell.speed2, rel=1e-9)
+    assert w1["set_speed_mm_s"] == pytest.approx(cell.speed1, rel=1e-9)
+    assert w2["travel_speed_mm_s"] == pytest.approx(o["speed_mm_s"], rel=2e-3)
+    assert w2["max_path_deviation_mm"] == pytest.approx(o["max_dev_mm"], abs=0.01)
+    assert abs(w2["start_error_mm"]) < 0.1 and abs(w2["end_error_mm"]) < 0.1
+    assert w2["torch_angle_error_deg"] < 0.1
+    speeds = [c for c in s["cartesian_speed"] if c.get("robot") == "r2"]
+    assert [c["phase"] for c in speeds] == ["touch", "weld"]
+    assert speeds[1]["set_mm_s"] == pytest.approx(cell.speed2, rel=1e-9)
+    assert abs(speeds[1]["cruise_mm_s"] / o["speed_mm_s"] - 1.0) < 0.01
+
+
+def test_summary_robots_and_checks_cover_r2(two_run):
+    """summary["robots"] names each robot's model, tool, base, joints and cycle end; the
+    checks cover r2's joints (tracking, saturation, speed, acceleration) and its weld (torch
+    angle, Cartesian speeds, subjects naming r2)."""
+    cell, ev = two_run
+    s = ev.summary
+    r = s["robots"]
+    assert list(r) == ["robot", "r2"]
+    assert r["r2"]["model"] == "lrmate200ic5l" and r["r2"]["tool"] == "mig_torch"
+    assert r["r2"]["joints"] == [f"r2_j{k}" for k in range(1, 7)]
+    assert r["robot"]["joints"] == [f"j{k}" for k in range(1, 7)]
+    assert r["r2"]["base_pos_mm"] == pytest.approx(list(cell.r2_pos), abs=1e-6)
+    assert r["r2"]["frame0_pos_mm"][:2] == pytest.approx(list(cell.r2_pos[:2]), abs=1e-6)
+    assert r["r2"]["frame0_euler_zyx_deg"][0] == pytest.approx(-90.0, abs=1e-9)
+    assert r["r2"]["t_end_s"] == pytest.approx(r["r2"]["phases"][-1]["t1"])
+    assert r["r2"]["phases"][0]["t1"] == pytest.approx(cell.start2_s)
+    assert max(r["robot"]["t_end_s"], r["r2"]["t_end_s"]) == pytest.approx(s["duration_s"])
+    # the tool point's deviation from its reference: the recorded arrays' own figure
+    a = ev.record.arrays
+    dev = np.linalg.norm(np.asarray(a["r2_tcp_pos"]) - a["r2_tcp_pos_ref"], axis=1).max()
+    assert r["r2"]["max_tcp_deviation_mm"] == pytest.approx(dev * 1e3, rel=1e-12)
+    checks = s["checks"]
+    for name in ("tracking", "saturation", "speed", "acceleration"):
+        got = {c["joint"] for c in checks if c["name"] == name}
+        assert {f"r2_j{k}" for k in range(1, 7)} <= got, name
+    torch = [c for c in checks if c["name"] == "torch_angle"]
+    assert sorted(c["subject"].split(":")[0] for c in torch) == ["r2", "robot"]
+    assert any(c["subject"].startswith("r2: weld") for c in checks
+               if c["name"] == "cartesian_speed")
+    assert s["verdict"] in ("pass", "fail")
+
+
+def test_planted_summary_fault_fails_the_r2_checks(two_run):
+    """A planted r2 weld error reaches the verdict: the torch angle check of r2 fails."""
+    from sim.analysis.verdict import torch_angle_checks
+
+    _, ev = two_run
+    s = dict(ev.summary)
+    s["weld"] = [dict(w, torch_angle_error_deg=5.0) if w["robot"] == "r2" else w
+                 for w in s["weld"]]
+    failed = [c for c in torch_angle_checks(s, 2.0) if not c.passed]
+    assert [c.subject.split(":")[0] for c in failed] == ["r2"]
+
+
+def test_console_prints_each_robots_weld(two_run, capsys):
+    """The console's weld lines carry the robot's name (the lines `cellsim run` prints)."""
+    from sim.cli.run import _who
+
+    _, ev = two_run
+    whos = [_who(w) for w in ev.summary["weld"]]
+    assert whos == ["robot: ", "r2: "]
+    assert _who({"phase": "weld"}) == ""
+
+
+@pytest.mark.slow  # two more simulations (the generated cell with r2 alone)
+def test_r2_physics_is_its_own(two_run, tmp_path: Path):
+    """The second robot's recorded torques equal the same robot's doing the same phases as the
+    only robot of an equivalent cell (its base, tool and seam), to 1e-9 of the peak."""
+    from sim.pipeline.run import RunOptions, evaluate_scenario
+    from sim.scenario import load_scenario
+
+    cell, ev = two_run
+    alone = evaluate_scenario(load_scenario(write_alone(cell, tmp_path / "alone")),
+                              RunOptions(video=False, plots=False, progress=False, sizing=False))
+    a2, a1 = ev.record.arrays, alone.record.arrays
+    cols = _cols(ev.summary, "r2")
+    # the alone run ends with r2's last phase; its last sample's acceleration (hence tau) is
+    # a one-sided difference, where the two-robot run still runs on: compared up to before it
+    n = min(len(a1["t"]), len(a2["t"])) - 1
+    np.testing.assert_allclose(a2["t"][:n], a1["t"][:n], rtol=0, atol=1e-12)
+    tau2 = np.asarray(a2["tau"])[:n, cols]
+    tau1 = np.asarray(a1["tau"])[:n, :6]
+    peak = np.abs(tau1).max(axis=0)
+    assert np.abs(tau2 - tau1).max(axis=0) / peak == pytest.approx(np.zeros(6), abs=1e-9)
+    # planted: the first robot's columns are another robot's torques
+    tau_r1 = np.asarray(a2["tau"])[:n, _cols(ev.summary, "robot")]
+    assert np.max(np.abs(tau_r1 - tau1).max(axis=0) / peak) > 1e-3
+    # a cell without other robots: no "robots", no "robot" in its entries (as before)
+    assert "robots" not in alone.summary
+    assert all("robot" not in w for w in alone.summary["weld"] + alone.summary["cartesian_speed"])
+    # the same robot's weld measured alone and as r2 agree
+    w_alone = alone.summary["weld"][0]
+    w_r2 = next(w for w in ev.summary["weld"] if w["robot"] == "r2")
+    for key in ("travel_speed_mm_s", "max_path_deviation_mm", "seam_length_mm"):
+        assert w_r2[key] == pytest.approx(w_alone[key], rel=1e-6, abs=1e-9), key
