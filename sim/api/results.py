@@ -3,7 +3,8 @@
 A :class:`RunResult` is what :func:`sim.evaluate` and :func:`sim.run` return and what
 :meth:`RunResult.load` reads back from a finished run folder. Its fields are the run's
 ``summary.json`` (and ``sizing.json``) in typed form: the verdict, every check, collisions,
-saturation intervals, per-joint sizing and the actuator selection, the cell's mechanisms
+saturation intervals, every robot's welds (:class:`WeldResult`; :class:`RobotResult` per robot
+of a cell with several), per-joint sizing and the actuator selection, the cell's mechanisms
 (positioners, turntables, tracks: what they carry, their axes' travel), the stage timings; the
 recorded arrays come from memory, or from ``trajectory.npz`` on first use for a loaded run.
 ``to_dict()`` gives ``summary.json``'s content back unchanged.
@@ -227,6 +228,103 @@ class MechanismResult:
                          for a, v in d.get("axes", {}).items()})
 
 
+#: The name of a cell's first robot in :attr:`RunResult.robots` and :attr:`WeldResult.robot`
+#: (its model's prefix; the cell's other robots have their own names, ``r2``).
+FIRST_ROBOT = "robot"
+
+
+@dataclass(frozen=True)
+class WeldResult:
+    """One weld phase of one robot (``summary.json``'s ``"weld"`` entry), measured on the
+    simulated tool frames: along a seam, its progress and distance from the seam, the torch
+    axis against the seam's commanded axis.
+
+    Attributes:
+        robot: The robot that welds it: :data:`FIRST_ROBOT` for the cell's first robot, else
+            the cell's name for it (``r2``).
+        phase: Its phase's name (the robot's own phases).
+        seam: The seam's name, or None for a weld along a programmed path.
+        set_speed_mm_s, travel_speed_mm_s, travel_speed_cv: The set and measured travel
+            speed (cruise part), mm/s, and the measured speed's coefficient of variation.
+        seam_length_mm: The seam's (or path's) length, mm.
+        max_path_deviation_mm: The tool point's largest distance from the seam, mm.
+        torch_angle_error_deg: The torch axis's largest angle from the commanded axis, deg;
+            ``work_angle_error_deg``/``travel_angle_error_deg`` its parts (None off a seam).
+        start_error_mm, end_error_mm: The first and last samples' distances from the seam's
+            ends, mm.
+    """
+
+    robot: str
+    phase: str
+    seam: str | None
+    set_speed_mm_s: float
+    travel_speed_mm_s: float
+    travel_speed_cv: float
+    seam_length_mm: float
+    max_path_deviation_mm: float
+    torch_angle_error_deg: float
+    work_angle_error_deg: float | None
+    travel_angle_error_deg: float | None
+    start_error_mm: float
+    end_error_mm: float
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> WeldResult:
+        def opt(key: str) -> float | None:
+            return None if d.get(key) is None else float(d[key])
+
+        def num(key: str) -> float:  # a figure an older run did not write: nan
+            return math.nan if d.get(key) is None else float(d[key])
+
+        return cls(robot=str(d.get("robot") or FIRST_ROBOT), phase=str(d["phase"]),
+                   seam=None if d.get("seam") is None else str(d["seam"]),
+                   set_speed_mm_s=num("set_speed_mm_s"),
+                   travel_speed_mm_s=num("travel_speed_mm_s"),
+                   travel_speed_cv=num("travel_speed_cv"), seam_length_mm=num("seam_length_mm"),
+                   max_path_deviation_mm=num("max_path_deviation_mm"),
+                   torch_angle_error_deg=num("torch_angle_error_deg"),
+                   work_angle_error_deg=opt("work_angle_error_deg"),
+                   travel_angle_error_deg=opt("travel_angle_error_deg"),
+                   start_error_mm=num("start_error_mm"), end_error_mm=num("end_error_mm"))
+
+
+@dataclass(frozen=True)
+class RobotResult:
+    """One robot of a cell with several (``summary.json``'s ``"robots"`` entry).
+
+    Attributes:
+        name: :data:`FIRST_ROBOT` for the cell's first robot, else the cell's name for it.
+        model: Its robot model's name.
+        tool: Its tool's name, or None.
+        joints: Its joints' names in :attr:`RunResult.joints` (``r2_j1``, ...).
+        phases: Its phases' names in order.
+        t_end_s: When its last phase ends, s.
+        max_tcp_deviation_mm: Its simulated tool point's largest distance from its reference,
+            mm.
+        welds: Its weld phases.
+    """
+
+    name: str
+    model: str
+    tool: str | None
+    joints: tuple[str, ...]
+    phases: tuple[str, ...]
+    t_end_s: float
+    max_tcp_deviation_mm: float
+    welds: tuple[WeldResult, ...]
+
+    @classmethod
+    def from_dict(cls, name: str, d: Mapping[str, Any], welds: tuple[WeldResult, ...]
+                  ) -> RobotResult:
+        return cls(name=name, model=str(d["model"]),
+                   tool=None if d.get("tool") is None else str(d["tool"]),
+                   joints=tuple(str(j) for j in d["joints"]),
+                   phases=tuple(str(p["name"]) for p in d.get("phases", [])),
+                   t_end_s=float(d["t_end_s"]),
+                   max_tcp_deviation_mm=float(d["max_tcp_deviation_mm"]),
+                   welds=tuple(w for w in welds if w.robot == name))
+
+
 @dataclass(frozen=True)
 class SelectedDrive:
     """The motor and reducer chosen from a catalogue for one joint (both None when no pair of
@@ -264,6 +362,9 @@ class RunResult:
             (empty for a cell without any).
         timings_s: Wall time of each stage, s.
         path: The run folder (None for a run evaluated in memory).
+        welds: Every robot's weld phases (:class:`WeldResult`; the first robot's first).
+        robots: In a cell with other robots, each robot by name (:data:`FIRST_ROBOT` first):
+            model, tool, joints, cycle end, its welds; empty for a cell with one robot.
     """
 
     scenario: str
@@ -281,6 +382,8 @@ class RunResult:
     timings_s: Mapping[str, float]
     path: Path | None = None
     mechanisms: Mapping[str, MechanismResult] = field(default_factory=dict)
+    welds: tuple[WeldResult, ...] = ()
+    robots: Mapping[str, RobotResult] = field(default_factory=dict)
     _summary: dict[str, Any] = field(default_factory=dict, repr=False)
     _arrays: dict[str, NDArray[Any]] | None = field(default=None, repr=False)
 
@@ -318,6 +421,10 @@ class RunResult:
             self._arrays = load_run(self.path).arrays
         return self._arrays
 
+    def welds_of(self, robot: str = FIRST_ROBOT) -> tuple[WeldResult, ...]:
+        """The weld phases of one robot (:data:`FIRST_ROBOT`: the cell's first)."""
+        return tuple(w for w in self.welds if w.robot == robot)
+
     def to_dict(self) -> dict[str, Any]:
         """``summary.json``'s content (a deep copy)."""
         return copy.deepcopy(self._summary)
@@ -348,6 +455,7 @@ class RunResult:
             sized = ({str(j["joint"]): SizedJoint.from_dict(j, basis)
                       for j in sizing.get("joints", [])} if sizing else {})
             chosen = (summary.get("selection") or {}).get("joints", {})
+            welds = tuple(WeldResult.from_dict(w) for w in summary.get("weld", []))
             return cls(
                 scenario=str(summary["scenario"]), robot=str(summary.get("robot", "")),
                 verdict=cast(Verdict, verdict), checks=checks,
@@ -364,6 +472,9 @@ class RunResult:
                 timings_s={str(k): float(v) for k, v in summary.get("timings_s", {}).items()},
                 mechanisms={str(n): MechanismResult.from_dict(str(n), m)
                             for n, m in summary.get("mechanisms", {}).items()},
+                welds=welds,
+                robots={str(n): RobotResult.from_dict(str(n), r, welds)
+                        for n, r in summary.get("robots", {}).items()},
                 path=path, _summary=dict(summary), _arrays=arrays)
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise RunFolderError(f"{where}: not a finished run's summary "

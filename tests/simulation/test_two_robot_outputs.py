@@ -198,3 +198,31 @@ def test_r2_physics_is_its_own(two_run, tmp_path: Path):
     w_r2 = next(w for w in ev.summary["weld"] if w["robot"] == "r2")
     for key in ("travel_speed_mm_s", "max_path_deviation_mm", "seam_length_mm"):
         assert w_r2[key] == pytest.approx(w_alone[key], rel=1e-6, abs=1e-9), key
+
+
+def test_run_result_types_each_robots_welds(two_run):
+    """RunResult: every robot's welds typed (WeldResult), per robot (RobotResult), equal to the
+    summary's figures; the oracle's r2 travel speed."""
+    from sim.api.results import RobotResult, RunResult, WeldResult
+
+    cell, ev = two_run
+    res = RunResult.from_evaluation(ev)
+    assert [w.robot for w in res.welds] == ["robot", "r2"]
+    assert all(isinstance(w, WeldResult) for w in res.welds)
+    (w2,) = res.welds_of("r2")
+    assert w2.seam == "right" and w2.set_speed_mm_s == pytest.approx(cell.speed2, rel=1e-9)
+    o = _oracle(cell, ev.record.arrays, ev.summary, cols=_cols(ev.summary, "r2"),
+                seam=cell.right, base=cell.r2_base)
+    assert w2.travel_speed_mm_s == pytest.approx(o["speed_mm_s"], rel=2e-3)
+    assert list(res.robots) == ["robot", "r2"]
+    r2 = res.robots["r2"]
+    assert isinstance(r2, RobotResult) and r2.welds == (w2,)
+    assert r2.joints == tuple(f"r2_j{k}" for k in range(1, 7))
+    assert r2.phases == ("start", "to_seam", "touch", "weld")
+    assert res.robots["robot"].welds == res.welds_of()
+    # a summary of a single robot (no "robot" keys): its welds are the first robot's
+    single = dict(ev.summary, weld=[{k: v for k, v in w.items() if k != "robot"}
+                                    for w in ev.summary["weld"][:1]])
+    single.pop("robots")
+    one = RunResult.from_summary(single)
+    assert [w.robot for w in one.welds] == ["robot"] and one.robots == {}
