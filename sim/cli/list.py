@@ -1,6 +1,6 @@
 """``cellsim list``: robots, mechanisms (turntables, positioners, tracks: kind, axes with their
-ranges and speeds, rated payload), cells (with their mechanisms, objects, seams, parts and
-cameras), tools and scenarios."""
+ranges and speeds, rated payload), cells (with their other robots, mechanisms, objects, seams,
+parts and cameras), tools and scenarios."""
 
 from __future__ import annotations
 
@@ -8,6 +8,8 @@ import argparse
 import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from sim.core.resources import shipped_scenarios
 from sim.core.text import printable
@@ -18,6 +20,7 @@ from sim.robots.registry import ROBOTS
 
 if TYPE_CHECKING:
     from sim.cells.mechanisms import PlacedMechanism
+    from sim.cells.partners import PlacedRobot
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -70,6 +73,21 @@ def _mechanisms_line(placed: Sequence[PlacedMechanism]) -> str | None:
     return f"mechanisms: {', '.join(items)}"
 
 
+def _partners_line(partners: Sequence[PlacedRobot]) -> str | None:
+    """A cell's other robots (``[[robots]]``): ``other robots: r2 (lrmate200ic5l, mig_torch;
+    base 0, 700, 0 mm, yaw -90 deg)``."""
+    if not partners:
+        return None
+    items = []
+    for pr in partners:
+        T = np.asarray(pr.base_pose, dtype=float)
+        pos = ", ".join(f"{1e3 * x:.6g}" for x in T[:3, 3])
+        yaw = math.degrees(math.atan2(T[1, 0], T[0, 0]))
+        tool = pr.tool.name if pr.tool is not None else "no tool"
+        items.append(f"{pr.name} ({pr.robot.name}, {tool}; base {pos} mm, yaw {yaw:.6g} deg)")
+    return f"other robots: {', '.join(items)}"
+
+
 def _cell_lines(spec, strict: bool = False) -> list[str]:
     """A cell's robots, objects (a ring of staves counts once; painted marks are left out),
     seams (kind, length), parts and cameras, from the cell composed for its first robot."""
@@ -82,12 +100,13 @@ def _cell_lines(spec, strict: bool = False) -> list[str]:
             raise
         return [f"(cannot be built: {exc})"]
     member = {g: obj for obj, geoms in cell.objects.items() for g in geoms}
+    robot_prefixes = ("robot/", *(f"{cr.name}/" for cr in getattr(cell, "partners", ())))
     # a mechanism's own solids (its base's and its links'), not objects of the cell
     mech_bodies = {b for pm in cell.mechanisms for b in (pm.name, *pm.joint_names)}
     objects: list[str] = []
     for geom in cell.mjcf.worldbody.find_all("geom"):
         full = geom.full_identifier
-        if not geom.name or full.startswith("robot/") or geom.name == "floor":
+        if not geom.name or full.startswith(robot_prefixes) or geom.name == "floor":
             continue
         if getattr(geom.parent, "name", None) in mech_bodies:
             continue
@@ -100,6 +119,9 @@ def _cell_lines(spec, strict: bool = False) -> list[str]:
             objects.append(name)
     seams = [f"{s.name} ({s.kind}, {1000.0 * s.length():.0f} mm)" for s in cell.seams.values()]
     lines = [f"robots: {', '.join(spec.robots)}; mounts: {', '.join(spec.mounts)}"]
+    others = _partners_line(getattr(spec, "partners", ()))
+    if others is not None:
+        lines.append(others)
     mech = _mechanisms_line(cell.mechanisms)
     if mech is not None:
         lines.append(mech)

@@ -45,11 +45,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def planned_phases(scenario: Scenario) -> list[PhaseMotion]:
-    """The scenario's polynomial phases on one clock (Cartesian ones through the cell's IK)."""
+def planned_motion(scenario: Scenario) -> Motion:
+    """The scenario's motion on one clock (Cartesian phases through the cell's IK; a cell's
+    other robots' in :attr:`Motion.lanes`); limit violations warned on stderr."""
     context = None
-    if any(isinstance(p, CartesianPhase) or (isinstance(p, JointPhase) and p.target is not None)
-           for p in scenario.phases):
+    if scenario.partners or any(
+            isinstance(p, CartesianPhase) or (isinstance(p, JointPhase) and p.target is not None)
+            for p in scenario.phases):
         from sim.simulation.compile import build
 
         context = build(scenario).context
@@ -57,11 +59,36 @@ def planned_phases(scenario: Scenario) -> list[PhaseMotion]:
     for line in limit_violations(scenario, motion,
                                  speed=True):
         print(f"cellsim: warning: {line}", file=sys.stderr)
-    return [pm for pm in motion.phases if not isinstance(pm.trajectory, HoldTrajectory)]
+    return motion
 
 
-def plan_json(scenario: Scenario, planned: list[PhaseMotion]) -> dict[str, Any]:
-    """The ``--json`` document of a planned scenario (coefficients in radians)."""
+def _polynomial(phases: list[PhaseMotion]) -> list[PhaseMotion]:
+    return [pm for pm in phases if not isinstance(pm.trajectory, HoldTrajectory)]
+
+
+def planned_phases(scenario: Scenario) -> list[PhaseMotion]:
+    """The scenario's (its first robot's) polynomial phases on one clock (Cartesian ones
+    through the cell's IK)."""
+    return _polynomial(planned_motion(scenario).phases)
+
+
+def planned_lanes(motion: Motion) -> list[tuple[str, list[PhaseMotion]]]:
+    """A cell's other robots' polynomial phases, ``(name, phases)`` each, on the same clock."""
+    return [(name, _polynomial(lane.phases)) for name, lane in motion.lanes]
+
+
+def plan_json(scenario: Scenario, planned: list[PhaseMotion],
+              lanes: list[tuple[str, list[PhaseMotion]]] | None = None) -> dict[str, Any]:
+    """The ``--json`` document of a planned scenario (coefficients in radians); with a cell's
+    other robots (``lanes``), ``"robots"``: ``[{"name": str, "phases": [...]}]`` (their
+    phases as the first robot's, joints indexed from 1 in their own robot)."""
+    out: dict[str, Any] = {"scenario": scenario.name, "phases": _phases_json(planned)}
+    if lanes:
+        out["robots"] = [{"name": name, "phases": _phases_json(ph)} for name, ph in lanes]
+    return out
+
+
+def _phases_json(planned: list[PhaseMotion]) -> list[dict[str, Any]]:
     phases = []
     for pp in planned:
         traj = pp.trajectory
@@ -84,7 +111,7 @@ def plan_json(scenario: Scenario, planned: list[PhaseMotion]) -> dict[str, Any]:
             "time_s": [float(t) for t in knots[inside[0]:inside[-1] + 2]],
             "joints": joints,
         })
-    return {"scenario": scenario.name, "phases": phases}
+    return phases
 
 
 def _window(pp: PhaseMotion) -> range:
@@ -110,9 +137,11 @@ def _poly_text(coeffs: np.ndarray, var: str) -> str:
     return " ".join(terms) if terms else "0"
 
 
-def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
-    """Human-readable tables (degrees), one block per phase and joint."""
-    axes = scenario.system.n_joints - scenario.robot.n_joints
+def format_plan(scenario: Scenario, planned: list[PhaseMotion],
+                lanes: list[tuple[str, list[PhaseMotion]]] | None = None) -> str:
+    """Human-readable tables (degrees), one block per phase and joint; a cell's other
+    robots' phases (``lanes``) follow, each headed by its robot, joints ``<name>_<joint>``."""
+    axes = len(scenario.system.external)
     lines = [f"scenario {scenario.name}: robot {scenario.robot.name} "
              f"({scenario.robot.n_joints} joints"
              + (f" and {axes} external axes" if axes else "")
@@ -120,6 +149,20 @@ def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
              "coefficients in degrees (a linear axis's in mm); normalized time "
              "t = (tau - tau_k-1)/t_k, "
              "last segment in t_bar = t - 1; real time in powers of tau [s]"]
+    linear = {n for n, a in scenario.system.external if a.kind == "prismatic"}
+    lines += _phase_blocks(planned, scenario.system.joints, linear)
+    works = {w.name: w for w in scenario.partners}
+    for name, phases in lanes or []:
+        robot = works[name].robot
+        lines += ["", f"robot {name} ({robot.name}, {robot.n_joints} joints), "
+                  f"{len(phases)} polynomial phase(s)"]
+        lines += _phase_blocks(phases, tuple(f"{name}_{j}" for j in robot.joints), set())
+    return "\n".join(lines)
+
+
+def _phase_blocks(planned: list[PhaseMotion], joint_names: tuple[str, ...],
+                  linear: set[str]) -> list[str]:
+    lines: list[str] = []
     deg = 180.0 / np.pi
     for pp in planned:
         traj = pp.trajectory
@@ -128,8 +171,7 @@ def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
         inside = _window(pp)
         lines.append(f"phase {pp.phase.index + 1} {pp.phase.name!r}: planner {pp.phase.planner}, "
                      f"knots at {', '.join(f'{t:g}' for t in knots[inside[0]:inside[-1] + 2])} s")
-        linear = {n for n, a in scenario.system.external if a.kind == "prismatic"}
-        for j, jname in enumerate(scenario.system.joints[: traj.n_joints]):
+        for j, jname in enumerate(joint_names[: traj.n_joints]):
             scale = 1e3 if jname in linear else deg
             lines.append(f"  joint {jname}" + (" (mm)" if jname in linear else ""))
             for s in inside:
@@ -141,15 +183,17 @@ def format_plan(scenario: Scenario, planned: list[PhaseMotion]) -> str:
                                           var))
                 lines.append("      real:       "
                              + _poly_text(np.asarray(traj.real_coefficients[s][j]) * scale, "tau"))
-    return "\n".join(lines)
+    return lines
 
 
 def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
-    planned = planned_phases(scenario)
+    motion = planned_motion(scenario)
+    planned = _polynomial(motion.phases)
+    lanes = planned_lanes(motion)
     if args.json:
-        json.dump(plan_json(scenario, planned), sys.stdout, indent=1)
+        json.dump(plan_json(scenario, planned, lanes), sys.stdout, indent=1)
         sys.stdout.write("\n")
     else:
-        print(format_plan(scenario, planned))
+        print(format_plan(scenario, planned, lanes))
     return 0

@@ -10,6 +10,7 @@ two more simulations and is slow.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
@@ -226,3 +227,29 @@ def test_run_result_types_each_robots_welds(two_run):
     single.pop("robots")
     one = RunResult.from_summary(single)
     assert [w.robot for w in one.welds] == ["robot"] and one.robots == {}
+
+
+def test_cli_list_and_plan_show_the_other_robot(tmp_path: Path, capsys):
+    """`cellsim list --cell` names r2 with its model, tool and the file's base; `cellsim plan`
+    lists r2's phases (its joints r2_j1..), its start phase's knots at the file's times."""
+    from sim.cli import main
+
+    cell = generate(SEED + 1)
+    path = write_two(cell, tmp_path / "gen")
+    assert main(["list", "--cell", str(path.parent / "cell.toml")]) == 0
+    out = capsys.readouterr().out
+    base = ", ".join(f"{x:.6g}" for x in cell.r2_pos)
+    assert f"other robots: r2 (lrmate200ic5l, mig_torch; base {base} mm, yaw -90 deg)" in out
+    assert main(["plan", str(path), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    (r2,) = doc["robots"]
+    assert r2["name"] == "r2"
+    assert [p["name"] for p in r2["phases"]] == ["start", "to_seam", "touch", "weld"]
+    start = r2["phases"][0]
+    assert start["time_s"][0] == 0.0 and start["time_s"][-1] == pytest.approx(cell.start2_s)
+    assert [j["index"] for j in start["joints"]] == [1, 2, 3, 4, 5, 6]
+    assert [p["name"] for p in doc["phases"]] == ["start", "to_seam", "touch", "weld"]
+    assert main(["plan", str(path)]) == 0
+    text = capsys.readouterr().out
+    assert "robot r2 (lrmate200ic5l, 6 joints), 4 polynomial phase(s)" in text
+    assert "  joint r2_j1" in text and "external axes" not in text
