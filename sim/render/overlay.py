@@ -11,6 +11,9 @@ Trails and bead are added to a ``mujoco.MjvScene`` as extra geoms after
   so that a bead in a fillet's corner is not buried in the plates; its width is
   ``OverlayStyle.bead_radius`` (m) but never thinner than ``bead_min_px`` pixels on screen.
 
+A cell's other robots (``summary["robots"]``) get the same trails and bead from their own
+recorded tool points (``<name>_tcp_pos``, ``<name>_tcp_pos_ref``, ``<name>_arc_on``).
+
 Each line point is moved towards the camera along its line of sight by a few millimetres
 (``lift_*``): its projection is unchanged, but it is drawn in front of the bead and the
 reference, instead of flickering with them at equal depth. Paths are
@@ -168,6 +171,11 @@ class PathOverlay:
                         sub, pts = idx[keep], local[keep]
                     self.bead_runs.append((pts, self.t[sub], float(self.t[a]), t_end))
                     self.bead_body.append(body)
+        # a cell's other robots: each its own trails and bead, from its recorded tool point
+        # (``<name>_tcp_pos``, ``_tcp_pos_ref``, ``_arc_on``); their seams stand still
+        self.others: list[PathOverlay] = [
+            PathOverlay(_RobotView(record, name), self.style)  # type: ignore[arg-type]
+            for name in _other_robots(record)]
 
     @property
     def max_geoms(self) -> int:
@@ -178,7 +186,7 @@ class PathOverlay:
         if self.actual is not None:
             n += len(self.actual) + 1
         n += sum(len(p) + 1 for p, _, _, _ in self.bead_runs)
-        return n
+        return n + sum(o.max_geoms for o in self.others)
 
     def add_to_scene(self, scene: Any, time: float, height: int, geoms: Any = None,
                      data: Any = None) -> int:
@@ -266,7 +274,41 @@ class PathOverlay:
             path = np.vstack([self.actual[:k], interp_rows(self.t, self._actual_full, time)])
             polyline(lifted(path, st.lift_actual), mujoco.mjtGeom.mjGEOM_LINE, st.actual_rgba,
                      line_px, 1.0)
+        for other in self.others:
+            added += other.add_to_scene(scene, time, height, geoms, data)
         return added
+
+
+def _other_robots(record: RunRecord) -> list[str]:
+    """A cell's other robots with a recorded tool point (``summary["robots"]`` after the
+    first), in the cell's order; empty for a cell with one robot."""
+    robots = list((record.summary or {}).get("robots", {}))[1:]
+    return [name for name in robots if record.has(f"{name}_tcp_pos")]
+
+
+class _RobotView:
+    """One of a cell's other robots' recorded tool point as a run's own (``tcp_pos``,
+    ``tcp_pos_ref``, ``arc_on`` are its ``<name>_...`` arrays), for :class:`PathOverlay`."""
+
+    KEYS = ("tcp_pos", "tcp_pos_ref", "arc_on")
+
+    def __init__(self, record: RunRecord, name: str) -> None:
+        self.record, self.name = record, name
+        self.t = record.t
+        self.summary: dict[str, Any] = {}
+
+    def _key(self, key: str) -> str | None:
+        return f"{self.name}_{key}" if key in self.KEYS else None
+
+    def has(self, key: str) -> bool:
+        k = self._key(key)
+        return k is not None and self.record.has(k)
+
+    def get(self, key: str) -> Any:
+        k = self._key(key)
+        if k is None:
+            raise KeyError(key)
+        return self.record.get(k)
 
 
 def _bead_carriers(record: RunRecord, model: Any) -> dict[int, int]:
@@ -274,7 +316,8 @@ def _bead_carriers(record: RunRecord, model: Any) -> dict[int, int]:
     mechanism the summary's weld entry names (``carried_by``); empty without a model."""
     if model is None or not record.summary or not record.has("phase"):
         return {}
-    carried = {w["phase"]: w.get("carried_by") for w in record.summary.get("weld", ())}
+    carried = {w["phase"]: w.get("carried_by") for w in record.summary.get("weld", ())
+               if w.get("robot", "robot") == "robot"}  # the first robot's phases
     names = [p["name"] if isinstance(p, dict) else str(p)
              for p in record.summary.get("phases", ())]
     if not any(carried.values()) or not record.has("arc_on"):

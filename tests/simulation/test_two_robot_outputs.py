@@ -253,3 +253,25 @@ def test_cli_list_and_plan_show_the_other_robot(tmp_path: Path, capsys):
     text = capsys.readouterr().out
     assert "robot r2 (lrmate200ic5l, 6 joints), 4 polynomial phase(s)" in text
     assert "  joint r2_j1" in text and "external axes" not in text
+
+
+def test_video_overlay_lays_r2_bead_on_its_seam(two_run):
+    """The video's overlay lays a bead for r2 too: one run, from r2's arc on, on the file's
+    seam (0.1 mm), covering it; the first robot's bead on its own seam."""
+    from sim.render.overlay import PathOverlay
+
+    cell, ev = two_run
+    ov = PathOverlay(ev.record)
+    (r2,) = ov.others
+    (run,) = r2.bead_runs
+    pts, _, t0, _ = run
+    dist, s = line_distance(pts, *cell.right)
+    assert dist.max() < 1e-4
+    assert s.min() < 1e-4 and s.max() > cell.length * 1e-3 - 1e-4
+    arc = np.asarray(ev.record.arrays["r2_arc_on"], bool)
+    assert t0 == pytest.approx(ev.record.arrays["t"][np.argmax(arc)])
+    (own,) = ov.bead_runs
+    assert line_distance(own[0], *cell.left)[0].max() < 1e-4
+    # planted: r2's bead is not on the first robot's seam
+    assert line_distance(pts, *cell.left)[0].max() > 5e-3
+    assert ov.max_geoms > r2.max_geoms > 0
