@@ -8,7 +8,9 @@
   of seed 001, figures 5-9, with the jerk added;
 * ``tool_path.png``: the tool point's path in 3D in mm with equal axes, reference vs actual,
   with the seam (samples where ``arc_on``) drawn thick, and the tool point's position error
-  ``|tcp_pos - tcp_pos_ref|`` (mm) against time;
+  ``|tcp_pos - tcp_pos_ref|`` (mm) against time; ``tool_path_<name>.png`` the same of each
+  of a cell's other robots (``summary["robots"]``: its ``<name>_tcp_pos``..., its phases),
+  whose joints' figures shade their own robot's phases;
 * ``tracking_error.png``: ``q - q_ref`` per joint (deg) against time;
 * ``torques.png``: simulated actuator torque ``tau`` vs inverse dynamics of the reference
   ``tau_id`` per joint (N m) against time;
@@ -201,7 +203,7 @@ def joint_figure(record: RunRecord, joint: int) -> Any:
         if act_key and record.has(act_key):
             ax.plot(t, scale * record.get(act_key)[:, joint], color=_ACT, lw=1.0, ls="--",
                     label="simulated")
-        shade_phases(ax, record.phases, label=k == 0)
+        shade_phases(ax, _joint_phases(record, name), label=k == 0)
         mark_knots(ax, knots)
         ax.set_ylabel(label)
         ax.grid(True, lw=0.3)
@@ -212,25 +214,44 @@ def joint_figure(record: RunRecord, joint: int) -> Any:
     return fig
 
 
-def tool_path_figure(record: RunRecord) -> Any:
+def other_robots(record: RunRecord) -> list[str]:
+    """A cell's other robots (``summary["robots"]`` after the first) with a recorded tool
+    point; empty for a cell with one robot."""
+    robots = list((record.summary or {}).get("robots", {}))[1:]
+    return [name for name in robots if record.has(f"{name}_tcp_pos")]
+
+
+def _joint_phases(record: RunRecord, joint: str) -> Any:
+    """The phases a joint's figures shade: its own robot's (``summary["robots"]``)."""
+    for r in list((record.summary or {}).get("robots", {}).values())[1:]:
+        if joint in r.get("joints", ()):
+            return r["phases"]
+    return record.phases
+
+
+def tool_path_figure(record: RunRecord, robot: str | None = None) -> Any:
     """The tool point's path in 3D (reference vs actual, seam thick) and its position error.
 
     Args:
         record: The run (needs ``tcp_pos``, ``tcp_pos_ref``; ``arc_on``, ``knot_t`` optional).
+        robot: One of a cell's other robots (its ``<robot>_tcp_pos``, ``_tcp_pos_ref``,
+            ``_arc_on`` and its phases); None: the first robot.
 
     Returns:
         A ``Figure`` with a 3D axes (lines: reference, actual, then seam segments) and a 2D
         axes of the error in mm.
     """
     t = record.t
-    ref = 1000.0 * record.get("tcp_pos_ref")
-    act = 1000.0 * record.get("tcp_pos")
+    pre = f"{robot}_" if robot else ""
+    phases = record.summary["robots"][robot]["phases"] if robot else record.phases
+    ref = 1000.0 * record.get(f"{pre}tcp_pos_ref")
+    act = 1000.0 * record.get(f"{pre}tcp_pos")
     fig = _figure("tool_path")
     ax = fig.add_subplot(1, 2, 1, projection="3d")
     ax.plot(*ref.T, color=_REF, lw=1.6, label="reference")
     ax.plot(*act.T, color=_ACT, lw=1.0, ls="--", label="actual")
-    if record.has("arc_on"):
-        arc = record.get("arc_on").astype(bool)
+    if record.has(f"{pre}arc_on"):
+        arc = record.get(f"{pre}arc_on").astype(bool)
         first = True
         for a, b in true_runs(arc):
             ax.plot(*act[a:b].T, color=_BEAD, lw=4.0, alpha=0.8,
@@ -246,10 +267,11 @@ def tool_path_figure(record: RunRecord) -> Any:
     ax.set_ylabel("y [mm]")
     ax.set_zlabel("z [mm]")
     ax.legend(loc="upper left", fontsize=8)
-    ax.set_title("tool point path (world frame)")
+    ax.set_title(f"{robot}: tool point path (world frame)" if robot
+                 else "tool point path (world frame)")
     ax2 = fig.add_subplot(1, 2, 2)
     ax2.plot(t, np.linalg.norm(act - ref, axis=1), color=_ACT, lw=1.2)
-    shade_phases(ax2, record.phases, label=True)
+    shade_phases(ax2, phases, label=True)
     mark_knots(ax2, _knots(record))
     ax2.set_xlabel("time [s]")
     ax2.set_ylabel("|tcp - tcp_ref| [mm]")
@@ -359,7 +381,8 @@ def write_plots(run: str | Path | RunRecord, out_dir: str | Path | None = None) 
         out_dir: Destination folder; default ``<run folder>/plots``.
 
     Returns:
-        Paths written: ``joint_<name>.png`` per joint, then ``tool_path.png``,
+        Paths written: ``joint_<name>.png`` per joint, then ``tool_path.png`` (and
+        ``tool_path_<robot>.png`` per other robot of the cell),
         ``tracking_error.png``, ``torques.png``, then ``mechanism_<name>.png`` per mechanism.
 
     Raises:
@@ -383,6 +406,8 @@ def write_plots(run: str | Path | RunRecord, out_dir: str | Path | None = None) 
     ]
     jobs += [
         ("tool_path.png", lambda: tool_path_figure(record)),
+        *((f"tool_path_{re.sub(r'[^A-Za-z0-9_.-]', '_', name)}.png",
+           lambda name=name: tool_path_figure(record, name)) for name in other_robots(record)),
         ("tracking_error.png", lambda: tracking_error_figure(record)),
         ("torques.png", lambda: torque_figure(record)),
     ]

@@ -275,3 +275,27 @@ def test_video_overlay_lays_r2_bead_on_its_seam(two_run):
     # planted: r2's bead is not on the first robot's seam
     assert line_distance(pts, *cell.left)[0].max() > 5e-3
     assert ov.max_geoms > r2.max_geoms > 0
+
+
+def test_tool_path_plot_per_robot(two_run, tmp_path: Path):
+    """plots: tool_path_r2.png; its seam line is r2's arc-on path, on r2's seam (0.1 mm), its
+    error axes shaded with r2's phases; r2's joints' figures shade r2's phases."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from sim.analysis.plots import _joint_phases, other_robots, tool_path_figure
+
+    cell, ev = two_run
+    rec = ev.record
+    assert other_robots(rec) == ["r2"]
+    fig = tool_path_figure(rec, "r2")
+    ax3d = fig.axes[0]
+    xs, ys, zs = ax3d.lines[2].get_data_3d()
+    pts = np.column_stack([xs, ys, zs]) * 1e-3
+    assert line_distance(pts, *cell.right)[0].max() < 1e-4
+    assert "r2" in ax3d.get_title()
+    assert _joint_phases(rec, "r2_j1") == ev.summary["robots"]["r2"]["phases"]
+    assert _joint_phases(rec, "j1") == rec.phases
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
