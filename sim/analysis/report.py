@@ -25,6 +25,7 @@ import html
 import io
 import json
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -289,6 +290,11 @@ def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
               result.verdict, ""]
     for sec in mechanism_sections(summary or {}, result):
         parts += [f"## Mechanism {sec.title}", "", sec.load, "", _md_table(AXIS_HEAD, sec.rows), ""]
+    for rs in robot_sections(summary or {}, result):
+        parts += [f"## Robot {rs.title}", "", rs.text, ""]
+        if rs.welds:
+            parts += [_md_table(WELD_HEAD, rs.welds), ""]
+        parts += [_md_table(ROBOT_JOINT_HEAD, rs.joints), ""]
     parts += ["## Per joint", ""]
     parts.append(_md_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
     parts += ["", "## Checks", ""]
@@ -300,6 +306,64 @@ def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
             parts.append("")
     parts += ["", "## Conventions", "", _CONVENTIONS, ""]
     return "\n".join(parts)
+
+
+#: Columns of a robot section's weld table (a cell with several robots).
+WELD_HEAD = ("phase", "seam", "length mm", "set mm/s", "travel mm/s", "path dev. mm",
+             "torch angle err. deg")
+#: Columns of a robot section's joint table.
+ROBOT_JOINT_HEAD = ("joint", "tracking error", "peak torque (ID / sim)",
+                    "RMS torque (ID / sim)", "margin %", "limiting check")
+
+
+@dataclass(frozen=True)
+class RobotSection:
+    """One robot of a cell with several (``summary["robots"]``): its title, a sentence (model,
+    tool, frame 0, joints, cycle end, tool point deviation), its welds and its joints."""
+
+    title: str
+    text: str
+    welds: tuple[tuple[str, ...], ...]
+    joints: tuple[tuple[str, ...], ...]
+
+
+def robot_sections(summary: Mapping[str, Any], result: SizingResult | None = None
+                   ) -> list[RobotSection]:
+    """A section per robot of a cell with other robots (none for a cell with one): the
+    robot's name on its joints, welds and figures."""
+    robots = summary.get("robots") or {}
+    if not robots:
+        return []
+    sized = {j.joint: j for j in result.joints} if result is not None else {}
+    names = list(summary.get("joints", []))
+    track = summary.get("max_tracking_error_deg", [])
+    units = summary.get("joint_units") or ["deg"] * len(track)
+    out = []
+    for name, r in robots.items():
+        pos = ", ".join(f"{float(x):.6g}" for x in r.get("frame0_pos_mm", ()))
+        text = (f"{r['model']} with {r.get('tool') or 'no tool'}; frame 0 at {pos} mm; joints "
+                f"{', '.join(r['joints'])}; its last phase ends at {float(r['t_end_s']):.4g} s; "
+                f"tool point up to {_f(float(r['max_tcp_deviation_mm']))} mm off its reference.")
+        welds = tuple(
+            (str(w["phase"]), str(w.get("seam") or "-"), _f(float(w["seam_length_mm"])),
+             _f(float(w["set_speed_mm_s"])), _f(float(w["travel_speed_mm_s"])),
+             _f(float(w["max_path_deviation_mm"])), _f(float(w["torch_angle_error_deg"])))
+            for w in summary.get("weld", ()) if w.get("robot") == name)
+        joints = []
+        for jn in r["joints"]:
+            k = names.index(jn) if jn in names else None
+            tr = (f"{_f(float(track[k]), 3)} {units[k]}" if k is not None and k < len(track)
+                  else "n/a")
+            j = sized.get(jn)
+            if j is None:
+                joints.append((jn, tr, "n/a", "n/a", "n/a", "n/a"))
+                continue
+            joints.append((jn, tr, _pair(j, "peak_torque", unit=j.torque_unit),
+                           _pair(j, "rms_torque", unit=j.torque_unit), _pct(j.margin_pct),
+                           j.limiting.title if j.limiting else "n/a"))
+        out.append(RobotSection(title=f"{name} ({r['model']})", text=text, welds=welds,
+                                joints=tuple(joints)))
+    return out
 
 
 def _html_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
@@ -500,6 +564,11 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
     for sec in mechanism_sections(summary, result):
         out += [f"<h2>Mechanism {esc(sec.title)}</h2>", f"<p>{esc(sec.load)}</p>",
                 _html_table(AXIS_HEAD, sec.rows)]
+    for rs in robot_sections(summary, result):
+        out += [f"<h2>Robot {esc(rs.title)}</h2>", f"<p>{esc(rs.text)}</p>"]
+        if rs.welds:
+            out.append(_html_table(WELD_HEAD, rs.welds))
+        out.append(_html_table(ROBOT_JOINT_HEAD, rs.joints))
     out.append("<h2>Per joint</h2>")
     out.append(_html_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
     out.append("<h2>Checks, per joint</h2>")

@@ -299,3 +299,28 @@ def test_tool_path_plot_per_robot(two_run, tmp_path: Path):
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_report_has_a_section_per_robot(two_run):
+    """sizing.md and report.html: a section per robot naming its joints, its weld (the
+    summary's figures) and its joints' sizing; none for a cell with one robot."""
+    from sim.analysis.report import robot_sections, sizing_html, sizing_markdown
+
+    _, ev = two_run
+    s = ev.summary
+    secs = robot_sections(s, ev.sizing)
+    assert [x.title for x in secs] == ["robot (lrmate200ic5l)", "r2 (lrmate200ic5l)"]
+    r2 = secs[1]
+    assert [row[0] for row in r2.joints] == [f"r2_j{k}" for k in range(1, 7)]
+    assert all(row[2] != "n/a" for row in r2.joints)  # sized
+    (weld,) = r2.welds
+    w2 = next(w for w in s["weld"] if w["robot"] == "r2")
+    assert weld[:2] == ("weld", "right")
+    assert float(weld[4]) == pytest.approx(w2["travel_speed_mm_s"], rel=1e-3)
+    md = sizing_markdown(ev.sizing, (), s)
+    assert "## Robot r2 (lrmate200ic5l)" in md and "| r2_j6 |" in md
+    page = sizing_html(ev.sizing, {}, s)
+    assert "<h2>Robot r2 (lrmate200ic5l)</h2>" in page
+    single = {k: v for k, v in s.items() if k != "robots"}
+    assert robot_sections(single, ev.sizing) == []
+    assert "## Robot" not in sizing_markdown(ev.sizing, (), single)
