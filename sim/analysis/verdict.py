@@ -90,12 +90,14 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                torch_angle_tolerance_deg: float,
                flange_load_kg: tuple[float, float] | None = None,
                tool_load: tuple[str, float, float] | None = None,
-               tracking_tolerance_mm: float = 0.5) -> list[RunCheck]:
+               tracking_tolerance_mm: float = 0.5,
+               partner_loads: Sequence[tuple[str, RobotSpec, float]] = ()) -> list[RunCheck]:
     """Every check of a run (module docstring): joint by joint, then collisions, clearance,
     the Cartesian phases' speeds, the weld phases' torch angles, the weaves, the actuator
     selection when one was made, and the payload (``flange_load_kg``: the tool's mass and the
     scenario's payload, kg) against the robot's rating, and the mass the tool holds against
-    the tool's (``tool_load``: the tool's name, the mass it holds and its rating, kg)."""
+    the tool's (``tool_load``: the tool's name, the mass it holds and its rating, kg), and each
+    of a cell's other robots' tool against its rating (``partner_loads``: name, robot, kg)."""
     checks: list[RunCheck] = []
     if tool_load is not None:
         name, held, rating = tool_load
@@ -109,6 +111,12 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                                load <= spec.payload_kg * (1 + 1e-9),
                                subject=f"tool {tool:g} kg + payload {payload:g} kg on the "
                                f"{spec.name}, rated {spec.payload_kg:g} kg"))
+    for name, robot, tool_kg in partner_loads:  # a cell's other robots carry their tools
+        if robot.payload_kg > 0:
+            checks.append(RunCheck("payload", "", float(tool_kg), float(robot.payload_kg), "kg",
+                                   tool_kg <= robot.payload_kg * (1 + 1e-9),
+                                   subject=f"{name}: tool {tool_kg:g} kg on the {robot.name}, "
+                                   f"rated {robot.payload_kg:g} kg"))
     # a linear axis (a track's) in mm, N; a joint in deg, N m
     linear = np.array(spec.linear)
     scale = np.where(linear, 1e3, np.degrees(1.0))

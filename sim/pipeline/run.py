@@ -274,7 +274,10 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
                                 scenario.simulation.torch_angle_tolerance_deg),
                             flange_load_kg=(built.cell.tool.mass_kg if built.cell.tool else 0.0,
                                             scenario.payload_kg),
-                            tool_load=_tool_load(built, scenario.payload_kg))
+                            tool_load=_tool_load(built, scenario.payload_kg),
+                            partner_loads=[(cr.name, cr.robot,
+                                            cr.tool.mass_kg if cr.tool is not None else 0.0)
+                                           for cr in built.cell.partners])
         summary["checks"] = [c.to_dict() for c in checks]
         summary["verdict"] = verdict(checks)
         summary["warnings"] = warnings_count(checks)

@@ -143,6 +143,8 @@ def test_summary_robots_and_checks_cover_r2(two_run):
     assert sorted(c["subject"].split(":")[0] for c in torch) == ["r2", "robot"]
     assert any(c["subject"].startswith("r2: weld") for c in checks
                if c["name"] == "cartesian_speed")
+    (pay,) = [c for c in checks if c["name"] == "payload" and c["subject"].startswith("r2")]
+    assert pay["value"] == pytest.approx(1.0) and pay["limit"] == pytest.approx(5.0)
     assert s["verdict"] in ("pass", "fail")
 
 
