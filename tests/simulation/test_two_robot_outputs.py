@@ -326,3 +326,48 @@ def test_report_has_a_section_per_robot(two_run):
     single = {k: v for k, v in s.items() if k != "robots"}
     assert robot_sections(single, ev.sizing) == []
     assert "## Robot" not in sizing_markdown(ev.sizing, (), single)
+
+
+@pytest.mark.slow  # one more generated cell per seed
+@pytest.mark.parametrize("seed", [3, 11])
+def test_generated_cells_r2_against_oracle(seed: int, tmp_path: Path):
+    """More generated cells: r2's tool point (link product at its recorded joints) on the
+    file's seam within 0.1 mm at its set speed within 1 %, and the summary's r2 weld agrees."""
+    from sim.pipeline.run import RunOptions, evaluate_scenario
+    from sim.scenario import load_scenario
+
+    cell = generate(seed)
+    ev = evaluate_scenario(load_scenario(write_two(cell, tmp_path / "gen")),
+                           RunOptions(video=False, plots=False, progress=False, sizing=False))
+    a, s = ev.record.arrays, ev.summary
+    o = _oracle(cell, a, s, cols=_cols(s, "r2"), seam=cell.right, base=cell.r2_base)
+    assert o["max_dev_mm"] < 0.1
+    assert abs(o["speed_mm_s"] / cell.speed2 - 1.0) < 0.01
+    w2 = next(w for w in s["weld"] if w["robot"] == "r2")
+    assert w2["travel_speed_mm_s"] == pytest.approx(o["speed_mm_s"], rel=2e-3)
+    assert w2["max_path_deviation_mm"] == pytest.approx(o["max_dev_mm"], abs=0.01)
+    assert w2["seam_length_mm"] == pytest.approx(cell.length, abs=1e-6)
+
+
+@pytest.mark.slow  # a whole `cellsim run` (sizing, report, no video)
+def test_cellsim_run_prints_each_robots_weld(tmp_path: Path, capsys):
+    """`cellsim run` prints r2's line and each robot's weld line prefixed with its name, and
+    writes tool_path_r2.png and report sections for r2."""
+    from sim.cli import main
+
+    cell = generate(SEED + 2)
+    path = write_two(cell, tmp_path / "gen")
+    out_dir = tmp_path / "run"
+    assert main(["run", str(path), "--no-video", "--quiet", "--out", str(out_dir)]) == 0
+    text = capsys.readouterr().out
+    assert f"  robot: weld weld: {cell.length:.1f} mm at {cell.speed1:.2f} mm/s" in text
+    assert f"  r2: weld weld: {cell.length:.1f} mm at {cell.speed2:.2f} mm/s" in text
+    assert "  r2 (lrmate200ic5l): cycle end " in text
+    assert (out_dir / "plots" / "tool_path_r2.png").is_file()
+    assert "## Robot r2 (lrmate200ic5l)" in (out_dir / "sizing.md").read_text()
+    summary = json.loads((out_dir / "summary.json").read_text())
+    from sim.api.results import RunResult
+
+    res = RunResult.load(out_dir)
+    assert res.welds_of("r2")[0].set_speed_mm_s == pytest.approx(cell.speed2)
+    assert summary["robots"]["r2"]["joints"] == list(res.robots["r2"].joints)
