@@ -108,8 +108,11 @@ def run(args: argparse.Namespace) -> int:
     for line in summary.get("program_warnings", []):
         print(f"  program: {line}")
     for name, r in list(summary.get("robots", {}).items())[1:]:
-        print(f"  {name} ({r['model']}): cycle end {r['t_end_s']:.3f} s, max tcp deviation "
-              f"{r['max_tcp_deviation_mm']:.3f} mm")
+        phases = r.get("phases", [])
+        idle = len(phases) == 1 and phases[0].get("kind") == "hold"  # no work: stays home
+        print(f"  {name} ({r['model']}): "
+              + ("holds its home all cycle" if idle else f"cycle end {r['t_end_s']:.3f} s")
+              + f", max tcp deviation {r['max_tcp_deviation_mm']:.3f} mm")
         for line in r.get("program_warnings", []):
             print(f"  {name}: program: {line}")
     for w in summary.get("weave", []):
