@@ -5,6 +5,15 @@ geometry, never from the planner's trajectory (:func:`measure_seam`): a torch th
 off the seam's work and travel angles, a tool point off the seam, a weave that slows the
 progress along it all show in the figures.
 
+A cell with other robots (``[[robots]]``, :attr:`Motion.lanes`): each robot's weld phases,
+Cartesian speeds and weaves are measured exactly as the first robot's, on its own recorded tool
+frames (``<name>_tcp_pos``/``_tcp_quat``, ``<name>_arc_on``), its own phases and the seams as its
+tool follows them (``context.partners[name]``); their entries join ``summary["weld"]``,
+``["cartesian_speed"]`` and ``["weave"]`` with ``"robot": "<name>"`` (the first robot's get
+``"robot": "robot"``), and ``summary["robots"]`` gives each robot's model, tool, frame 0, joints,
+phases, cycle end, tool point deviation, tracking errors and closest approach to a singularity.
+A cell with one robot gets neither (its summary as before, key for key).
+
 Owns which phases are measured and the run's summary; the measurement along one seam is
 :mod:`sim.simulation.seam_measure`'s (its names importable from here as before).
 May import: planners, :mod:`sim.core`, :mod:`sim.scenario` and the simulation modules.
