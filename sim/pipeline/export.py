@@ -42,7 +42,9 @@ from the even turn by at most :data:`TURN_TOL_DEG` (an arc's pieces span at most
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -60,6 +62,11 @@ from sim.scenario.fanuc_ls import (
 )
 from sim.scenario.model import CartesianPhase, HoldPhase, JointPhase
 
+if TYPE_CHECKING:
+    from sim.cells.spec import Cell
+    from sim.simulation.motion.context import CartesianContext
+    from sim.simulation.motion.timeline import Motion
+
 #: The axes' law of a coordinated phase may deviate this far from linear in the path within a
 #: written piece, rad (revolute) and m (prismatic).
 LAW_TOL_RAD = np.radians(0.05)
@@ -72,31 +79,95 @@ MAX_PIECE_DEG = 30.0
 MAX_PIECES = 256
 
 
+@dataclass(frozen=True)
+class RobotProgram:
+    """One robot's exported TP program.
+
+    Attributes:
+        robot: The robot's name in the cell: None for the first robot (the scenario's
+            ``robot``), else one of the cell's other robots (``[robots.<name>]``).
+        text: The program (``.ls``).
+        notes: What it leaves out, and what the scenario that runs it back must give.
+        table: Its weave table's text, or None when no phase weaves.
+    """
+
+    robot: str | None
+    text: str
+    notes: list[str]
+    table: str | None
+
+
 def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
-    """The TP program text of ``scenario``, notes on what it leaves out, and the text of its
-    weave table (None when no phase weaves).
+    """The TP program text of ``scenario``'s first robot, notes on what it leaves out, and the
+    text of its weave table (None when no phase weaves); the cell's other robots' programs:
+    :func:`export_programs`.
 
     Raises:
         ScenarioError: A motion the TP form cannot hold (one line).
     """
-    from sim.core.rotations import matrix_to_euler_zyx
-    from sim.robots.kinematics.ik import solve_ik
-    from sim.robots.maker import to_maker
-    from sim.scenario.program import CNT_SHARE, TP_WEAVE_PATTERNS, config_of
+    first = export_programs(scenario)[0]
+    return first.text, first.notes, first.table
+
+
+def export_programs(scenario: Scenario) -> list[RobotProgram]:
+    """The TP program of each robot of ``scenario``: the first robot's, then each of the
+    cell's other robots' that has work (``[robots.<name>]`` phases or program), in the cell's
+    order; each written in its own robot's frame 0 (its user frame 0) and joints, from the
+    motion planned for the run. One without work stays home and has no program.
+
+    Raises:
+        ScenarioError: A motion the TP form cannot hold (one line).
+    """
     from sim.simulation.compile import build
     from sim.simulation.motion import build_motion, check_motion_limits
+    from sim.simulation.motion.timeline import Motion
 
     built = build(scenario)
     motion = build_motion(scenario, built.context)
     check_motion_limits(scenario, motion)
-    ctx = built.context
+    lead = Motion(phases=motion.phases, actions=motion.actions, n_joints=motion.n_lead)
+    base = _program_name(scenario.name)
+    out = [RobotProgram(None, *_export_robot(
+        scenario, scenario, lead, built.context, built.cell, base))]
+    lanes = dict(motion.lanes)
+    for work in scenario.partners:
+        if not work.phases:
+            continue
+        suffix = f"_{_program_name(work.name)}"
+        text, notes, table = _export_robot(
+            scenario, scenario.partner_scenario(work), lanes[work.name],
+            built.context.partners[work.name], built.cell,
+            base[:max(1, 36 - len(suffix))] + suffix, f"robots.{work.name}: ")
+        out.append(RobotProgram(work.name, text, notes, table))
+    return out
+
+
+def _program_name(name: str) -> str:
+    """A program name from a scenario's or robot's name (letters, digits, ``_``; 36 at
+    most)."""
+    return "".join(c if c.isalnum() else "_" for c in name)[:36] or "PROG"
+
+
+def _export_robot(scenario: Scenario, work: Scenario, motion: Motion, ctx: CartesianContext,
+                  cell: Cell, name: str, what_prefix: str = ""
+                  ) -> tuple[str, list[str], str | None]:
+    """One robot's program: ``work`` its scenario (the scenario itself for the first robot,
+    :meth:`Scenario.partner_scenario` for another), ``motion`` its planned motion alone (its
+    joints, then the cell's axes for the first robot), ``ctx`` its planning context; its
+    text, notes and weave table (:func:`export_fanuc_ls`). ``what_prefix`` starts its error
+    messages' subject (``robots.r2: ``)."""
+    from sim.core.rotations import matrix_to_euler_zyx
+    from sim.robots.kinematics.ik import solve_ik
+    from sim.robots.maker import to_maker
+    from sim.scenario.program import CNT_SHARE, TP_WEAVE_PATTERNS, config_of
+
     kin = ctx.kinematics
-    robot = scenario.robot
+    robot = work.robot
     n = robot.n_joints
     notes: list[str] = []
     ins: list = [LSOther("uframe", 0), LSOther("utool", 1)]
     positions: dict[int, LSPosition] = {}
-    vmax = np.asarray(scenario.system.max_speed, dtype=float)
+    vmax = np.asarray(work.system.max_speed, dtype=float)[:n]
     units = tuple("deg" if a.kind == "revolute" else "mm"
                   for pm in ctx.mechanisms for a in pm.spec.axes)
     user_frames: dict[str, int] = {}  # cell object -> its user frame number
@@ -126,9 +197,11 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
         try:
             sols = [s for s in solve_ik(kin, T, current=q_near) if s.within_limits]
         except CellsimError as exc:
-            raise ScenarioError(f"{scenario.source.name}: export: {what}: {exc}") from None
+            raise ScenarioError(f"{scenario.source.name}: export: {what_prefix}{what}: "
+                                f"{exc}") from None
         if not sols:
-            raise ScenarioError(f"{scenario.source.name}: export: {what}: no IK solution in the "
+            raise ScenarioError(f"{scenario.source.name}: export: {what_prefix}{what}: no IK "
+                                "solution in the "
                                 "joint ranges")
         best = min(sols, key=lambda s: float(np.abs(s.q - q_near).max()))
         W = T if T_written is None else T_written
@@ -140,9 +213,10 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
     def coordinated(pm, ph: CartesianPhase) -> None:
         """A phase whose axes move, as COORD moves in its part's user frame (module
         docstring)."""
-        part = _part_of(ph, built.cell, ctx)
+        part = _part_of(ph, cell, ctx)
         if part is None:
-            raise ScenarioError(f"{scenario.source.name}: export: {ph.name}: its axes move, "
+            raise ScenarioError(f"{scenario.source.name}: export: {what_prefix}{ph.name}: its "
+                                "axes move, "
                                 "but its points are in no cell object's frame (a COORD move's "
                                 "user frame)")
         uf = user_frames.setdefault(part, len(user_frames) + 1)
@@ -235,9 +309,8 @@ def export_fanuc_ls(scenario: Scenario) -> tuple[str, list[str], str | None]:
                      "give it in the scenario that runs the program")
         ins[0:0] = [LSOther("comment", f"UF {k} = {obj} (program_frames)")
                     for obj, k in user_frames.items()]
-    name = "".join(c if c.isalnum() else "_" for c in scenario.name)[:36] or "PROG"
     table = write_weave_schedules(schedules, name.upper()) if schedules else None
-    return write_ls(name, ins, positions, comment=scenario.name), notes, table
+    return write_ls(name, ins, positions, comment=work.name), notes, table
 
 
 def _axes_move(motion, pm, n: int) -> bool:
@@ -316,13 +389,24 @@ def coordinated_pieces(motion, pm, ctx, part: str) -> list[tuple[float, float]]:
     return [(t_at(0.5 * (sa + sb)), t_at(sb) if sb < length else pm.t1) for sa, sb in done]
 
 
+def program_path(out: str | Path, robot: str | None) -> Path:
+    """Where the program of ``robot`` goes when the first robot's goes to ``out``: ``out``
+    itself for the first robot (None), ``prog_<name>.ls`` beside it for another."""
+    out = Path(out)
+    return out if robot is None else out.with_name(f"{out.stem}_{robot}{out.suffix}")
+
+
 def write_program(scenario: Scenario, out: str | Path) -> tuple[list[str], list[Path]]:
-    """Write the TP program of ``scenario`` to ``out``, and its weave table beside it when a
-    phase weaves (:func:`sim.scenario.fanuc_ls.weave_table_path`), each atomically, refusing
-    to replace an existing file. Returns the notes and the files written.
+    """Write the TP program of ``scenario``'s first robot to ``out``, each other robot's with
+    work beside it (:func:`program_path`: ``prog_r2.ls``), and each program's weave table
+    beside it when one of its phases weaves (:func:`sim.scenario.fanuc_ls.weave_table_path`),
+    each atomically, refusing to replace an existing file (none is written when one of them
+    exists). Returns the notes (another robot's start with ``robots.<name>: ``) and the files
+    written.
 
     Raises:
-        ScenarioError: ``out`` or its weave table exists, or the folder does not.
+        ScenarioError: ``out``, another robot's program or a weave table exists, or the folder
+            does not.
     """
     def refuse_existing(path: Path) -> None:
         if path.exists():
@@ -333,19 +417,35 @@ def write_program(scenario: Scenario, out: str | Path) -> tuple[list[str], list[
     refuse_existing(out)
     if not out.parent.is_dir():
         raise ScenarioError(f"{out.parent}: no such folder")
-    text, notes, table = export_fanuc_ls(scenario)
-    if table is None:
-        _write_new(out, text)
-        return notes, [out]
-    table_path = weave_table_path(out)
-    refuse_existing(table_path)
-    _write_new(table_path, table)  # the table first: the program never runs without it
+    programs = export_programs(scenario)
+    files: list[tuple[Path, str]] = []  # (path, text): the tables first, each before its program
+    notes: list[str] = []
+    paths, tables = [], []
+    for prog in programs:
+        path = program_path(out, prog.robot)
+        if prog.table is not None:
+            files.append((weave_table_path(path), prog.table))
+            tables.append(weave_table_path(path))
+        files.append((path, prog.text))
+        paths.append(path)
+        if prog.robot is None:
+            notes += prog.notes
+            continue
+        notes += [f"robots.{prog.robot}: {n}" for n in prog.notes]
+        notes.append(f"robots.{prog.robot}: {path.name}: run it back with [robots.{prog.robot}] "
+                     f'program = "{path.name}" in the scenario')
+    for path, _ in files:
+        refuse_existing(path)
+    written: list[Path] = []
     try:
-        _write_new(out, text)
+        for path, text in files:  # a table first: its program never runs without it
+            _write_new(path, text)
+            written.append(path)
     except ScenarioError:
-        table_path.unlink()
+        for path in written:
+            path.unlink()
         raise
-    return notes, [out, table_path]
+    return notes, paths + tables
 
 
 def _write_new(path: Path, text: str) -> None:
@@ -370,4 +470,5 @@ def _write_new(path: Path, text: str) -> None:
 
 
 __all__ = ["LAW_TOL_M", "LAW_TOL_RAD", "MAX_PIECES", "MAX_PIECE_DEG", "TURN_TOL_DEG",
-           "coordinated_pieces", "export_fanuc_ls", "part_pose", "write_program"]
+           "RobotProgram", "coordinated_pieces", "export_fanuc_ls", "export_programs",
+           "part_pose", "program_path", "write_program"]
