@@ -1,5 +1,6 @@
 """``cellsim export SCENARIO --format fanuc-ls --out prog.ls``: a scenario's motion as a robot
-program (:mod:`sim.pipeline.export`)."""
+program (:mod:`sim.pipeline.export`); in a cell with other robots (``[[robots]]``) each one's
+with work as its own program beside it (``prog_r2.ls``)."""
 
 from __future__ import annotations
 
@@ -14,12 +15,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "positions with their CONFIG, FINE or CNT, Arc Start/End, WAIT, and Weave "
                     "Sine/Circle ... Weave End with the weave schedules in prog.weave.toml "
                     "beside the program. A scenario with `program = \"prog.ls\"` runs it back. "
-                    "An existing file is never replaced.")
+                    "In a cell with other robots each one with work gets its own program beside "
+                    "the first robot's (prog_r2.ls for r2; `[robots.r2] program = "
+                    "\"prog_r2.ls\"` runs it back). An existing file is never replaced.")
     p.add_argument("scenario", metavar="SCENARIO",
                    help="a scenario file, or a shipped scenario's name (see `cellsim list`)")
     p.add_argument("--format", choices=["fanuc-ls"], default="fanuc-ls",
                    help="program format (default: fanuc-ls)")
-    p.add_argument("--out", required=True, help="the program file to write (must not exist)")
+    p.add_argument("--out", required=True, help="the (first robot's) program file to write "
+                   "(must not exist)")
     p.set_defaults(func=run)
 
 

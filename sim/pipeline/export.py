@@ -37,6 +37,15 @@ law deviates from that by at most :data:`LAW_TOL_RAD` / :data:`LAW_TOL_M` and it
 from the even turn by at most :data:`TURN_TOL_DEG` (an arc's pieces span at most
 :data:`MAX_PIECE_DEG`). The user frames' cell objects are a note (``program_frames = { "1" =
 "head" }``: the scenario that runs the program gives it) and a comment in the program.
+
+In a cell with other robots (a cell file's ``[[robots]]``) each one with work (``[robots.<name>]``
+phases or program) gets a program of its own, written the same way from its own planned motion
+(:attr:`sim.simulation.motion.Motion.lanes`): its positions in its own frame 0 (its user frame 0:
+its base) and joints, its own tool (tool 1), no extended axes (the cell's axes move with the
+first robot). It goes beside the first robot's (:func:`program_path`: ``prog.ls`` ->
+``prog_r2.ls``; its weave table ``prog_r2.weave.toml``), and its notes start with
+``robots.<name>:``; ``[robots.<name>] program = "prog_<name>.ls"`` runs it back. Each program
+starts where its robot is at the cycle's start (its home in the cell), all at once.
 """
 
 from __future__ import annotations
