@@ -426,6 +426,9 @@ def write_program(scenario: Scenario, out: str | Path) -> tuple[list[str], list[
     refuse_existing(out)
     if not out.parent.is_dir():
         raise ScenarioError(f"{out.parent}: no such folder")
+    for work in scenario.partners:  # before the planning: the other programs' places too
+        if work.phases:
+            refuse_existing(program_path(out, work.name))
     programs = export_programs(scenario)
     files: list[tuple[Path, str]] = []  # (path, text): the tables first, each before its program
     notes: list[str] = []
