@@ -176,7 +176,7 @@ def _export_robot(scenario: Scenario, work: Scenario, motion: Motion, ctx: Carte
     notes: list[str] = []
     ins: list = [LSOther("uframe", 0), LSOther("utool", 1)]
     positions: dict[int, LSPosition] = {}
-    vmax = np.asarray(work.system.max_speed, dtype=float)[:n]
+    vmax = np.asarray(work.system.max_speed, dtype=float)[:motion.n_joints]  # and the axes
     units = tuple("deg" if a.kind == "revolute" else "mm"
                   for pm in ctx.mechanisms for a in pm.spec.axes)
     user_frames: dict[str, int] = {}  # cell object -> its user frame number
