@@ -263,3 +263,21 @@ def test_an_unknown_user_frame_of_r2_names_its_table(tmp_path):
     scenario = load_scenario(path)
     with pytest.raises(ScenarioError, match=r"^two\.toml: robots\.r2: .*unknown frame 'nope'"):
         build_motion(scenario, build(scenario).context)
+
+
+@pytest.mark.parametrize(("drop", "message"), [
+    ("program_weld_speed_mm_s", r"robots\.r2: program: r2\.ls: line 11: WELD_SPEED"),
+    ("program_registers", r"robots\.r2: program: r2\.ls: line 16: PR\[1\]: no value"),
+    ("program_frames", r"robots\.r2: program: r2\.ls: line 8: UFRAME_NUM = 1: no frame"),
+])
+def test_what_r2s_program_needs_from_the_scenario_is_one_line(tmp_path, drop, message):
+    """Bad input: r2's program without its weld speed, register or user frame in
+    ``[robots.r2]`` is one line naming the scenario, ``robots.r2``, the program and its line."""
+    from sim.scenario import load_scenario
+
+    tee = Tee(length=60.0)
+    table = "".join(line + "\n" for line in tee.r2_program_table().splitlines()
+                    if not line.startswith(drop))
+    with pytest.raises(ScenarioError, match=rf"^two\.toml: {message}") as info:
+        load_scenario(tee.write(tmp_path, tee.scenario_toml(r2=table)))
+    assert "\n" not in str(info.value)
