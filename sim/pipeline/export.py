@@ -53,7 +53,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -72,9 +72,10 @@ from sim.scenario.fanuc_ls import (
 from sim.scenario.model import CartesianPhase, HoldPhase, JointPhase
 
 if TYPE_CHECKING:
+    from planners.weave import Weave
     from sim.cells.spec import Cell
     from sim.simulation.motion.context import CartesianContext
-    from sim.simulation.motion.timeline import Motion
+    from sim.simulation.motion.timeline import Motion, PhaseMotion
 
 #: The axes' law of a coordinated phase may deviate this far from linear in the path within a
 #: written piece, rad (revolute) and m (prismatic).
@@ -184,7 +185,7 @@ def _export_robot(scenario: Scenario, work: Scenario, motion: Motion, ctx: Carte
     schedules: dict[int, WeaveSchedule] = {}
     tp_pattern = {v: k for k, v in TP_WEAVE_PATTERNS.items()}
 
-    def schedule_of(weave) -> int:
+    def schedule_of(weave: Weave) -> int:
         """The number of the weave's schedule (a new one for a weave not yet written)."""
         sch = WeaveSchedule(weave.frequency, weave.amplitude * 1e3, weave.dwell, weave.dwell)
         for k, other in schedules.items():
@@ -193,7 +194,7 @@ def _export_robot(scenario: Scenario, work: Scenario, motion: Motion, ctx: Carte
         schedules[len(schedules) + 1] = sch
         return len(schedules)
 
-    def add_pos(qe: np.ndarray, uf: int = 0, **kw) -> int:
+    def add_pos(qe: np.ndarray, uf: int = 0, **kw: Any) -> int:
         k = len(positions) + 1
         positions[k] = LSPosition(k, uf, 1, ext=tuple(float(v) for v in qe), ext_units=units,
                                   **kw)
@@ -219,7 +220,7 @@ def _export_robot(scenario: Scenario, work: Scenario, motion: Motion, ctx: Carte
         return add_pos(qe, uf, xyzwpr=(x, y, z, g, b, a),
                        config=config_of(robot, best.q, best.branch))
 
-    def coordinated(pm, ph: CartesianPhase) -> None:
+    def coordinated(pm: PhaseMotion, ph: CartesianPhase) -> None:
         """A phase whose axes move, as COORD moves in its part's user frame (module
         docstring)."""
         part = _part_of(ph, cell, ctx)
@@ -322,14 +323,14 @@ def _export_robot(scenario: Scenario, work: Scenario, motion: Motion, ctx: Carte
     return write_ls(name, ins, positions, comment=work.name), notes, table
 
 
-def _axes_move(motion, pm, n: int) -> bool:
+def _axes_move(motion: Motion, pm: PhaseMotion, n: int) -> bool:
     """Whether the external axes move during planned phase ``pm``."""
     ts = np.linspace(pm.t0, pm.t1, 65)
     qe = np.asarray(motion.at(ts).q, dtype=float)[:, n:]
     return bool(qe.size) and float(np.ptp(qe, axis=0).max()) > 1e-9
 
 
-def _part_of(ph: CartesianPhase, cell, ctx) -> str | None:
+def _part_of(ph: CartesianPhase, cell: Cell, ctx: CartesianContext) -> str | None:
     """The cell object a coordinated phase's points are relative to: its seam's object, or its
     frame when that is a cell object; None otherwise."""
     if ph.seam is not None:
@@ -339,7 +340,7 @@ def _part_of(ph: CartesianPhase, cell, ctx) -> str | None:
     return ph.frame if ph.frame in ctx.frames else None
 
 
-def part_pose(ctx, part: str, qe: np.ndarray, T0: np.ndarray) -> np.ndarray:
+def part_pose(ctx: CartesianContext, part: str, qe: np.ndarray, T0: np.ndarray) -> np.ndarray:
     """A tool pose ``T0`` in frame 0 (the robot's, carried by its track at axes ``qe``) in the
     frame of cell object ``part`` (carried by its mechanism at ``qe``), (4, 4)."""
     from sim.simulation.motion.axes import displacement, world_from_frame0
@@ -348,7 +349,8 @@ def part_pose(ctx, part: str, qe: np.ndarray, T0: np.ndarray) -> np.ndarray:
     return np.linalg.inv(F) @ world_from_frame0(ctx, qe) @ T0
 
 
-def coordinated_pieces(motion, pm, ctx, part: str) -> list[tuple[float, float]]:
+def coordinated_pieces(motion: Motion, pm: PhaseMotion, ctx: CartesianContext, part: str
+                       ) -> list[tuple[float, float]]:
     """The pieces a coordinated phase (``pm`` of ``motion``) is written in, relative to cell
     object ``part``: ``(t_mid, t_end)`` for each, the times at the middle of its path and at
     its end (module docstring)."""

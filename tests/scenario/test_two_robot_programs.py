@@ -38,7 +38,7 @@ RUN_SETTINGS = settings(deadline=None, derandomize=True, phases=[Phase.explicit,
 
 
 @st.composite
-def tees(draw, max_length: float = 200.0) -> Tee:
+def tees(draw: st.DrawFn, max_length: float = 200.0) -> Tee:
     """A generated case: the seams anywhere along the web, the bases moved and turned apart
     (never mirror images of each other: :func:`_asymmetric`)."""
     length = draw(st.floats(50.0, max_length))
@@ -113,7 +113,7 @@ def export(tee: Tee, root: Path) -> tuple[Path, list[str]]:
 
 
 # ------------------------------------------------------------------------------ fast share
-def test_the_path_oracle_catches_a_shifted_or_short_weld():
+def test_the_path_oracle_catches_a_shifted_or_short_weld() -> None:
     """Planted fault: a weld moved 0.2 mm sideways, or cut 0.2 mm short, is caught."""
     s = np.linspace(0.0, 0.1, 1001)
     orig = np.c_[s, np.zeros_like(s), np.zeros_like(s)]
@@ -122,7 +122,8 @@ def test_the_path_oracle_catches_a_shifted_or_short_weld():
     assert path_gap(orig, orig[orig[:, 0] < 0.0998]) > BACK_TOL
 
 
-def test_export_writes_a_program_per_robot_and_refuses_an_existing_one(tmp_path, capsys):
+def test_export_writes_a_program_per_robot_and_refuses_an_existing_one(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """``cellsim export`` writes the first robot's program to --out and r2's beside it
     (``prog_r2.ls``, in r2's own frame 0 and tool), says how to run it back; an existing
     ``prog_r2.ls`` is refused in one line (exit 2) and nothing is written."""
@@ -140,7 +141,9 @@ def test_export_writes_a_program_per_robot_and_refuses_an_existing_one(tmp_path,
     # r2's weld ends where the seam ends, in r2's frame 0 (its base: at base2, turned -90 deg)
     end = tee.seam("right")[1] * 1e3 - [tee.base2[0], tee.base2[1], 330.0]
     in_f0 = np.array([-end[1], end[0], end[2]])  # Rz(+90) of world offsets
-    xyz = np.array(second.positions[max(second.positions)].xyzwpr[:3])
+    last = second.positions[max(second.positions)].xyzwpr
+    assert last is not None
+    xyz = np.array(last[:3])
     assert np.abs(xyz - in_f0).max() < 1e-3 + 1e-9, (xyz, in_f0)
     # refusing: r2's program exists; neither file is (re)written
     (tmp_path / "again_r2.ls").write_text("mine")
@@ -151,7 +154,7 @@ def test_export_writes_a_program_per_robot_and_refuses_an_existing_one(tmp_path,
     assert (tmp_path / "again_r2.ls").read_text() == "mine"
 
 
-def test_a_robot_without_work_gets_no_program(tmp_path):
+def test_a_robot_without_work_gets_no_program(tmp_path: Path) -> None:
     """r2 without ``[robots.r2]`` stays home: the export writes the first robot's program
     only."""
     from sim.pipeline.export import write_program
@@ -166,7 +169,8 @@ def test_a_robot_without_work_gets_no_program(tmp_path):
 
 @settings(RUN_SETTINGS, max_examples=2)
 @given(tee=tees(max_length=120.0))
-def test_r2_program_plans_onto_its_seam(tmp_path_factory, tee):
+def test_r2_program_plans_onto_its_seam(tmp_path_factory: pytest.TempPathFactory,
+                                        tee: Tee) -> None:
     """r2's hand-written program (UF 1 = the web, PR[1], WELD_SPEED) planned with r2's own
     context: the compiled model posed at the planned joints (MuJoCo's own kinematics) puts
     r2's tool point on its seam while its arc is on, and r2 starts at its home in the cell."""
@@ -205,7 +209,7 @@ def test_r2_program_plans_onto_its_seam(tmp_path_factory, tee):
 @pytest.mark.slow
 @settings(RUN_SETTINGS, max_examples=3)
 @given(tee=tees())
-def test_r2_runs_its_program(tmp_path_factory, tee):
+def test_r2_runs_its_program(tmp_path_factory: pytest.TempPathFactory, tee: Tee) -> None:
     """Simulated: r2's program welds r2's seam (the cell file's numbers) from end to end at
     the scenario's weld speed, from its home in the cell, while the first robot's phases
     weld its own."""
@@ -222,7 +226,8 @@ def test_r2_runs_its_program(tmp_path_factory, tee):
 @pytest.mark.slow
 @settings(RUN_SETTINGS, max_examples=3)
 @given(tee=tees())
-def test_export_of_two_robots_runs_back(tmp_path_factory, tee):
+def test_export_of_two_robots_runs_back(tmp_path_factory: pytest.TempPathFactory,
+                                        tee: Tee) -> None:
     """Simulated: the two exported programs, run back, give each robot's recorded weld (and its
     rest at the cycle's end) within 0.1 mm of the original run's."""
     root = tmp_path_factory.mktemp("export")
@@ -233,7 +238,7 @@ def test_export_of_two_robots_runs_back(tmp_path_factory, tee):
 
 
 @pytest.mark.slow
-def test_swapped_programs_are_caught(tmp_path):
+def test_swapped_programs_are_caught(tmp_path: Path) -> None:
     """Planted fault: the two exported programs swapped in the run-back scenario (each robot
     runs the other's, in its own frame 0) fail the round trip's oracle."""
     tee = Tee(x0=20.0, length=80.0, speed1=30.0, speed2=22.0, base1=(40.0, -680.0),
@@ -251,7 +256,7 @@ def test_swapped_programs_are_caught(tmp_path):
         check_back(orig, bad)
 
 
-def test_an_unknown_user_frame_of_r2_names_its_table(tmp_path):
+def test_an_unknown_user_frame_of_r2_names_its_table(tmp_path: Path) -> None:
     """Bad input: r2's program_frames naming no cell object is one line naming robots.r2."""
     from sim.scenario import load_scenario
     from sim.simulation.compile import build
@@ -270,7 +275,8 @@ def test_an_unknown_user_frame_of_r2_names_its_table(tmp_path):
     ("program_registers", r"robots\.r2: program: r2\.ls: line 16: PR\[1\]: no value"),
     ("program_frames", r"robots\.r2: program: r2\.ls: line 8: UFRAME_NUM = 1: no frame"),
 ])
-def test_what_r2s_program_needs_from_the_scenario_is_one_line(tmp_path, drop, message):
+def test_what_r2s_program_needs_from_the_scenario_is_one_line(tmp_path: Path, drop: str,
+                                                              message: str) -> None:
     """Bad input: r2's program without its weld speed, register or user frame in
     ``[robots.r2]`` is one line naming the scenario, ``robots.r2``, the program and its line."""
     from sim.scenario import load_scenario
