@@ -121,10 +121,13 @@ def rotation_wpr(w: float, p: float, r: float) -> NDArray[np.float64]:
 def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                    frames: dict[int, str], registers: dict[int, LSPosition], where: str,
                    has_tool: bool, weld_speed: float | None = None,
-                   mechanisms: tuple = ()) -> tuple[list, list[Action], list[str]]:
+                   mechanisms: tuple = (), no_axes: str | None = None
+                   ) -> tuple[list, list[Action], list[str]]:
     """The phases, tool actions and warnings of a TP program (module docstring);
     ``mechanisms``: the cell's (:class:`sim.cells.mechanisms.PlacedMechanism`, in cell order),
-    whose axes the program's extended values drive, starting at their home.
+    whose axes the program's extended values drive, starting at their home. ``no_axes``: why
+    the program drives no axes where that is not for want of mechanisms (a cell's other robot:
+    its program's positions hold no extended values), said where a position has some.
 
     Raises:
         ScenarioError: One line naming the program file and line.
@@ -160,7 +163,7 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                       f"program runs UFRAME_NUM = {uf}, UTOOL_NUM = {ut}")
         return pos
 
-    cell_axes = _CellAxes(mechanisms)
+    cell_axes = _CellAxes(mechanisms, no_axes)
 
     def axes_of(pos: LSPosition) -> dict[str, float]:
         """The position's extended values on the cell's axes (SI), {} when it has none."""
@@ -397,7 +400,8 @@ class _CellAxes:
     """The cell's external axes as a program drives them: names, kinds, ranges, carriers, and
     where the axes are (``current``, from their home)."""
 
-    def __init__(self, mechanisms: tuple) -> None:
+    def __init__(self, mechanisms: tuple, no_axes: str | None = None) -> None:
+        self.no_axes = no_axes
         self.names = tuple(n for pm in mechanisms for n in pm.joint_names)
         self.kinds = {n: a.kind for pm in mechanisms
                       for n, a in zip(pm.joint_names, pm.spec.axes, strict=True)}
@@ -429,6 +433,9 @@ class _CellAxes:
         if not vals:
             return {}
         labels = ", ".join(v[0] for v in vals)
+        if self.no_axes is not None:
+            raise ValueError(f"P[{pos.index}] has extended axis values ({labels}); "
+                             f"{self.no_axes}")
         if not self.names:
             raise ValueError(f"P[{pos.index}] has extended axis values ({labels}), but the cell "
                              "has no external axes (no [[mechanisms]])")

@@ -287,3 +287,24 @@ def test_what_r2s_program_needs_from_the_scenario_is_one_line(tmp_path: Path, dr
     with pytest.raises(ScenarioError, match=rf"^two\.toml: {message}") as info:
         load_scenario(tee.write(tmp_path, tee.scenario_toml(r2=table)))
     assert "\n" not in str(info.value)
+
+
+def test_extended_values_in_another_robots_program_say_why(tmp_path: Path) -> None:
+    """A program read for a robot whose positions hold no extended axes (``no_axes``: a cell's
+    other robot) says why at the position's line, not that the cell has no mechanisms."""
+    from sim.robots.registry import resolve_robot
+    from sim.scenario.fanuc_ls import parse_ls
+    from sim.scenario.program import program_phases
+
+    text = Tee(length=60.0).r2_program().replace(
+        "R = 180.000 deg\n}", "R = 180.000 deg,\n\tE1= 10.000 deg\n}", 1)
+    prog = parse_ls(text, tmp_path / "r2.ls")
+    robot = resolve_robot("lrmate200ic5l")
+    why = "the cell's axes move with its first robot"
+    with pytest.raises(ScenarioError, match=rf"^w: program: r2\.ls: line 18: P\[1\] has "
+                       rf"extended axis values \(E1\); {why}$"):
+        program_phases(prog, robot, np.zeros(6), {1: "web"}, {}, "w", has_tool=True,
+                       weld_speed=20.0, no_axes=why)
+    with pytest.raises(ScenarioError, match="the cell has no external axes"):
+        program_phases(prog, robot, np.zeros(6), {1: "web"}, {}, "w", has_tool=True,
+                       weld_speed=20.0)
