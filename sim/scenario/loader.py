@@ -181,12 +181,13 @@ def parse_scenario(text: str, source: str | Path = "<scenario>") -> Scenario:
 
 
 def _work(spec: ScenarioSpec | RobotWorkSpec, robot: RobotSpec, tool: ToolSpec | None,
-          cell: CellSpec | None, base: Path, where: str
+          cell: CellSpec | None, base: Path, where: str, no_axes: str | None = None
           ) -> tuple[list[Phase], list[Action], tuple[str, ...]]:
     """One robot's work: its phases (or its TP program's) and its tool actions.
 
     ``where`` starts every error (``file.toml`` for the first robot, ``file.toml: robots.r2``
-    for another).
+    for another); ``no_axes`` says why a program's extended-axis values have no axes to move
+    (:func:`~sim.scenario.program.program_phases`).
     """
     tool_kind = None if tool is None else tool.kind
     phases: list[Phase] = []
@@ -244,7 +245,7 @@ def _work(spec: ScenarioSpec | RobotWorkSpec, robot: RobotSpec, tool: ToolSpec |
         phases, actions, warns = program_phases(
             prog, robot, np.full(robot.n_joints, np.nan), frames, registers, where,
             has_tool=tool_kind == "torch", weld_speed=spec.program_weld_speed_mm_s,
-            mechanisms=() if cell is None else cell.mechanisms)
+            mechanisms=() if cell is None else cell.mechanisms, no_axes=no_axes)
         program_warnings = tuple(warns)
         seen = {ph.name: k for k, ph in enumerate(phases)}
     phases = with_ctwd(phases, spec, tool, where)
@@ -294,7 +295,10 @@ def _partners(spec: ScenarioSpec, cell: CellSpec | None, base: Path, where: str
         if tool is not None and tool.suction_gain_n > 0.0:
             raise ScenarioError(f"{key}.tool: {tool.name!r} is a suction gripper; a cell's "
                                 "other robots carry torches or tools without suction")
-        phases, actions, warns = _work(ws, pr.robot, tool, None, base, key)
+        phases, actions, warns = _work(
+            ws, pr.robot, tool, None, base, key,
+            no_axes="the cell's axes move with its first robot's program or phases; another "
+                    "robot's positions hold no extended values")
         out.append(RobotWork(name, pr.robot, tool, tuple(phases), tuple(actions), warns))
     return tuple(out)
 

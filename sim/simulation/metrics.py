@@ -419,7 +419,8 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "cartesian_speed": cartesian_speeds(a, motion, built.context.world_from_frame0,
                                             built.context),
         "weave": weave_metrics(a, motion, built, measured),
-        "program_warnings": list(scenario.program_warnings),
+        "program_warnings": list(scenario.program_warnings) + [
+            f"robots.{w.name}: {x}" for w in scenario.partners for x in w.program_warnings],
     }
     if built.cell.mechanisms:
         summary["mechanisms"] = mechanism_summary(a, built)
