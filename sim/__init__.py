@@ -42,6 +42,7 @@ if _TYPE_CHECKING:
         Collision,
         MechanismAxis,
         MechanismResult,
+        RobotResult,
         RunOptions,
         RunResult,
         Saturation,
@@ -50,6 +51,7 @@ if _TYPE_CHECKING:
         SizedJoint,
         SizingCheck,
         SweepResult,
+        WeldResult,
         evaluate,
         load_scenario,
         run,
@@ -71,9 +73,9 @@ if _TYPE_CHECKING:
 
 __all__ = [
     # the API (sim.api)
-    "Check", "Collision", "MechanismAxis", "MechanismResult", "RunOptions", "RunResult",
-    "Saturation", "Scenario", "SelectedDrive",
-    "SizedJoint", "SizingCheck", "SweepResult", "evaluate", "load_scenario", "run", "sweep",
+    "Check", "Collision", "MechanismAxis", "MechanismResult", "RobotResult", "RunOptions",
+    "RunResult", "Saturation", "Scenario", "SelectedDrive", "SizedJoint", "SizingCheck",
+    "SweepResult", "WeldResult", "evaluate", "load_scenario", "run", "sweep",
     # the exception tree (sim.errors; CellsimError is its root)
     "CatalogError", "CellsimError", "CellsimWarning", "InternalError", "ReachError",
     "RenderError", "RunFolderError", "ScenarioError", "SimulationError", "SweepError",
@@ -81,8 +83,8 @@ __all__ = [
     "__version__",
 ]
 
-_API_NAMES = frozenset(__all__[:16])
-_ERROR_NAMES = frozenset(__all__[16:-1])
+_API_NAMES = frozenset(__all__[:18])
+_ERROR_NAMES = frozenset(__all__[18:-1])
 
 
 def __getattr__(name: str) -> object:

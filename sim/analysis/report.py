@@ -25,7 +25,6 @@ import html
 import io
 import json
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +32,8 @@ import numpy as np
 
 from sim.analysis.catalog import describe_entry
 from sim.analysis.mechanism_report import AXIS_HEAD, mechanism_sections
+from sim.analysis.report_text import num_text, pair_text, pct_text
+from sim.analysis.robot_report import ROBOT_JOINT_HEAD, robot_sections
 from sim.analysis.selection import REPORT_TOP
 from sim.analysis.sizing import (
     CHECK_TITLES,
@@ -180,24 +181,7 @@ def _linear_column(key: str) -> str:
 # Markdown and HTML
 # --------------------------------------------------------------------------------------------
 
-def _pct(m: float) -> str:
-    """A margin in percent: one decimal, more when it is small (so a fail never reads -0.0)."""
-    if m is None or not np.isfinite(m):
-        return "n/a"
-    return f"{m:.1f}" if abs(m) >= 1 else f"{m:.2g}"
-
-
-def _f(x: float, digits: int = 4) -> str:
-    return f"{x:.{digits}g}" if x is not None and np.isfinite(x) else "n/a"
-
-
-def _pair(j: JointSizing, attr: str, motor: bool = False, digits: int = 4,
-          unit: str = "") -> str:
-    src = j.motor if motor else j.stats
-    if not src:
-        return "n/a"
-    return (f"{_f(getattr(src['id'], attr), digits)} / {_f(getattr(src['sim'], attr), digits)}"
-            f" {unit}").rstrip()
+_pct, _f, _pair = pct_text, num_text, pair_text
 
 
 _TABLE_HEAD = ("joint", "peak torque or force (ID / sim)", "RMS torque or force (ID / sim)",
@@ -312,60 +296,6 @@ def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
 WELD_HEAD = ("phase", "seam", "length mm", "set mm/s", "travel mm/s", "path dev. mm",
              "torch angle err. deg")
 #: Columns of a robot section's joint table.
-ROBOT_JOINT_HEAD = ("joint", "tracking error", "peak torque (ID / sim)",
-                    "RMS torque (ID / sim)", "margin %", "limiting check")
-
-
-@dataclass(frozen=True)
-class RobotSection:
-    """One robot of a cell with several (``summary["robots"]``): its title, a sentence (model,
-    tool, frame 0, joints, cycle end, tool point deviation), its welds and its joints."""
-
-    title: str
-    text: str
-    welds: tuple[tuple[str, ...], ...]
-    joints: tuple[tuple[str, ...], ...]
-
-
-def robot_sections(summary: Mapping[str, Any], result: SizingResult | None = None
-                   ) -> list[RobotSection]:
-    """A section per robot of a cell with other robots (none for a cell with one): the
-    robot's name on its joints, welds and figures."""
-    robots = summary.get("robots") or {}
-    if not robots:
-        return []
-    sized = {j.joint: j for j in result.joints} if result is not None else {}
-    names = list(summary.get("joints", []))
-    track = summary.get("max_tracking_error_deg", [])
-    units = summary.get("joint_units") or ["deg"] * len(track)
-    out = []
-    for name, r in robots.items():
-        pos = ", ".join(f"{float(x):.6g}" for x in r.get("frame0_pos_mm", ()))
-        text = (f"{r['model']} with {r.get('tool') or 'no tool'}; frame 0 at {pos} mm; joints "
-                f"{', '.join(r['joints'])}; its last phase ends at {float(r['t_end_s']):.4g} s; "
-                f"tool point up to {_f(float(r['max_tcp_deviation_mm']))} mm off its reference.")
-        welds = tuple(
-            (str(w["phase"]), str(w.get("seam") or "-"), _f(float(w["seam_length_mm"])),
-             _f(float(w["set_speed_mm_s"])), _f(float(w["travel_speed_mm_s"])),
-             _f(float(w["max_path_deviation_mm"])), _f(float(w["torch_angle_error_deg"])))
-            for w in summary.get("weld", ()) if w.get("robot") == name)
-        joints = []
-        for jn in r["joints"]:
-            k = names.index(jn) if jn in names else None
-            tr = (f"{_f(float(track[k]), 3)} {units[k]}" if k is not None and k < len(track)
-                  else "n/a")
-            j = sized.get(jn)
-            if j is None:
-                joints.append((jn, tr, "n/a", "n/a", "n/a", "n/a"))
-                continue
-            joints.append((jn, tr, _pair(j, "peak_torque", unit=j.torque_unit),
-                           _pair(j, "rms_torque", unit=j.torque_unit), _pct(j.margin_pct),
-                           j.limiting.title if j.limiting else "n/a"))
-        out.append(RobotSection(title=f"{name} ({r['model']})", text=text, welds=welds,
-                                joints=tuple(joints)))
-    return out
-
-
 def _html_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     h = "".join(f"<th>{html.escape(x)}</th>" for x in head)
     body = []

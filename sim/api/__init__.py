@@ -11,11 +11,13 @@ from sim.api.results import (
     Collision,
     MechanismAxis,
     MechanismResult,
+    RobotResult,
     RunResult,
     Saturation,
     SelectedDrive,
     SizedJoint,
     SizingCheck,
+    WeldResult,
 )
 from sim.api.runs import evaluate, run, sweep
 from sim.pipeline.run import RunOptions
@@ -23,7 +25,7 @@ from sim.pipeline.sweep import SweepResult
 from sim.scenario import Scenario, load_scenario
 
 __all__ = [
-    "Check", "Collision", "MechanismAxis", "MechanismResult", "RunOptions", "RunResult",
-    "Saturation", "Scenario", "SelectedDrive",
-    "SizedJoint", "SizingCheck", "SweepResult", "evaluate", "load_scenario", "run", "sweep",
+    "Check", "Collision", "MechanismAxis", "MechanismResult", "RobotResult", "RunOptions",
+    "RunResult", "Saturation", "Scenario", "SelectedDrive", "SizedJoint", "SizingCheck",
+    "SweepResult", "WeldResult", "evaluate", "load_scenario", "run", "sweep",
 ]

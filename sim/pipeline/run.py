@@ -48,6 +48,7 @@ from sim.simulation.compile import BuiltCell, build
 from sim.simulation.metrics import make_summary
 from sim.simulation.motion import build_motion, check_motion_limits, check_size
 from sim.simulation.motion.axes import world_from_frame0 as frame0_in_world
+from sim.simulation.robot_metrics import add_robots
 from sim.simulation.simulate import simulate
 
 
@@ -243,6 +244,8 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
     arrays = rec.arrays
     with stages.stage("checks"):
         summary = make_summary(scenario, built, motion, rec, feedforward)
+        if motion.lanes:  # a cell's other robots measured as the first is
+            add_robots(summary, scenario, built, motion, rec)
         add_collisions(summary, built, motion, arrays)
     # post-processing reads the record in memory, never the files a run writes
     record = runfolder.RunRecord.from_arrays(
