@@ -199,14 +199,8 @@ def read_cell_file(path: str | Path) -> CellFile:
                             "stands on a track")
         robot_local = base
         base = pm.mount_in_world(pm.home) @ base
-    for s in solids.values():
-        if s.block.role == "part" or not s.block.collide:
-            continue
-        d = s.distance(base[:3, 3])
-        if d < -BASE_TOLERANCE_M:
-            raise CellError(f"{where}: robot.base_pos_mm: the robot base {rb.base_pos_mm} mm is "
-                            f"{-d * 1e3:.1f} mm inside {s.block.role} {s.block.name!r} "
-                            f"(objects[{s.index}]); stand it on the object, not in it")
+    _check_base_clear(solids, base, f"{where}: robot.base_pos_mm", "the robot base",
+                      rb.base_pos_mm)
     carried: dict[str, list[str]] = {name: [] for name in mechanisms}
     for obj, (mech, _) in mounted.items():
         carried[mech].append(obj)
@@ -214,18 +208,35 @@ def read_cell_file(path: str | Path) -> CellFile:
         carried[rb.on].append("robot")
     mechanisms = {name: dataclasses.replace(pm, carries=tuple(carried[name]))
                   for name, pm in mechanisms.items()}
-    partners = read_partners(spec, path, set(solids) | set(mechanisms))
+    partners = read_partners(spec, path, set(solids) | set(mechanisms), solids)
     return CellFile(path=path, spec=spec, solids=solids, base_pose=base, mechanisms=mechanisms,
                     mounted=mounted, robot_on=rb.on, robot_local=robot_local, partners=partners)
 
 
-def read_partners(spec: CellFileSpec, path: Path, taken: set[str]) -> dict[str, PlacedRobot]:
-    """The cell file's other robots (``[[robots]]``): model and home resolved; their tools are
-    resolved with the cell's (:func:`sim.cells.registry.load_cell`, :func:`partner_tool`).
+def _check_base_clear(solids: dict[str, Solid], base: NDArray[np.float64], key: str,
+                      what: str, given: list[float]) -> None:
+    """Refuse a robot base origin more than :data:`BASE_TOLERANCE_M` inside a fixture or
+    workpiece (``key`` starts the message: file and key)."""
+    for s in solids.values():
+        if s.block.role == "part" or not s.block.collide:
+            continue
+        d = s.distance(base[:3, 3])
+        if d < -BASE_TOLERANCE_M:
+            raise CellError(f"{key}: {what} {given} mm is {-d * 1e3:.1f} mm inside "
+                            f"{s.block.role} {s.block.name!r} (objects[{s.index}]); stand it on "
+                            "the object, not in it")
+
+
+def read_partners(spec: CellFileSpec, path: Path, taken: set[str],
+                  solids: dict[str, Solid] | None = None) -> dict[str, PlacedRobot]:
+    """The cell file's other robots (``[[robots]]``): model and home resolved, each base
+    checked against ``solids`` as the first robot's is; their tools are resolved with the
+    cell's (:func:`sim.cells.registry.load_cell`, :func:`partner_tool`).
 
     Raises:
         CellError: One line naming the file and the key (a name taken or reserved, an unknown
-            robot, home values that do not fit the robot).
+            robot, home values that do not fit the robot, a base inside a fixture or
+            workpiece).
     """
     from sim.robots.registry import resolve_robot
 
@@ -250,6 +261,8 @@ def read_partners(spec: CellFileSpec, path: Path, taken: set[str]) -> dict[str, 
         base = object_pose(rb.base_pos_mm, rb.base_euler_zyx_deg)
         if rb.mount == "ceiling":
             base[:3, :3] = base[:3, :3] @ np.diag([1.0, -1.0, -1.0])
+        _check_base_clear(solids or {}, base, f"{key}.base_pos_mm",
+                          f"the base of robot {rb.name!r}", rb.base_pos_mm)
         out[rb.name] = PlacedRobot(rb.name, robot, None, base, home, i)
     return out
 
