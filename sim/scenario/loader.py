@@ -56,6 +56,7 @@ from sim.scenario.schema import (
     ScenarioSpec,
     SimulationSpec,
     VideoSpec,
+    WeaveSpec,
 )
 
 if TYPE_CHECKING:
@@ -271,10 +272,20 @@ def _partners(spec: ScenarioSpec, cell: CellSpec | None, base: Path, where: str
     home all cycle."""
     placed = {} if cell is None else {p.name: p for p in cell.partners}
     for name in spec.robots:
-        if name not in placed:
-            what = (UnknownNameError("robot", name, list(placed)) if placed
-                    else "the cell has no other robots (a cell file's [[robots]])")
-            raise ScenarioError(f"{where}: robots.{name}: {what}")
+        if name in placed:
+            continue
+        if cell is None:
+            what = ("a scenario without a cell has one robot (a cell file's [[robots]] places "
+                    "the others)")
+        elif not placed:
+            what = (f"cell {cell.name} has no other robots (a cell file's [[robots]] places "
+                    "them)")
+        else:
+            close = difflib.get_close_matches(name, list(placed), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            what = (f"cell {cell.name} has no other robot {name!r}{hint}; its [[robots]]: "
+                    f"{', '.join(placed)}")
+        raise ScenarioError(f"{where}: robots.{name}: {what}")
     out = []
     for name, pr in placed.items():
         ws = spec.robots.get(name)
@@ -338,20 +349,36 @@ def _strip_tags(loc: tuple[Any, ...]) -> tuple[Any, ...]:
     return tuple(out)
 
 
-def _model_at(loc: tuple[Any, ...], raw: Any) -> type[BaseModel] | None:
-    """The pydantic model class that validates the table at ``loc`` (for key suggestions)."""
+def _model_at(loc: tuple[Any, ...], raw: Any,
+              root: type[BaseModel] = ScenarioSpec) -> type[BaseModel] | None:
+    """The pydantic model class that validates the table at ``loc`` (for key suggestions);
+    ``robots.<name>`` is a :class:`RobotWorkSpec`, whose phases and actions are looked up as
+    the top level's."""
     loc = _strip_tags(loc)
     if not loc:
-        return ScenarioSpec
+        return root
     head = loc[0]
-    if head == "phases" and len(loc) == 2 and isinstance(loc[1], int):
+    table = raw if isinstance(raw, dict) else {}
+    if head == "robots" and root is ScenarioSpec:
+        if len(loc) < 2:
+            return None
+        robots = table.get("robots")
+        work = robots.get(loc[1]) if isinstance(robots, dict) else None
+        return _model_at(loc[2:], work, RobotWorkSpec)
+    if head == "phases" and len(loc) in (2, 3) and isinstance(loc[1], int):
         try:
-            kind = raw["phases"][loc[1]].get("kind", "joint")
+            kind = table["phases"][loc[1]].get("kind", "joint")
         except (KeyError, IndexError, TypeError, AttributeError):
             return None
-        return PHASE_KINDS.get(kind) if isinstance(kind, str) else None
+        model = PHASE_KINDS.get(kind) if isinstance(kind, str) else None
+        if len(loc) == 3:  # a phase's own table: its weave
+            weaves = model is not None and loc[2] == "weave" and "weave" in model.model_fields
+            return WeaveSpec if weaves else None
+        return model
     if head == "actions" and len(loc) == 2:
         return ActionSpec
+    if root is not ScenarioSpec:
+        return None
     if head == "drives" and len(loc) == 2:
         return DriveOverrideSpec
     if len(loc) == 1:
