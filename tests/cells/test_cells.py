@@ -64,7 +64,8 @@ def test_cell_compiles_and_holds_home_without_warnings(cell, robot, mount):
     assert all(d.warning[i].number == 0 for i in range(len(d.warning))), \
         [(mujoco.mjtWarning(i).name, d.warning[i].number) for i in range(len(d.warning))]
     q = np.array([d.joint(j).qpos[0] for j in c.joint_names])
-    home = np.concatenate([c.home_q, c.axis_home])  # the robot's joints, then external axes
+    # the robot's joints, then external axes, then the other robots' joints ([[robots]])
+    home = np.concatenate([c.home_q, c.axis_home, *(cr.home_q for cr in c.partners)])
     assert np.abs(q - home).max() < 2e-3  # position servos hold home (sag < 0.1 deg, 2 mm)
     assert np.linalg.norm(d.site(c.tcp_site).xpos - tcp0) < 1e-3
     parts1 = np.array([d.body(p).xpos for p in c.parts]).reshape(-1, 3)
@@ -76,7 +77,8 @@ def test_cell_compiles_and_holds_home_without_warnings(cell, robot, mount):
 def test_cell_names_cameras_and_frames(cell, robot, mount):
     c, m = cell_and_model(cell, robot, mount)
     kinds = [("revolute",) * c.robot.n_joints] + [
-        tuple(a.kind for a in pm.spec.axes) for pm in c.mechanisms]
+        tuple(a.kind for a in pm.spec.axes) for pm in c.mechanisms] + [
+        ("revolute",) * cr.robot.n_joints for cr in c.partners]
     joint_type = {"revolute": mujoco.mjtJoint.mjJNT_HINGE,
                   "prismatic": mujoco.mjtJoint.mjJNT_SLIDE}
     for j, kind in zip(c.joint_names, [k for ks in kinds for k in ks], strict=True):
