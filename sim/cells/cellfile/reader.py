@@ -239,6 +239,7 @@ def read_partners(spec: CellFileSpec, path: Path, taken: set[str],
             workpiece).
     """
     from sim.robots.registry import resolve_robot
+    from sim.robots.spec import joint_ranges
 
     where = path.name
     out: dict[str, PlacedRobot] = {}
@@ -258,6 +259,12 @@ def read_partners(spec: CellFileSpec, path: Path, taken: set[str],
                 raise CellError(f"{key}.home_deg: {len(rb.home_deg)} values; robot "
                                 f"{robot.name} has {robot.n_joints} joints")
             home = np.deg2rad(np.asarray(rb.home_deg, dtype=float))
+            ranges = joint_ranges(robot)
+            for j, (qj, (lo, hi)) in enumerate(zip(home, ranges, strict=True)):
+                if not lo - 1e-9 <= qj <= hi + 1e-9:
+                    raise CellError(f"{key}.home_deg[{j}]: {rb.home_deg[j]:g} deg is outside "
+                                    f"joint {robot.joints[j]}'s range [{np.rad2deg(lo):g}, "
+                                    f"{np.rad2deg(hi):g}] deg (robot {robot.name})")
         base = object_pose(rb.base_pos_mm, rb.base_euler_zyx_deg)
         if rb.mount == "ceiling":
             base[:3, :3] = base[:3, :3] @ np.diag([1.0, -1.0, -1.0])
