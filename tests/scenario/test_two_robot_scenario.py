@@ -208,10 +208,22 @@ def test_hostile_work_of_another_robot_is_one_line_and_exit_2(case, tmp_path, ca
     assert re.search(pattern, lines[0]), lines[0]
 
 
-def test_another_robot_welding_a_seam_a_positioner_carries_is_refused(tmp_path, capsys):
-    rc, lines = _run(tmp_path, POSITIONER_SCENARIO, capsys, POSITIONER_CELL)
+_WELD_ONLY = POSITIONER_SCENARIO[:POSITIONER_SCENARIO.index('[[robots.r2.phases]]\nname = "to_seam"')] \
+    + POSITIONER_SCENARIO[POSITIONER_SCENARIO.index('[[robots.r2.phases]]\nname = "weld"'):]
+
+
+@pytest.mark.parametrize("text, where", [
+    (POSITIONER_SCENARIO, r"phases\[1\]\.to_seam"),  # its approach to the carried seam
+    (_WELD_ONLY, r"phases\[1\]\.seam"),  # the weld along it
+    (_WELD_ONLY.replace('kind = "circular"\nseam = "fillet"\norientation = "seam"',
+                        'kind = "linear"\nto_mm = [0, 0, 100]\nframe = "pipe"'),
+     r"phases\[1\]\.frame"),  # a move in its frame
+])
+def test_another_robot_working_on_what_a_positioner_carries_is_refused(tmp_path, capsys, text,
+                                                                       where):
+    rc, lines = _run(tmp_path, text, capsys, POSITIONER_CELL)
     assert rc == 2 and len(lines) == 1, lines
-    assert re.search(r"two\.toml: robots\.r2: phases\[3\]\.seam: 'fillet' is carried by "
+    assert re.search(r"two\.toml: robots\.r2: " + where + r": '(fillet|pipe)' is carried by "
                      r"'positioner'", lines[0]), lines
 
 

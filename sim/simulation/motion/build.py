@@ -179,13 +179,8 @@ def _plan_partners(scenario: Scenario, context: CartesianContext | None, t0: flo
         else:
             sub = scenario.partner_scenario(work)
             for ph in work.phases:
-                seam = getattr(ph, "seam", None)
-                if seam is not None and seam in context.seam_mechanism:
-                    raise ScenarioError(
-                        f"{scenario.source.name}: robots.{work.name}: phases[{ph.index}].seam: "
-                        f"{seam!r} is carried by {context.seam_mechanism[seam]!r}; a cell's "
-                        "other robots weld seams that stand still (the first robot welds with "
-                        "the cell's axes)")
+                _check_still(ph, context, f"{scenario.source.name}: robots.{work.name}: "
+                                          f"phases[{ph.index}]")
             lane = build_motion(dataclasses.replace(
                 sub, source=scenario.source.with_name(
                     f"{scenario.source.name}: robots.{work.name}")), ctx)
@@ -223,6 +218,28 @@ def _joint_phase_with_axes(phase: JointPhase, t: float, q: NDArray[np.float64] |
         placed = _timed_by_speed(placed, system, label)
     traj = plan_phase(placed, "")
     return PhaseMotion(placed, placed.t0, placed.t1, traj, knot_times=placed.times.copy())
+
+
+def _check_still(phase: object, context: CartesianContext, label: str) -> None:
+    """A cell's other robot works only on what stands still: a seam (``seam``, ``to_seam``)
+    or a frame (``frame``) a mechanism carries is refused (its motion is planned with the
+    cell at home; the first robot's phases move the axes)."""
+    target = getattr(phase, "target", None)
+    seams = [("seam", getattr(phase, "seam", None)),
+             ("to_seam", None if target is None else target.seam)]
+    frames = [("frame", getattr(phase, "frame", None)),
+              ("frame", None if target is None else target.frame)]
+    for key, seam in seams:
+        if seam is not None and seam in context.seam_mechanism:
+            raise ScenarioError(f"{label}.{key}: {seam!r} is carried by "
+                                f"{context.seam_mechanism[seam]!r}; a cell's other robots weld "
+                                "seams that stand still (the first robot welds with the cell's "
+                                "axes)")
+    for key, frame in frames:
+        if frame is not None and frame in context.frame_mechanism:
+            raise ScenarioError(f"{label}.{key}: {frame!r} is carried by "
+                                f"{context.frame_mechanism[frame]!r}; a cell's other robots "
+                                "move in frames that stand still")
 
 
 def _resolve_actions(scenario: Scenario, motion: Motion) -> list[tuple[float, str]]:
