@@ -12,9 +12,10 @@ the Cartesian paths) and checks the reference motion for:
   factors of ``det J``, :func:`sim.robots.kinematics.jacobian.singularity_measures`, below
   :data:`SINGULAR_LIMITS`), where the joint speeds a straight or circular tool path asks for
   grow without bound (a joint move through ``theta5 = 0`` is harmless and not reported);
-* ``collision``: a collision of the robot with itself, of the tool or the arm with the cell
-  (:mod:`sim.simulation.collisions`, every :data:`CHECK_DT_S`; parts stay where the cell puts
-  them: held parts are checked by ``cellsim run``, which records where they go).
+* ``collision``: a collision of the robot with itself, of the tool or the arm with the cell,
+  of two robots of the cell with each other (their bodies named ``robot/...`` and
+  ``r2/...``) (:mod:`sim.simulation.collisions`, every :data:`CHECK_DT_S`; parts stay where
+  the cell puts them: held parts are checked by ``cellsim run``, which records where they go).
 
 Each finding is one line naming the phase, the time and the value.
 """

@@ -2,7 +2,9 @@
 welding wire in the seam's workpieces while the arc is on (up to its radius, the phase's weave
 reach and :data:`WIRE_ARC_DEPTH_M`), the torch's touch sensing, the suction cup with the part
 it picks, parts resting, lifted off and set down; see :mod:`sim.simulation.collisions` for the
-full rules.
+full rules. In a cell with several robots each robot's wire and tool mount are declared for
+itself (its own phases, seams and arc: :meth:`MotionSamples.lane`; only the first robot picks);
+nothing is ever allowed between two robots.
 
 Owns the declarations and the mask of the contacts they allow (:func:`allowed_mask`).
 May import: :mod:`sim.core` and the check model.
@@ -19,6 +21,7 @@ from numpy.typing import NDArray
 from sim.core.intervals import true_runs
 from sim.simulation.collision_model import (
     CELL,
+    LEAD,
     LINK,
     PART,
     PENETRATION_TOLERANCE_M,
@@ -72,33 +75,44 @@ def allowed_contacts(cm: CollisionModel, samples: MotionSamples,
     out: list[AllowedContact] = [
         AllowedContact(frozenset({a}), frozenset({b}), np.ones(n, bool), reason)
         for a, b, reason in mount_overlaps(cm)]
-    work = frozenset(g for g, cg in cm.geoms.items() if cg.work)
-    torch = cell.tool is not None and cell.tool.kind == "torch"
-    if work and torch and cell.seam_objects:
+    # each robot's wire: the first robot's phases and arc, then each other robot's
+    robots = [(LEAD, cell.tool, samples.arc_on, samples.phase, phase_seams, weaves, "")]
+    for cr in cell.partners:
+        lane = samples.lane(cr.name)
+        robots.append((cr.name, cr.tool, lane.arc_on, lane.phase, lane.phase_seams, lane.weaves,
+                       f"{cr.name}: "))
+    lead_work: frozenset[int] = frozenset()
+    for name, tool, arc_on, phase, seams, phase_weaves, label in robots:
+        work = frozenset(g for g, cg in cm.geoms.items() if cg.work and cg.robot == name)
+        if name == LEAD:
+            lead_work = work
+        if tool is None or tool.kind != "torch" or not (work and cell.seam_objects):
+            continue
         all_work = frozenset().union(*(cm.ids(CELL, obj) for objs in cell.seam_objects.values()
                                        for obj in objs))
         radius = max(float(built.model.geom_size[g, 0]) for g in work)
         # the wire in the joint of the seam it welds, weaving included, while the arc is on
-        for k, seam in enumerate(phase_seams):
-            when = samples.arc_on & (samples.phase == k)
+        for k, seam in enumerate(seams):
+            when = arc_on & (phase == k)
             if not when.any():
                 continue
             objs = cell.seam_objects.get(seam, ()) if seam is not None else ()
             pieces = (frozenset().union(*(cm.ids(CELL, o) for o in objs)) if objs else all_work)
-            reach = 0.0 if weaves is None else float(weaves[k])
+            reach = 0.0 if phase_weaves is None else float(phase_weaves[k])
             depth = radius + reach + WIRE_ARC_DEPTH_M
             weaving = f" + weave {reach * 1e3:.1f} mm" if reach > 0 else ""
             out.append(AllowedContact(
-                work, pieces, when, f"wire in the joint of seam {seam!r}, arc on (up to "
+                work, pieces, when, f"{label}wire in the joint of seam {seam!r}, arc on (up to "
                 f"{depth * 1e3:.1f} mm: radius{weaving} + {WIRE_ARC_DEPTH_M * 1e3:g} mm)",
                 max_depth_m=depth))
         # the wire tip set on a workpiece, arc off included (touch sensing, the tip on the
         # root at a seam's start or end); deeper is a collision
-        touch = cell.tool.touch_depth_m
+        touch = tool.touch_depth_m
         out.append(AllowedContact(work, all_work, np.ones(n, bool),
-                                  f"wire touching a workpiece (up to {(radius + touch) * 1e3:.1f} "
-                                  f"mm: radius + touch depth {touch * 1e3:g} mm)",
-                                  max_depth_m=radius + touch))
+                                  f"{label}wire touching a workpiece (up to "
+                                  f"{(radius + touch) * 1e3:.1f} mm: radius + touch depth "
+                                  f"{touch * 1e3:g} mm)", max_depth_m=radius + touch))
+    work = lead_work  # the first robot picks (the others carry no suction gripper)
     # parts: at rest, lifted off, set down; the cup lip with the part it picks
     part_ids = {p: cm.ids(PART, p) for p in cell.parts}
     if not part_ids:
@@ -175,9 +189,18 @@ def mount_overlaps(cm: CollisionModel) -> list[tuple[int, int, str]]:
     cached = getattr(cm, "_mount_overlaps", None)
     if cached is not None:
         return list(cached)
+    found: list[tuple[int, int, str]] = []
+    for robot in cm.robots:
+        found += _mount_overlaps(cm, robot)
+    cm._mount_overlaps = tuple(found)  # type: ignore[attr-defined]
+    return found
+
+
+def _mount_overlaps(cm: CollisionModel, robot: str) -> list[tuple[int, int, str]]:
+    """:func:`mount_overlaps` of one robot's tool."""
     mujoco = mujoco_module()
     m = cm.model
-    tool = sorted(g for g, cg in cm.geoms.items() if cg.role == TOOL)
+    tool = sorted(g for g, cg in cm.geoms.items() if cg.role == TOOL and cg.robot == robot)
     found: list[tuple[int, int, str]] = []
     if tool:
         body = int(m.geom_bodyid[tool[0]])
@@ -185,7 +208,8 @@ def mount_overlaps(cm: CollisionModel) -> list[tuple[int, int, str]]:
             body = int(m.body_parentid[body])
         before = int(m.body_parentid[body])
         link = sorted(g for g, cg in cm.geoms.items()
-                      if cg.role == LINK and int(m.geom_bodyid[g]) == before)
+                      if cg.role == LINK and cg.robot == robot
+                      and int(m.geom_bodyid[g]) == before)
         if body != 0 and m.body_jntnum[body] == 1 and link:
             joint = int(m.body_jntadr[body])
             lo, hi = ((float(m.jnt_range[joint, 0]), float(m.jnt_range[joint, 1]))
@@ -206,11 +230,10 @@ def mount_overlaps(cm: CollisionModel) -> list[tuple[int, int, str]]:
                         continue  # already clear at some angle
                     dist = mujoco.mj_geomDistance(m, d, a, b, 1.0, fromto)
                     worst[(a, b)] = max(w, float(dist))
-            joint_name = m.joint(joint).name.removeprefix("robot/")
+            joint_name = m.joint(joint).name.removeprefix(f"{robot}/")
             for (a, b), w in worst.items():
                 if w <= -PENETRATION_TOLERANCE_M:
                     found.append((a, b, f"{cm.geoms[a].name} overlaps {cm.geoms[b].name} at "
                                   f"every angle of {joint_name} (at least {-w * 1e3:.1f} mm): "
                                   "the model's shapes meeting at the tool mount"))
-    cm._mount_overlaps = tuple(found)  # type: ignore[attr-defined]
     return found

@@ -2,6 +2,12 @@
 collisions are checked for (robot links, tool, cell objects, parts), the geoms' roles, and the
 scan that measures the pairs' distances at given samples of a motion.
 
+Every robot of the cell is checked: the first (prefix ``robot``) and each other robot
+(:attr:`sim.cells.Cell.partners`, prefix its name, ``r2/link3``, ``r2/tool/nozzle``). Each
+checked geom of a robot names its robot (:attr:`CheckGeom.robot`); a robot's links and tool
+are checked against the cell, the parts and every other robot's links and tool (tool against
+tool too), and against its own links as for a single robot.
+
 Owns what is checked and how a sample is measured (:class:`CollisionModel`,
 :class:`Contacts`, :func:`coarse_scan`); what may touch is
 :mod:`sim.simulation.allowed_contacts`', the search for collisions and clearance along a motion
@@ -33,6 +39,11 @@ CLEARANCE_RANGE_M = 0.1
 LINK, TOOL, CELL, PART = "link", "tool", "cell", "part"
 _BITS = {LINK: 1, TOOL: 2, CELL: 4, PART: 8}
 _AFFINITY = {LINK: 1 | 2 | 4 | 8, TOOL: 1 | 4 | 8, CELL: 1 | 2 | 8, PART: 1 | 2 | 4 | 8}
+#: With several robots a tool is checked against the other robots' tools too (a robot's own
+#: tool geoms share its last link's weld body: MuJoCo never pairs them).
+_AFFINITY_ROBOTS = {**_AFFINITY, TOOL: 1 | 2 | 4 | 8}
+#: The first robot's name (its MJCF prefix).
+LEAD = "robot"
 ROLE_CODE = {LINK: 0, TOOL: 1, CELL: 2, PART: 3}
 
 
@@ -47,6 +58,8 @@ class CheckGeom:
         owner: What a report names: the robot body, the tool body, the cell object or the part.
         work: A tool work geom (wire, cup lip).
         base: A geom of the robot's fixed base (left out of the arm's clearance).
+        robot: The robot a link or tool geom belongs to (``robot`` for the first, the cell's
+            name of another, ``r2``); None for the cell and the parts.
     """
 
     id: int
@@ -55,6 +68,7 @@ class CheckGeom:
     owner: str
     work: bool = False
     base: bool = False
+    robot: str | None = None
 
 
 @dataclass
@@ -67,6 +81,8 @@ class MotionSamples:
         phase: Phase index of each sample, (N,).
         arc_on: Arc on, (N,).
         suction: Suction on, (N,).
+        lanes: The cell's other robots' work on the same samples, by name (their phases and
+            arc); :attr:`phase` and :attr:`arc_on` are the first robot's.
     """
 
     t: NDArray[np.float64]
@@ -74,10 +90,39 @@ class MotionSamples:
     phase: NDArray[np.int64]
     arc_on: NDArray[np.bool_]
     suction: NDArray[np.bool_]
+    lanes: dict[str, LaneSamples] = field(default_factory=dict)
 
     @property
     def dt(self) -> float:
         return float(np.median(np.diff(self.t))) if self.t.size > 1 else 1.0
+
+    def lane(self, name: str) -> LaneSamples:
+        """Another robot's work (:attr:`lanes`); one phase following no seam, arc off, when
+        the samples do not say (a motion sampled without it)."""
+        got = self.lanes.get(name)
+        if got is not None:
+            return got
+        n = self.t.size
+        return LaneSamples(np.zeros(n, int), np.zeros(n, bool), ["cycle"], [None], [0.0])
+
+
+@dataclass
+class LaneSamples:
+    """Another robot's work on the samples of a :class:`MotionSamples`.
+
+    Attributes:
+        phase: Index of its phase at each sample, (N,).
+        arc_on: Its arc on, (N,).
+        phase_names: Its phases' names.
+        phase_seams: The seam each of its phases follows (None where it follows none).
+        weaves: Each of its phases' weave reach, m.
+    """
+
+    phase: NDArray[np.int64]
+    arc_on: NDArray[np.bool_]
+    phase_names: list[str]
+    phase_seams: list[str | None]
+    weaves: list[float]
 
 
 @dataclass(frozen=True)
@@ -142,16 +187,21 @@ class CollisionModel:
         self.built = built
         src = built.model
         cell = built.cell
-        tool_prefix = "robot/tool/"
-        work = {f"{tool_prefix}{g}" for g in (cell.tool.work_geoms if cell.tool else ())}
+        #: The cell's robots, the first one first: (name, tool).
+        self.robots: list[str] = [LEAD, *(cr.name for cr in cell.partners)]
+        tools = [cell.tool, *(cr.tool for cr in cell.partners)]
+        work = {f"{name}/tool/{g}" for name, tool in zip(self.robots, tools, strict=True)
+                for g in (tool.work_geoms if tool else ())}
         object_of = {g: obj for obj, geoms in cell.objects.items() for g in geoms}
         parts = set(cell.parts)
         geoms: dict[int, CheckGeom] = {}
         unnamed: dict[int, int] = {}
-        # the robot's base: the bodies welded to its root (the world's on the floor, a track's
+        # each robot's base: the bodies welded to its root (the world's on the floor, a track's
         # carriage when it stands on one)
-        root = next(b for b in range(1, src.nbody) if src.body(b).name.startswith("robot/"))
-        base_weld = int(src.body_weldid[root])
+        base_weld = {}
+        for name in self.robots:
+            root = next(b for b in range(1, src.nbody) if src.body(b).name.startswith(f"{name}/"))
+            base_weld[name] = int(src.body_weldid[root])
         moving_cell = {int(src.body_weldid[src.body(f"{pm.name}_{a.name}").id])
                        for pm in cell.mechanisms for a in pm.spec.axes}
         moving_cell |= {int(src.body(pm.mount_body).id) for pm in cell.mechanisms}
@@ -162,36 +212,47 @@ class CollisionModel:
             if not gname:
                 unnamed[body] = unnamed.get(body, 0) + 1
                 gname = f"{bname}#{unnamed[body] - 1}"
-            if gname.startswith(tool_prefix) or bname.startswith(tool_prefix):
-                geoms[g] = CheckGeom(g, gname, TOOL, bname, work=gname in work)
-            elif bname.startswith("robot/"):
+            robot = next((r for r in self.robots if bname.startswith(f"{r}/")
+                          or gname.startswith(f"{r}/tool/")), None)
+            if robot is not None and (gname.startswith(f"{robot}/tool/")
+                                      or bname.startswith(f"{robot}/tool/")):
+                geoms[g] = CheckGeom(g, gname, TOOL, bname, work=gname in work, robot=robot)
+            elif robot is not None:
                 if src.geom_group[g] == 3:
                     geoms[g] = CheckGeom(g, gname, LINK, bname,
-                                         base=bool(src.body_weldid[body] == base_weld))
+                                         base=bool(src.body_weldid[body] == base_weld[robot]),
+                                         robot=robot)
             elif bname in parts:
                 geoms[g] = CheckGeom(g, gname, PART, bname)
             elif src.geom_contype[g] | src.geom_conaffinity[g]:
                 if src.body_weldid[body] != 0 and int(src.body_weldid[body]) not in moving_cell:
-                    raise InternalError(f"cell body {bname!r} moves but is neither the robot nor "
+                    raise InternalError(f"cell body {bname!r} moves but is neither a robot nor "
                                         "a part: collision checks do not cover it")
                 geoms[g] = CheckGeom(g, gname, CELL, object_of.get(gname, gname))
         missing = work - {cg.name for cg in geoms.values() if cg.work}
         if missing:
-            raise InternalError(f"tool {cell.tool.name!r} declares work geoms it does not have: "
+            names = ", ".join(repr(t.name) for t in tools if t is not None)
+            raise InternalError(f"tool {names} declares work geoms it does not have: "
                                 f"{', '.join(sorted(missing))}")
         self.geoms = geoms
         self.model = self._masked(src, DETECTION_MARGIN_M, every=True)
-        self.range_model = self._masked(src, CLEARANCE_RANGE_M)
+        # several robots: every robot geom gets the clearance range too (a robot's distance to
+        # another is a clearance); its pairs with its own robot are left out of the scan
+        self.range_model = self._masked(src, CLEARANCE_RANGE_M, every=len(self.robots) > 1)
         self._data = mujoco.MjData(self.model)
         self._range_data = mujoco.MjData(self.range_model)
         n = src.ngeom
         self.role = np.full(n, -1)
         self.is_work = np.zeros(n, bool)
         self.is_base = np.zeros(n, bool)
+        #: Index in :attr:`robots` of each geom's robot (-1: the cell or a part), (ngeom,).
+        self.robot_of = np.full(n, -1)
         for g, cg in geoms.items():
             self.role[g] = ROLE_CODE[cg.role]
             self.is_work[g] = cg.work
             self.is_base[g] = cg.base
+            if cg.robot is not None:
+                self.robot_of[g] = self.robots.index(cg.robot)
 
     def _masked(self, src: Any, margin: float, every: bool = False) -> Any:
         """The cell recompiled with the check masks and ``margin`` on the cell and part geoms
@@ -210,19 +271,23 @@ class CollisionModel:
         if len(geoms) != src.ngeom or any(
                 g.name != src.geom(i).name for i, g in enumerate(geoms) if g.name):
             raise InternalError("the check model's geoms do not match the compiled cell's")
+        affinity = _AFFINITY_ROBOTS if len(self.robots) > 1 else _AFFINITY
         for i, g in enumerate(geoms):
             cg = self.geoms.get(i)
             g.contype = _BITS[cg.role] if cg else 0
-            g.conaffinity = _AFFINITY[cg.role] if cg else 0
+            g.conaffinity = affinity[cg.role] if cg else 0
             g.margin = margin if cg and (every or cg.role in (CELL, PART)) else 0.0
             g.gap = 0.0
         spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
         for body in spec.bodies:
-            if body.name.startswith("robot/") and body.joints and body.parent is not None:
+            own = next((f"{r}/" for r in self.robots if body.name.startswith(f"{r}/")), None)
+            if own is None:
+                continue
+            if body.joints and body.parent is not None:
                 ex = spec.add_exclude()
                 ex.bodyname1, ex.bodyname2 = body.parent.name, body.name
-            if (body.name.startswith("robot/") and body.parent is not None
-                    and body.parent.name and not body.parent.name.startswith("robot/")):
+            if (body.parent is not None and body.parent.name
+                    and not body.parent.name.startswith(own)):
                 # a robot standing on a track: its base sits on the carriage (the bodies up to
                 # the carriage's jointed link)
                 up = body.parent
@@ -259,10 +324,13 @@ class CollisionModel:
             best = max(best, r)
         return best
 
-    def ids(self, role: str | None = None, owner: str | None = None) -> frozenset[int]:
-        """Ids of the checked geoms with that role and/or owner."""
+    def ids(self, role: str | None = None, owner: str | None = None,
+            robot: str | None = None) -> frozenset[int]:
+        """Ids of the checked geoms with that role and/or owner (and of that robot)."""
         return frozenset(g for g, cg in self.geoms.items()
-                         if (role is None or cg.role == role) and (owner is None or cg.owner == owner))
+                         if (role is None or cg.role == role)
+                         and (owner is None or cg.owner == owner)
+                         and (robot is None or cg.robot == robot))
 
     def scan(self, qpos: NDArray[np.float64], samples: NDArray[np.int64], *,
              ranged: bool = False) -> Contacts:
@@ -288,6 +356,9 @@ class CollisionModel:
             geom = d.contact.geom[:n]
             if ranged:
                 keep = d.contact.dist[:n] < CLEARANCE_RANGE_M
+                if len(self.robots) > 1:  # a robot with itself: penetrations only, as alone
+                    r1, r2 = self.robot_of[geom[:, 0]], self.robot_of[geom[:, 1]]
+                    keep &= ~((r1 == r2) & (r1 >= 0) & (d.contact.dist[:n] >= 0.0))
                 if keep.any():
                     out_s.append(np.full(int(keep.sum()), i))
                     out_g1.append(geom[keep, 0].copy())
@@ -303,8 +374,8 @@ class CollisionModel:
                     out_d.append(np.array([dist]))
         if not out_s:
             return Contacts()
-        a, b = np.concatenate(out_g1), np.concatenate(out_g2)
-        g1, g2 = np.minimum(a, b), np.maximum(a, b)
+        ga, gb = np.concatenate(out_g1), np.concatenate(out_g2)
+        g1, g2 = np.minimum(ga, gb), np.maximum(ga, gb)
         s, dist = np.concatenate(out_s), np.concatenate(out_d)
         # one row per (sample, pair): the closest of the pair's contact points
         order = np.lexsort((dist, g2, g1, s))

@@ -1,4 +1,4 @@
-"""Collisions and clearance along a motion: the robot, its tool, the cell and the parts.
+"""Collisions and clearance along a motion: the robots, their tools, the cell and the parts.
 
 The physics model keeps contacts that are part of the work only (parts on fixtures, the suction
 cup on a part): a contact of the arm or the torch with the cell would push back and pollute the
@@ -14,9 +14,15 @@ What is checked (:class:`CollisionModel`):
 * **pairs**: robot link with robot link but each link with its parent (they meet at their
   joint; the robot's own ``<exclude>`` pairs apply too), tool with robot link (every link but
   the one it is mounted on), robot or tool with any cell object or part, part with cell object
-  or part.
+  or part;
+* **several robots** (a cell's ``[[robots]]``, prefix their name: ``r2/link3``,
+  ``r2/tool/nozzle``): each robot's links and tool as above, and against every other robot's
+  links and tool (link with link, tool with link, tool with tool); two robots' bases both
+  welded to the floor are not paired (neither moves).
 
-Allowed contacts are declared (:func:`allowed_contacts`), not guessed:
+Allowed contacts are declared (:func:`allowed_contacts`), not guessed (each robot's wire
+and tool mount for itself, on its own phases and arc: :class:`MotionSamples` ``lanes``; nothing
+between two robots is ever allowed):
 
 * the tool's *work geoms* (:attr:`sim.cells.tools.ToolSpec.work_geoms`): the welding wire
   in the joint while the arc is on: with the workpieces of the seam the phase welds
@@ -60,7 +66,11 @@ contact may reach where that declaration holds all through. Collisions are repor
 intervals (:func:`find_collisions`): ``t0``, ``t1`` (s), the ``phase`` at ``t0`` and every
 phase the interval spans (``phases``), the two ``bodies`` (robot body, tool body, cell object
 or part), the worst geom pair (``geoms``), every geom involved (``all_geoms``, for the video)
-and the worst penetration ``depth_mm`` at ``t_worst``.
+and the worst penetration ``depth_mm`` at ``t_worst``. In a cell with several robots each
+interval also names the ``robots`` of its two bodies (None for the cell or a part), each one's
+phase (``robot_phases``) and says it in a line (``message``: ``"robot link5 against r2 tool
+nozzle at 2.000 s (...)"``); two robots' bodies are kind ``robot_robot``, the first robot's
+first. The coarse scan bounds each robot's geoms by its own joints (:func:`motion_bound`).
 
 Clearance (:func:`clearance`): per phase, the smallest distance from the tool (its geoms but the
 work geoms: nozzle and torch body) and from the arm (the links but the fixed base) to any cell
@@ -68,7 +78,11 @@ object or part, allowed contacts left out. MuJoCo's narrow phase computes the di
 pairs closer than :data:`CLEARANCE_RANGE_M` (the check model's geom margin); the scan runs every
 :data:`CLEARANCE_STRIDE_S` and is refined at every sample around each phase's closest sample. A
 phase farther than the range reports ``null``; a phase closer than the scenario's
-``simulation.clearance_mm`` (default 5 mm) is a failed warning check of the verdict.
+``simulation.clearance_mm`` (default 5 mm) is a failed warning check of the verdict. With
+several robots, each other robot gets the same entries per phase of its own (``"r2: weld"``),
+and each pair of robots its distance per phase of the first robot (``"weld: robot / r2"``,
+every geom of the two: tool with the other robot, ``tool_mm``; link with link, ``arm_mm``): a
+near miss between two robots is a clearance warning naming both.
 
 Owns the search along a motion (collision intervals, clearance) and the entry points
 (:func:`check_motion`, the samples of a motion); the check model is
@@ -100,6 +114,7 @@ from sim.simulation.collision_model import (  # the check model, importable from
     CELL,
     CLEARANCE_RANGE_M,
     DETECTION_MARGIN_M,  # noqa: F401
+    LEAD,
     LINK,
     PART,
     PENETRATION_TOLERANCE_M,
@@ -109,6 +124,7 @@ from sim.simulation.collision_model import (  # the check model, importable from
     CheckGeom,  # noqa: F401
     CollisionModel,
     Contacts,
+    LaneSamples,
     MotionSamples,
     coarse_scan,
     mujoco_module,
@@ -140,8 +156,12 @@ def _intervals_to_check(cm: CollisionModel, samples: MotionSamples, coarse: NDAr
         return [(int(coarse[0]), int(coarse[0]))] if len(coarse) else []
     starts = coarse[:-1]
     bounds = motion_bound(cm, samples, coarse)
-    # too fast for the coarse distances to tell
-    need = (bounds[LINK] + np.maximum(bounds[LINK], bounds[PART])) >= CLEARANCE_RANGE_M
+    # too fast for the coarse distances to tell: a pair beyond the range at both ends (not in
+    # the scan) may come closer by its two geoms' bounds, the largest a robot's and another
+    # robot's, a part's or a cell mechanism's
+    robots = [bounds[LINK], *(bounds[f"{r}/"] for r in cm.robots[1:])]
+    hi = np.maximum.reduce([*robots, bounds[PART], bounds[CELL]])
+    need = (np.maximum.reduce(robots) + hi) >= CLEARANCE_RANGE_M
     through = [(rule, np.logical_and.reduceat(rule.when, starts) & rule.when[coarse[1:]])
                for rule in allowed]
     pos = np.searchsorted(coarse, scan.s)
@@ -166,7 +186,7 @@ def _intervals_to_check(cm: CollisionModel, samples: MotionSamples, coarse: NDAr
 def _kind(cm: CollisionModel, g1: int, g2: int) -> str:
     roles = {cm.geoms[g1].role, cm.geoms[g2].role}
     if roles <= {LINK, TOOL}:
-        return "self"
+        return "self" if cm.geoms[g1].robot == cm.geoms[g2].robot else "robot_robot"
     if PART in roles and roles & {LINK, TOOL}:
         return "part"
     if PART in roles:
@@ -175,10 +195,25 @@ def _kind(cm: CollisionModel, g1: int, g2: int) -> str:
 
 
 def _ordered(cm: CollisionModel, g1: int, g2: int) -> tuple[int, int]:
-    """Robot side first (link, tool, part, cell)."""
+    """Robot side first (link, tool, part, cell); two robots: in the cell's order (the first
+    robot first)."""
+    ra, rb = int(cm.robot_of[g1]), int(cm.robot_of[g2])
+    if ra >= 0 and rb >= 0 and ra != rb:
+        return (g1, g2) if ra < rb else (g2, g1)
     order = {LINK: 0, TOOL: 1, PART: 2, CELL: 3}
     a, b = cm.geoms[g1], cm.geoms[g2]
     return (g1, g2) if order[a.role] <= order[b.role] else (g2, g1)
+
+
+def describe_geom(cm: CollisionModel, g: int) -> str:
+    """A checked geom as a message names it: ``r2 tool nozzle``, ``robot link5``, an object's
+    name, ``part box``."""
+    cg = cm.geoms[g]
+    if cg.robot is not None and cg.role == TOOL:
+        return f"{cg.robot} tool {cg.name.removeprefix(f'{cg.robot}/tool/')}"
+    if cg.robot is not None:
+        return f"{cg.robot} {cg.owner.removeprefix(f'{cg.robot}/')}"
+    return f"part {cg.owner}" if cg.role == PART else cg.owner
 
 
 def coarse_samples(samples: MotionSamples) -> NDArray[np.int64]:
@@ -193,8 +228,9 @@ def coarse_samples(samples: MotionSamples) -> NDArray[np.int64]:
 def motion_bound(cm: CollisionModel, samples: MotionSamples, coarse: NDArray[np.int64]
                  ) -> dict[str, NDArray[np.float64]]:
     """Upper bounds of how far a checked geom of each role moves within each coarse interval
-    (between any two of its samples), m, by role (``link`` and ``tool``: the robot's bound;
-    ``part``; ``cell``: 0).
+    (between any two of its samples), m, by role (``link`` and ``tool``: the first robot's
+    bound; ``part``; ``cell``: its mechanisms', 0 without) and, for each other robot of the
+    cell, by its prefix (``r2/``: its links' and tool's bound, from its own joints).
 
     Interval ``k`` runs from sample ``coarse[k]`` to ``coarse[k + 1]``. A robot joint turning
     by ``dq`` moves a point at most ``dq`` times its distance from the joint's axis, bounded
@@ -224,9 +260,16 @@ def motion_bound(cm: CollisionModel, samples: MotionSamples, coarse: NDArray[np.
     robot = np.zeros(len(starts))
     cell = np.zeros(len(starts))  # the cell's mechanisms move their solids and what they carry
     n_arm = cm.built.cell.robot.n_joints
+    # the other robots' joints move their own geoms only
+    partner_of = {i: name for name, cols in cm.built.partner_cols.items()
+                  for i in range(cols.start, cols.stop)}
+    partners = {f"{name}/": np.zeros(len(starts)) for name in cm.built.partner_cols}
     for i, (j, adr) in enumerate(zip(cm.built.joint_ids, cm.built.robot_qpos, strict=True)):
         slide = m.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE  # moves every point as far
         move = span(qpos[:, adr]) * (1.0 if slide else cm.reach_from_joint(int(j)))
+        if i in partner_of:
+            partners[f"{partner_of[i]}/"] += move
+            continue
         robot += move
         if i >= n_arm:
             cell += move
@@ -242,15 +285,25 @@ def motion_bound(cm: CollisionModel, samples: MotionSamples, coarse: NDArray[np.
         turn = np.maximum.reduceat(ang, starts)
         turn = np.maximum(turn, ang[ends])
         part = np.maximum(part, move + r * 2.0 * turn)  # any two samples: twice from the start
-    return {LINK: robot, TOOL: robot, PART: part, CELL: cell}
+    return {LINK: robot, TOOL: robot, PART: part, CELL: cell, **partners}
 
 
 def _pair_reach(cm: CollisionModel, bounds: dict[str, NDArray[np.float64]],
                 g1: NDArray[np.int64], g2: NDArray[np.int64], k: NDArray[np.int64]
                 ) -> NDArray[np.float64]:
     """How much closer each pair (geoms g1, g2) can get within interval k, m."""
-    table = np.stack([bounds[LINK], bounds[TOOL], bounds[CELL], bounds[PART]])  # by role code
-    return table[cm.role[g1], k] + table[cm.role[g2], k]
+    table, row = _bound_table(cm, bounds)
+    return table[row[g1], k] + table[row[g2], k]
+
+
+def _bound_table(cm: CollisionModel, bounds: dict[str, NDArray[np.float64]]
+                 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """The bounds of :func:`motion_bound` as a table (one row per role, then one per other
+    robot) and each geom's row in it, (ngeom,)."""
+    table = np.stack([bounds[LINK], bounds[TOOL], bounds[CELL], bounds[PART],  # by role code
+                      *(bounds[f"{r}/"] for r in cm.robots[1:])])
+    row = np.where(cm.robot_of > 0, len(ROLE_CODE) - 1 + cm.robot_of, cm.role)
+    return table, row
 
 
 def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
@@ -288,7 +341,7 @@ def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Seq
             w = sel[int(np.argmin(c.dist[sel]))]
             a, b = _ordered(cm, int(c.g1[w]), int(c.g2[w]))
             names = sorted({cm.geoms[int(g)].name for g in np.concatenate([c.g1[sel], c.g2[sel]])})
-            out.append({
+            entry: dict[str, Any] = {
                 "t0": float(samples.t[lo]), "t1": float(samples.t[hi]),
                 "phase": phase_names[int(samples.phase[lo])],
                 "phases": [phase_names[int(k)] for k in dict.fromkeys(samples.phase[lo:hi + 1])],
@@ -298,8 +351,29 @@ def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Seq
                 "all_geoms": names,
                 "depth_mm": float(-c.dist[w] * 1e3),
                 "t_worst": float(samples.t[c.s[w]]),
-            })
+            }
+            if len(cm.robots) > 1:  # several robots: which, in which of its phases, and a line
+                entry.update(_robots_named(cm, samples, phase_names, a, b, int(lo)))
+                entry["message"] = (f"{describe_geom(cm, a)} against {describe_geom(cm, b)} at "
+                                    f"{entry['t0']:.3f} s ({entry['t0']:.3f}-{entry['t1']:.3f} s, "
+                                    f"{entry['depth_mm']:.1f} mm deep)")
+            out.append(entry)
     return sorted(out, key=lambda e: (e["t0"], e["bodies"]))
+
+
+def _robots_named(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
+                  a: int, b: int, i: int) -> dict[str, Any]:
+    """``robots``: the robot of each geom of a pair (None for the cell or a part), and
+    ``robot_phases``: each of them's phase at sample ``i``."""
+    robots = [cm.geoms[a].robot, cm.geoms[b].robot]
+    phases = {}
+    for r in robots:
+        if r == LEAD:
+            phases[r] = phase_names[int(samples.phase[i])]
+        elif r is not None:
+            lane = samples.lane(r)
+            phases[r] = lane.phase_names[int(lane.phase[i])]
+    return {"robots": robots, "robot_phases": phases}
 
 
 def clearance(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
@@ -314,56 +388,128 @@ def clearance(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[
     The coarse scan is refined at every sample around each dip of the distance (a coarse sample
     closer than both neighbours, plateaus counted once) that could hide a value below the
     phase's coarse minimum (:func:`motion_bound`), the :data:`MAX_DIPS` deepest per phase.
+
+    With several robots, the first robot's entries come first, then each other robot's, per
+    phase of its own (``phase`` ``"r2: weld"``, ``robot``), then each pair of robots', per
+    phase of the first robot (``phase`` ``"weld: robot / r2"``, ``robots``): ``tool_mm``
+    between a tool and the other robot (its tool or links, the wire included), ``arm_mm``
+    between their links.
     """
     coarse = coarse_samples(samples)
     if scanned is None:
         scanned = coarse_scan(cm, samples.qpos, coarse)
     bounds = motion_bound(cm, samples, coarse) if len(coarse) > 1 else None
-    # robot against cell or part: how much closer within each interval
-    bound = (bounds[LINK] + bounds[PART]) if bounds is not None else np.zeros(0)
+    subjects = _subjects(cm, samples, phase_names, bounds)
     c = _clearance_rows(cm, scanned, allowed)
     pos_of = {int(i): k for k, i in enumerate(coarse)}
     refine: set[int] = set()
-    for grp, rows in _group_rows(cm, c).items():
-        # the group's smallest distance at each coarse sample (the range where none is closer)
-        d = np.full(len(coarse), CLEARANCE_RANGE_M)
-        np.minimum.at(d, [pos_of[int(i)] for i in c.s[rows]], c.dist[rows])
-        ph = samples.phase[coarse]
-        for k in range(len(phase_names)):
-            idx = np.flatnonzero(ph == k)
-            if idx.size == 0 or np.min(d[idx]) >= CLEARANCE_RANGE_M:
-                continue
-            best = float(np.min(d[idx]))
-            left = np.concatenate([[np.inf], d[idx][:-1]])
-            right = np.concatenate([d[idx][1:], [np.inf]])
-            dips = idx[(d[idx] < left) & (d[idx] <= right)]
-            slack = np.array([max(bound[j - 1] if j > 0 else 0.0,
-                                  bound[j] if j < len(bound) else 0.0) for j in dips])
-            dips = dips[d[dips] - slack < best]
-            for j in dips[np.argsort(d[dips])][:MAX_DIPS]:
-                lo = int(coarse[max(j - 1, 0)])
-                hi = int(coarse[min(j + 1, len(coarse) - 1)])
-                refine.update(range(lo, hi + 1))
+    subject_of = _subject_of(cm, c)
+    for si, subject in enumerate(subjects):
+        bound = subject.bound
+        for grp_rows in _group_rows(cm, c).values():
+            rows = grp_rows & (subject_of == si)
+            # the group's smallest distance at each coarse sample (the range where none is
+            # closer)
+            d = np.full(len(coarse), CLEARANCE_RANGE_M)
+            np.minimum.at(d, [pos_of[int(i)] for i in c.s[rows]], c.dist[rows])
+            ph = subject.phase[coarse]
+            for k in range(len(subject.names)):
+                idx = np.flatnonzero(ph == k)
+                if idx.size == 0 or np.min(d[idx]) >= CLEARANCE_RANGE_M:
+                    continue
+                best = float(np.min(d[idx]))
+                left = np.concatenate([[np.inf], d[idx][:-1]])
+                right = np.concatenate([d[idx][1:], [np.inf]])
+                dips = idx[(d[idx] < left) & (d[idx] <= right)]
+                slack = np.array([max(bound[j - 1] if j > 0 else 0.0,
+                                      bound[j] if j < len(bound) else 0.0) for j in dips])
+                dips = dips[d[dips] - slack < best]
+                for j in dips[np.argsort(d[dips])][:MAX_DIPS]:
+                    lo = int(coarse[max(j - 1, 0)])
+                    hi = int(coarse[min(j + 1, len(coarse) - 1)])
+                    refine.update(range(lo, hi + 1))
     fine = (_clearance_rows(cm, cm.scan(samples.qpos, np.array(sorted(refine), int),
                                         ranged=True), allowed) if refine else Contacts())
     both = Contacts.concat([c, fine])
     rows_by = _group_rows(cm, both)
+    subject_of = _subject_of(cm, both)
     out = []
-    for k, name in enumerate(phase_names):
-        entry: dict[str, Any] = {"phase": name}
-        for grp in ("tool", "arm"):
-            sel = rows_by[grp] & (samples.phase[both.s] == k)
-            if sel.any():
-                r = np.flatnonzero(sel)[int(np.argmin(both.dist[sel]))]
-                a, b = _ordered(cm, int(both.g1[r]), int(both.g2[r]))
-                entry[f"{grp}_mm"] = max(0.0, float(both.dist[r] * 1e3))
-                entry[f"{grp}_pair"] = [cm.geoms[a].name, cm.geoms[b].name]
-                entry[f"{grp}_bodies"] = [cm.geoms[a].owner, cm.geoms[b].owner]
-                entry[f"{grp}_t"] = float(samples.t[both.s[r]])
-            else:
-                entry[f"{grp}_mm"] = None
-        out.append(entry)
+    for si, subject in enumerate(subjects):
+        for k, name in enumerate(subject.names):
+            entry: dict[str, Any] = {"phase": subject.label.format(phase=name), **subject.keys}
+            for grp in ("tool", "arm"):
+                sel = rows_by[grp] & (subject_of == si) & (subject.phase[both.s] == k)
+                if sel.any():
+                    r = np.flatnonzero(sel)[int(np.argmin(both.dist[sel]))]
+                    a, b = _ordered(cm, int(both.g1[r]), int(both.g2[r]))
+                    entry[f"{grp}_mm"] = max(0.0, float(both.dist[r] * 1e3))
+                    entry[f"{grp}_pair"] = [cm.geoms[a].name, cm.geoms[b].name]
+                    entry[f"{grp}_bodies"] = [cm.geoms[a].owner, cm.geoms[b].owner]
+                    entry[f"{grp}_t"] = float(samples.t[both.s[r]])
+                else:
+                    entry[f"{grp}_mm"] = None
+            out.append(entry)
     return out
+
+
+@dataclass
+class _Subject:
+    """What a clearance entry measures: a robot's distance to the cell and the parts, or two
+    robots' distance to each other.
+
+    Attributes:
+        robots: The robot (one index in ``cm.robots``) or the two robots.
+        phase: The phase each sample counts in (the robot's; a pair: the first robot's), (N,).
+        names: Those phases' names.
+        label: The entries' ``phase``, ``{phase}`` standing for the phase's name.
+        keys: What else the entries say (the robot or robots).
+        bound: How much closer the pair of geoms can get within each coarse interval, m.
+    """
+
+    robots: tuple[int, ...]
+    phase: NDArray[np.int64]
+    names: Sequence[str]
+    label: str
+    keys: dict[str, Any]
+    bound: NDArray[np.float64]
+
+
+def _subjects(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
+              bounds: dict[str, NDArray[np.float64]] | None) -> list[_Subject]:
+    """The clearance entries' subjects: the first robot against the cell, each other robot
+    against it, each pair of robots (:func:`clearance`)."""
+    def bound(r: int) -> NDArray[np.float64]:
+        assert bounds is not None
+        return bounds[LINK] if r == 0 else bounds[f"{cm.robots[r]}/"]
+
+    none = np.zeros(0)
+    # the first robot: as with a single robot (against the cell or a part)
+    out = [_Subject((0,), samples.phase, phase_names, "{phase}", {},
+                    (bounds[LINK] + bounds[PART]) if bounds is not None else none)]
+    for r, name in enumerate(cm.robots[1:], start=1):
+        lane = samples.lane(name)
+        out.append(_Subject((r,), lane.phase, lane.phase_names, f"{name}: {{phase}}",
+                            {"robot": name},
+                            (bound(r) + np.maximum(bounds[PART], bounds[CELL]))
+                            if bounds is not None else none))
+    for ra in range(len(cm.robots)):
+        for rb in range(ra + 1, len(cm.robots)):
+            a, b = cm.robots[ra], cm.robots[rb]
+            out.append(_Subject((ra, rb), samples.phase, phase_names,
+                                f"{{phase}}: {a} / {b}", {"robots": [a, b]},
+                                (bound(ra) + bound(rb)) if bounds is not None else none))
+    return out
+
+
+def _subject_of(cm: CollisionModel, c: Contacts) -> NDArray[np.int64]:
+    """The subject (:func:`_subjects`) of each clearance row: its robot's index for a robot
+    against the cell or a part, then one per pair of robots."""
+    r1, r2 = cm.robot_of[c.g1], cm.robot_of[c.g2]
+    n = len(cm.robots)
+    lo, hi = np.minimum(r1, r2), np.maximum(r1, r2)
+    # pair (a, b), a < b: after the n robots, in the order of _subjects
+    pair = n + lo * n - lo * (lo + 1) // 2 + (hi - lo - 1)
+    return np.where(lo >= 0, pair, hi).astype(int)
 
 
 def _phase_ends(samples: MotionSamples) -> NDArray[np.int64]:
@@ -374,17 +520,21 @@ def _phase_ends(samples: MotionSamples) -> NDArray[np.int64]:
 
 def _clearance_rows(cm: CollisionModel, c: Contacts, allowed: Sequence[AllowedContact]
                     ) -> Contacts:
-    """Pairs of the robot (tool but its work geoms, links but the base) with the cell or a part,
-    leaving out allowed pairs and the tool near a part it may touch."""
+    """Pairs of a robot (tool but its work geoms, links but the base) with the cell or a part,
+    and pairs of two robots' geoms (every geom), leaving out allowed pairs and the tool near a
+    part it may touch."""
     r1, r2 = cm.role[c.g1], cm.role[c.g2]
     robot = ROLE_CODE[LINK], ROLE_CODE[TOOL]
     world = ROLE_CODE[CELL], ROLE_CODE[PART]
     keep = ((np.isin(r1, robot) & np.isin(r2, world)) | (np.isin(r2, robot) & np.isin(r1, world)))
     keep &= ~(cm.is_work[c.g1] | cm.is_work[c.g2] | cm.is_base[c.g1] | cm.is_base[c.g2])
+    if len(cm.robots) > 1:
+        o1, o2 = cm.robot_of[c.g1], cm.robot_of[c.g2]
+        keep |= (o1 >= 0) & (o2 >= 0) & (o1 != o2)
     c = c.select(keep)
     ok = allowed_mask(c, allowed)
     # the whole tool near a part its lip may touch: picking, not a clearance
-    tool, parts = cm.ids(TOOL), cm.ids(PART)
+    tool, parts = cm.ids(TOOL, robot=LEAD), cm.ids(PART)
     for rule in allowed:
         if rule.a & tool and rule.b <= parts and c.s.size:
             ok |= AllowedContact(tool, rule.b, rule.when, rule.reason).mask(c.s, c.g1, c.g2)
@@ -392,9 +542,11 @@ def _clearance_rows(cm: CollisionModel, c: Contacts, allowed: Sequence[AllowedCo
 
 
 def _group_rows(cm: CollisionModel, c: Contacts) -> dict[str, NDArray[np.bool_]]:
+    """Clearance rows by group: ``tool`` (a tool geom in the pair), ``arm`` (a link and no
+    tool)."""
     tool = (cm.role[c.g1] == ROLE_CODE[TOOL]) | (cm.role[c.g2] == ROLE_CODE[TOOL])
     link = (cm.role[c.g1] == ROLE_CODE[LINK]) | (cm.role[c.g2] == ROLE_CODE[LINK])
-    return {"tool": tool, "arm": link}
+    return {"tool": tool, "arm": link & ~tool}
 
 
 # --------------------------------------------------------------------------------------------
@@ -428,13 +580,38 @@ def check_motion(built: BuiltCell, samples: MotionSamples, phase_names: Sequence
     return CollisionReport(collisions, clear, sorted({a.reason for a in allowed}))
 
 
-def samples_from_arrays(arrays: Any) -> MotionSamples:
-    """The recorded motion of a run (``t``, ``qpos``, ``phase``, ``arc_on``, ``suction``)."""
+def samples_from_arrays(arrays: Any, motion: Any = None) -> MotionSamples:
+    """The recorded motion of a run (``t``, ``qpos``, ``phase``, ``arc_on``, ``suction``; each
+    other robot's ``<name>_arc_on``, its phases from ``motion``'s lanes when given:
+    :func:`lane_samples`)."""
     t = np.asarray(arrays["t"], dtype=float)
+    names = ([name for name, _ in motion.lanes] if motion is not None else
+             [k.removesuffix("_arc_on") for k in arrays if k.endswith("_arc_on")])
+    lanes = {}
+    for name in names:
+        lane = dict(motion.lanes)[name] if motion is not None else None
+        arc = (np.asarray(arrays[f"{name}_arc_on"]).astype(bool) if f"{name}_arc_on" in arrays
+               else None)
+        lanes[name] = lane_samples(t, lane, arc)
     return MotionSamples(t, np.asarray(arrays["qpos"], dtype=float),
                          np.asarray(arrays["phase"]).astype(int),
                          np.asarray(arrays["arc_on"]).astype(bool),
-                         np.asarray(arrays["suction"]).astype(bool))
+                         np.asarray(arrays["suction"]).astype(bool), lanes)
+
+
+def lane_samples(t: NDArray[np.float64], lane: Any = None,
+                 arc_on: NDArray[np.bool_] | None = None) -> LaneSamples:
+    """Another robot's work at times ``t``: its phases, their seams and weaves from its
+    motion (``lane``, a :class:`sim.simulation.motion.Motion` of ``Motion.lanes``; None: one
+    phase ``cycle`` following no seam), its arc from ``arc_on`` (None: from the motion, off
+    without one)."""
+    if lane is None:
+        return LaneSamples(np.zeros(t.size, int),
+                           np.zeros(t.size, bool) if arc_on is None else arc_on,
+                           ["cycle"], [None], [0.0])
+    return LaneSamples(np.asarray(lane.phase_index(t)).astype(int),
+                       lane.tool_state(t, "arc") if arc_on is None else arc_on,
+                       [pm.name for pm in lane.phases], phase_seams(lane), phase_weaves(lane))
 
 
 def samples_from_motion(built: BuiltCell, motion: Any, dt: float) -> MotionSamples:
@@ -451,7 +628,8 @@ def samples_from_motion(built: BuiltCell, motion: Any, dt: float) -> MotionSampl
     qpos = np.tile(base, (t.size, 1))
     qpos[:, built.robot_qpos] = motion.at(t).q
     return MotionSamples(t, qpos, np.asarray(motion.phase_index(t)).astype(int),
-                         motion.tool_state(t, "arc"), motion.tool_state(t, "suction"))
+                         motion.tool_state(t, "arc"), motion.tool_state(t, "suction"),
+                         {name: lane_samples(t, lane) for name, lane in motion.lanes})
 
 
 def phase_seams(motion: Any) -> list[str | None]:
