@@ -17,6 +17,7 @@ May import: :mod:`sim.errors` and the compiled cell.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -179,6 +180,9 @@ class CollisionModel:
         model: Check model for collisions (geom margins :data:`DETECTION_MARGIN_M`).
         range_model: Check model for clearance (cell and part geoms with margin
             :data:`CLEARANCE_RANGE_M`).
+        pair_model: With several robots, the check model of the robots' distances to each
+            other (every robot geom with margin :data:`CLEARANCE_RANGE_M`, paired with the
+            other robots' geoms only); None with one robot.
     """
 
     def __init__(self, built: BuiltCell) -> None:
@@ -236,11 +240,15 @@ class CollisionModel:
                                 f"{', '.join(sorted(missing))}")
         self.geoms = geoms
         self.model = self._masked(src, DETECTION_MARGIN_M, every=True)
-        # several robots: every robot geom gets the clearance range too (a robot's distance to
-        # another is a clearance); its pairs with its own robot are left out of the scan
-        self.range_model = self._masked(src, CLEARANCE_RANGE_M, every=len(self.robots) > 1)
+        self.range_model = self._masked(src, CLEARANCE_RANGE_M)
+        # several robots: their distances to each other are a clearance too, measured on a
+        # model of their geoms only, each paired with the other robots' (not with its own: a
+        # robot's pairs with itself, dozens within the range, are penetrations or nothing)
+        self.pair_model = (self._masked(src, CLEARANCE_RANGE_M, robots_only=True)
+                           if len(self.robots) > 1 else None)
         self._data = mujoco.MjData(self.model)
         self._range_data = mujoco.MjData(self.range_model)
+        self._pair_data = None if self.pair_model is None else mujoco.MjData(self.pair_model)
         n = src.ngeom
         self.role = np.full(n, -1)
         self.is_work = np.zeros(n, bool)
@@ -254,9 +262,12 @@ class CollisionModel:
             if cg.robot is not None:
                 self.robot_of[g] = self.robots.index(cg.robot)
 
-    def _masked(self, src: Any, margin: float, every: bool = False) -> Any:
+    def _masked(self, src: Any, margin: float, every: bool = False,
+                robots_only: bool = False) -> Any:
         """The cell recompiled with the check masks and ``margin`` on the cell and part geoms
-        (on every checked geom when ``every``).
+        (on every checked geom when ``every``); ``robots_only``: the robots' geoms only, each
+        robot's paired with every other robot's (one contact bit per robot), all with
+        ``margin``.
 
         The masks are set before compiling, not on a compiled copy: MuJoCo's compiler leaves
         geoms that collide with nothing out of their body's bounding-volume tree, so a geom
@@ -272,11 +283,17 @@ class CollisionModel:
                 g.name != src.geom(i).name for i, g in enumerate(geoms) if g.name):
             raise InternalError("the check model's geoms do not match the compiled cell's")
         affinity = _AFFINITY_ROBOTS if len(self.robots) > 1 else _AFFINITY
+        every_robot = (1 << len(self.robots)) - 1
         for i, g in enumerate(geoms):
             cg = self.geoms.get(i)
-            g.contype = _BITS[cg.role] if cg else 0
-            g.conaffinity = affinity[cg.role] if cg else 0
-            g.margin = margin if cg and (every or cg.role in (CELL, PART)) else 0.0
+            if robots_only:
+                bit = 1 << self.robots.index(cg.robot) if cg and cg.robot is not None else 0
+                g.contype, g.conaffinity = bit, (every_robot & ~bit) if bit else 0
+                g.margin = margin if bit else 0.0
+            else:
+                g.contype = _BITS[cg.role] if cg else 0
+                g.conaffinity = affinity[cg.role] if cg else 0
+                g.margin = margin if cg and (every or cg.role in (CELL, PART)) else 0.0
             g.gap = 0.0
         spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_FILTERPARENT)
         for body in spec.bodies:
@@ -343,10 +360,13 @@ class CollisionModel:
         measured: 0.09 mm reported where the geoms overlap by 2.2 mm).
         """
         mujoco = mujoco_module()
-        m, d = (self.range_model, self._range_data) if ranged else (self.model, self._data)
+        models = ([(self.range_model, self._range_data)] if ranged
+                  else [(self.model, self._data)])
+        if ranged and self.pair_model is not None:
+            models.append((self.pair_model, self._pair_data))
         fromto = np.zeros(6)
         out_s, out_g1, out_g2, out_d = [], [], [], []
-        for i in samples:
+        for i, (m, d) in itertools.product(samples, models):
             d.qpos[:] = qpos[i]
             mujoco.mj_kinematics(m, d)
             mujoco.mj_collision(m, d)
@@ -356,9 +376,6 @@ class CollisionModel:
             geom = d.contact.geom[:n]
             if ranged:
                 keep = d.contact.dist[:n] < CLEARANCE_RANGE_M
-                if len(self.robots) > 1:  # a robot with itself: penetrations only, as alone
-                    r1, r2 = self.robot_of[geom[:, 0]], self.robot_of[geom[:, 1]]
-                    keep &= ~((r1 == r2) & (r1 >= 0) & (d.contact.dist[:n] >= 0.0))
                 if keep.any():
                     out_s.append(np.full(int(keep.sum()), i))
                     out_g1.append(geom[keep, 0].copy())
