@@ -35,7 +35,7 @@ from sim.simulation.collisions import (
     phase_weaves,
     samples_from_motion,
 )
-from sim.simulation.compile import build
+from sim.simulation.compile import BuiltCell, build
 from sim.simulation.motion import Motion, build_motion, check_size, limit_violations
 
 #: Sampling period of the reference motion, s (``cellsim run`` checks every recorded sample).
@@ -99,12 +99,12 @@ def check_scenario(scenario: Scenario, *, dt: float = CHECK_DT_S) -> CheckResult
     for c in report.collisions:
         res.findings.append(Finding("collision", (
             f"{c['phase']}: {c['kind']} collision {c['bodies'][0]} / {c['bodies'][1]} from "
-            f"{c['t0']:.3f} to {c['t1']:.3f} s, {c['depth_mm']:.1f} mm deep at {c['t_worst']:.3f} s "
-            f"({c['geoms'][0]}, {c['geoms'][1]})")))
+            f"{c['t0']:.3f} to {c['t1']:.3f} s, {c['depth_mm']:.1f} mm deep at "
+            f"{c['t_worst']:.3f} s ({c['geoms'][0]}, {c['geoms'][1]})")))
     return res
 
 
-def _singular_passes(built, motion: Motion, dt: float) -> list[Finding]:
+def _singular_passes(built: BuiltCell, motion: Motion, dt: float) -> list[Finding]:
     from sim.core.intervals import true_runs
     from sim.robots.kinematics.jacobian import singularity_measures
 

@@ -84,10 +84,10 @@ and each pair of robots its distance per phase of the first robot (``"weld: robo
 every geom of the two: tool with the other robot, ``tool_mm``; link with link, ``arm_mm``): a
 near miss between two robots is a clearance warning naming both.
 
-Owns the search along a motion (collision intervals, clearance) and the entry points
-(:func:`check_motion`, the samples of a motion); the check model is
-:mod:`sim.simulation.collision_model`'s, the declarations of what may touch
-:mod:`sim.simulation.allowed_contacts`' (their names importable from here, as before).
+Owns the search along a motion (collision intervals, clearance) and the entry point
+(:func:`check_motion`); the check model is :mod:`sim.simulation.collision_model`'s, the
+declarations of what may touch :mod:`sim.simulation.allowed_contacts`', the samples of a
+motion :mod:`sim.simulation.collision_samples`' (their names importable from here, as before).
 May import: :mod:`sim.errors` and the simulation modules below it.
 """
 
@@ -102,13 +102,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import SimulationError
+from sim.simulation import collision_samples as _samples
 from sim.simulation.allowed_contacts import (  # the declarations, importable from here as before
     PART_CONTACT_DEPTH_M,  # noqa: F401
     PICK_REACH_M,  # noqa: F401
     WIRE_ARC_DEPTH_M,  # noqa: F401
     allowed_contacts,
     allowed_mask,
-    weave_reach,
+    weave_reach,  # noqa: F401
 )
 from sim.simulation.collision_model import (  # the check model, importable from here as before
     CELL,
@@ -124,10 +125,10 @@ from sim.simulation.collision_model import (  # the check model, importable from
     CheckGeom,  # noqa: F401
     CollisionModel,
     Contacts,
-    LaneSamples,
+    LaneSamples,  # noqa: F401
     MotionSamples,
     coarse_scan,
-    mujoco_module,
+    mujoco_module,  # noqa: F401
 )
 from sim.simulation.compile import BuiltCell
 
@@ -580,63 +581,9 @@ def check_motion(built: BuiltCell, samples: MotionSamples, phase_names: Sequence
     return CollisionReport(collisions, clear, sorted({a.reason for a in allowed}))
 
 
-def samples_from_arrays(arrays: Any, motion: Any = None) -> MotionSamples:
-    """The recorded motion of a run (``t``, ``qpos``, ``phase``, ``arc_on``, ``suction``; each
-    other robot's ``<name>_arc_on``, its phases from ``motion``'s lanes when given:
-    :func:`lane_samples`)."""
-    t = np.asarray(arrays["t"], dtype=float)
-    names = ([name for name, _ in motion.lanes] if motion is not None else
-             [k.removesuffix("_arc_on") for k in arrays if k.endswith("_arc_on")])
-    lanes = {}
-    for name in names:
-        lane = dict(motion.lanes)[name] if motion is not None else None
-        arc = (np.asarray(arrays[f"{name}_arc_on"]).astype(bool) if f"{name}_arc_on" in arrays
-               else None)
-        lanes[name] = lane_samples(t, lane, arc)
-    return MotionSamples(t, np.asarray(arrays["qpos"], dtype=float),
-                         np.asarray(arrays["phase"]).astype(int),
-                         np.asarray(arrays["arc_on"]).astype(bool),
-                         np.asarray(arrays["suction"]).astype(bool), lanes)
-
-
-def lane_samples(t: NDArray[np.float64], lane: Any = None,
-                 arc_on: NDArray[np.bool_] | None = None) -> LaneSamples:
-    """Another robot's work at times ``t``: its phases, their seams and weaves from its
-    motion (``lane``, a :class:`sim.simulation.motion.Motion` of ``Motion.lanes``; None: one
-    phase ``cycle`` following no seam), its arc from ``arc_on`` (None: from the motion, off
-    without one)."""
-    if lane is None:
-        return LaneSamples(np.zeros(t.size, int),
-                           np.zeros(t.size, bool) if arc_on is None else arc_on,
-                           ["cycle"], [None], [0.0])
-    return LaneSamples(np.asarray(lane.phase_index(t)).astype(int),
-                       lane.tool_state(t, "arc") if arc_on is None else arc_on,
-                       [pm.name for pm in lane.phases], phase_seams(lane), phase_weaves(lane))
-
-
-def samples_from_motion(built: BuiltCell, motion: Any, dt: float) -> MotionSamples:
-    """The reference motion sampled every ``dt`` s, parts where the cell puts them (its
-    ``home`` keyframe): what ``cellsim check`` checks, without dynamics."""
-    n = int(np.floor(motion.duration / dt + 1e-9)) + 1
-    t = motion.t0 + dt * np.arange(n)
-    if t[-1] < motion.t1 - 1e-12:
-        t = np.append(t, motion.t1)
-    mujoco = mujoco_module()
-    model = built.model
-    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
-    base = model.key_qpos[key] if key >= 0 else model.qpos0
-    qpos = np.tile(base, (t.size, 1))
-    qpos[:, built.robot_qpos] = motion.at(t).q
-    return MotionSamples(t, qpos, np.asarray(motion.phase_index(t)).astype(int),
-                         motion.tool_state(t, "arc"), motion.tool_state(t, "suction"),
-                         {name: lane_samples(t, lane) for name, lane in motion.lanes})
-
-
-def phase_seams(motion: Any) -> list[str | None]:
-    """The seam each phase of a motion follows (None where it follows none)."""
-    return [None if pm.seam is None else pm.seam.name for pm in motion.phases]
-
-
-def phase_weaves(motion: Any) -> list[float]:
-    """Each phase's weave reach, m (:func:`weave_reach`; 0 where it does not weave)."""
-    return [weave_reach(getattr(pm.phase, "weave", None)) for pm in motion.phases]
+# the samples of a motion, importable from here as before
+samples_from_arrays = _samples.samples_from_arrays
+samples_from_motion = _samples.samples_from_motion
+lane_samples = _samples.lane_samples
+phase_seams = _samples.phase_seams
+phase_weaves = _samples.phase_weaves
