@@ -484,7 +484,8 @@ def add_collisions(summary: dict[str, Any], built: BuiltCell, motion: Any,
     )
 
     start = time.perf_counter()
-    report = check_motion(built, samples_from_arrays(arrays), [pm.name for pm in motion.phases],
+    report = check_motion(built, samples_from_arrays(arrays, motion),
+                          [pm.name for pm in motion.phases],
                           phase_seams(motion), weaves=phase_weaves(motion))
     summary["collisions"] = report.collisions
     summary["clearance"] = report.clearance

@@ -57,8 +57,15 @@ def test_weld_seams_path_speed_and_torch(name, scenario_run):
         if carried.get(ph["name"]):
             p = in_body_frame(out, f"{carried[ph['name']]}_mount", a["qpos"][sel][::50], p)
         length += np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))
-    seam_total = sum(w["seam_length_mm"] for w in welds)
+    seam_total = sum(w["seam_length_mm"] for w in welds if w.get("robot", "robot") == "robot")
     assert length * 1e3 == pytest.approx(seam_total, rel=0.01)
+    # each of a cell's other robots: its own recorded tool point over its own arc-on time
+    for name in set(summary.get("robots", {})) - {"robot"}:
+        on = a[f"{name}_arc_on"]
+        p = a[f"{name}_tcp_pos"][on][::50]
+        length = np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))
+        total = sum(w["seam_length_mm"] for w in welds if w.get("robot") == name)
+        assert total > 0 and length * 1e3 == pytest.approx(total, rel=0.01), name
 
 
 @pytest.mark.parametrize("name", WELD)
