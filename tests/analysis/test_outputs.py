@@ -64,7 +64,10 @@ SHIPPED = sorted(__import__("sim.core.resources", fromlist=["x"]).shipped_scenar
 
 
 @pytest.mark.render
-@pytest.mark.parametrize("name", SHIPPED)
+#: the fast share's ten minutes: the two-robot scenario's frames (a second full video run) are
+#: checked in the slow share
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow)
+                                  if n == "two_robot_tee_weld" else n for n in SHIPPED])
 def test_overview_frames_show_the_whole_robot(name, scenario_run):
     """The first and middle frames of the overview: no pixel of the robot (or its tool) on
     the image border, and the robot is in the picture."""
