@@ -261,13 +261,12 @@ class ExpectSpec(_Strict):
                                      "expected to fail")
 
 
-class RobotWorkSpec(_Strict):
-    """``[robots.<name>]``: the work of one of the cell's other robots (its phases or its TP
-    program, its tool actions); the keys mean what they mean at the top level."""
+class _WorkSpec(_Strict):
+    """A robot's work: its phases or its TP program, and its tool actions (the top level's
+    keys for the first robot, ``[robots.<name>]``'s for another)."""
 
-    tool: str | None = Field(None, description="its tool (default: the cell file's for it)")
     actions: list[ActionSpec] = []
-    phases: list[PhaseSpec] = Field([], description="its work cycle, in order")
+    phases: list[PhaseSpec] = Field([], description="the work cycle, in order")
     program: str | None = Field(None, description="a FANUC TP program (.ls) to run instead "
                                 "of phases, relative to the scenario file")
     program_frames: dict[str, str] = Field({}, description="user frame number -> cell object")
@@ -277,7 +276,14 @@ class RobotWorkSpec(_Strict):
                                                   "program's WELD_SPEED moves, mm/s")
 
 
-class ScenarioSpec(_Strict):
+class RobotWorkSpec(_WorkSpec):
+    """``[robots.<name>]``: the work of one of the cell's other robots (its phases or its TP
+    program, its tool actions); the keys mean what they mean at the top level."""
+
+    tool: str | None = Field(None, description="its tool (default: the cell file's for it)")
+
+
+class ScenarioSpec(_WorkSpec):
     """Top level of a scenario file."""
 
     name: str = Field(pattern=_NAME_PATTERN, description="scenario name")
@@ -294,15 +300,6 @@ class ScenarioSpec(_Strict):
     video: VideoSpec = VideoSpec()
     drives: dict[str, DriveOverrideSpec] = {}
     sizing: SizingSpec = SizingSpec()
-    actions: list[ActionSpec] = []
-    phases: list[PhaseSpec] = Field([], description="the work cycle, in order")
-    program: str | None = Field(None, description="a FANUC TP program (.ls) to run instead "
-                                "of phases, relative to the scenario file")
-    program_frames: dict[str, str] = Field({}, description="user frame number -> cell object")
-    program_registers: dict[str, list[float]] = Field(
-        {}, description="position register number -> [X, Y, Z, W, P, R] (mm, deg)")
-    program_weld_speed_mm_s: float | None = Field(None, gt=0, description="the speed of the "
-                                                  "program's WELD_SPEED moves, mm/s")
     expect: ExpectSpec = Field(ExpectSpec(), description="what a run is expected to give "
                                "(a documented failure, with its reason)")
     robots: dict[str, RobotWorkSpec] = Field({}, description="the work of the cell's other "
