@@ -13,6 +13,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from support.limits import run_limited
 from support.window_oracle import sustained_peak
 
 from sim.analysis.sizing import PEAK_WINDOW_S
@@ -181,8 +182,8 @@ def test_torque_scales_with_speed_squared_without_gravity(tmp_path, monkeypatch)
 
 
 def _cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "sim", *args], capture_output=True, text=True,
-                          timeout=600)
+    return run_limited([sys.executable, "-m", "sim", *args], capture_output=True, text=True,
+                          cpu_s=600)
 
 
 def test_size_sweep_payload_raises_j2_j3_torque(tmp_path):

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import subprocess
 import sys
 from pathlib import Path
 
@@ -30,6 +29,7 @@ from support.cell_files import (
     rz,
     write_bracket,
 )
+from support.limits import run_limited
 
 from sim.cells import build_cell, load_cell
 from sim.cells.seam import Seam
@@ -389,8 +389,8 @@ def test_bad_cell_files_are_one_line_naming_the_file_and_key(case, tmp_path):
     assert old in CELL
     path = make_cell(tmp_path, cell=CELL.replace(old, new))
     out = tmp_path / "out"
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(path), "--out", str(out),
-                        "--no-video"], capture_output=True, text=True, timeout=120)
+    r = run_limited([sys.executable, "-m", "sim", "run", str(path), "--out", str(out),
+                        "--no-video"], capture_output=True, text=True, cpu_s=120)
     assert r.returncode == 2, r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
@@ -454,9 +454,9 @@ def test_format_reference_documents_every_key():
 def test_the_shipped_cell_files_are_what_their_derivations_give():
     """models/cells/*.toml are written by models/cells/generate.py from sim/cells/*.py; a
     derivation changed without regenerating (or a hand-edited file) fails here."""
-    r = subprocess.run([sys.executable, "models/cells/generate.py", "--check"],
+    r = run_limited([sys.executable, "models/cells/generate.py", "--check"],
                        cwd=Path(__file__).resolve().parents[2], capture_output=True, text=True,
-                       timeout=300)
+                       cpu_s=300)
     assert r.returncode == 0, r.stdout + r.stderr
 
 
@@ -557,10 +557,10 @@ radius_mm = 20
 """)
     base = [sys.executable, "-m", "sim", "ik", "lrmate200ic5l", "500", "0", "300", "--json",
             "--all"]
-    a = subprocess.run([*base, "--tool", "mig_torch"], capture_output=True, text=True,
-                       timeout=120)
-    b = subprocess.run([*base, "--tool", str(tmp_path / "t.toml")], capture_output=True,
-                       text=True, timeout=120)
+    a = run_limited([*base, "--tool", "mig_torch"], capture_output=True, text=True,
+                       cpu_s=120)
+    b = run_limited([*base, "--tool", str(tmp_path / "t.toml")], capture_output=True,
+                       text=True, cpu_s=120)
     assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
     qa = [s["joints_deg"] for s in json.loads(a.stdout)["solutions"]]
     qb = [s["joints_deg"] for s in json.loads(b.stdout)["solutions"]]

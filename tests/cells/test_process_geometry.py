@@ -12,12 +12,12 @@ as ``cellsim check`` checks it.
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from support.limits import run_limited
 
 from sim.pipeline.check import check_scenario
 from sim.scenario import load_scenario
@@ -414,8 +414,8 @@ def test_bad_distances_are_one_line_naming_the_key(case, tmp_path):
     if weld_to:
         text = text.replace('seam = "fillet"\norientation = "seam"', weld_to)
     path = write(tmp_path, text, cell)
-    r = subprocess.run([sys.executable, "-m", "sim", "check", str(path)], capture_output=True,
-                       text=True, timeout=120)
+    r = run_limited([sys.executable, "-m", "sim", "check", str(path)], capture_output=True,
+                       text=True, cpu_s=120)
     lines = r.stderr.strip().splitlines()
     assert r.returncode == 2 and len(lines) == 1, r.stderr
     assert "Traceback" not in r.stderr and want in lines[0], lines[0]

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from support.limits import run_limited
 
 from sim.cli import main
 from sim.core.rotations import euler_zyx_to_matrix, matrix_to_euler_zyx
@@ -127,20 +127,20 @@ def test_wrong_number_of_values_argparse_exit_2(capsys, argv):
 
 def test_python_m_sim_ik_subprocess():
     env = dict(os.environ, PYTHONPATH=str(REPO))
-    ok = subprocess.run([sys.executable, "-m", "sim", "ik", "lrmate100ib", "428.36", "0",
+    ok = run_limited([sys.executable, "-m", "sim", "ik", "lrmate100ib", "428.36", "0",
                          "-426.53", "--euler-zyx-deg", "0", "90", "0", "--json"],
-                        capture_output=True, text=True, cwd=REPO, env=env, timeout=120)
+                        capture_output=True, text=True, cwd=REPO, env=env, cpu_s=120)
     assert ok.returncode == 0, ok.stderr
     doc = json.loads(ok.stdout)
     q = doc["solutions"][0]["joints_deg"]
     # seed 000 Table 3 row 3: q2 86.38, q3 -3.62, q4 7.24
     np.testing.assert_allclose(q, [0.0, 86.38, -3.62, 7.24, 0.0], atol=0.35)
-    bad = subprocess.run([sys.executable, "-m", "sim", "ik", "nosuchrobot", "1", "2", "3"],
-                         capture_output=True, text=True, cwd=REPO, env=env, timeout=120)
+    bad = run_limited([sys.executable, "-m", "sim", "ik", "nosuchrobot", "1", "2", "3"],
+                         capture_output=True, text=True, cwd=REPO, env=env, cpu_s=120)
     assert bad.returncode == 2 and "known: " in bad.stderr
     assert all(name in bad.stderr for name in ROBOTS)
-    bad = subprocess.run([sys.executable, "-m", "sim", "ik", "robot_5r", "1"],
-                         capture_output=True, text=True, cwd=REPO, env=env, timeout=120)
+    bad = run_limited([sys.executable, "-m", "sim", "ik", "robot_5r", "1"],
+                         capture_output=True, text=True, cwd=REPO, env=env, cpu_s=120)
     assert bad.returncode == 2
 
 

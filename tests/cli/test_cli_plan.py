@@ -10,14 +10,15 @@ import sys
 
 import numpy as np
 import pytest
+from support.limits import run_limited
 
 from sim.cli import main
 from sim.core.resources import shipped_scenarios
 
 
 def _run(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "sim", *args], capture_output=True, text=True,
-                          timeout=120)
+    return run_limited([sys.executable, "-m", "sim", *args], capture_output=True, text=True,
+                          cpu_s=120)
 
 
 def test_plan_json_shape_and_seed001_joint1(capsys):

@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
+
+from support.limits import run_limited
 
 
 def _cellsim(args, tmp_path):
     env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
     env["MUJOCO_GL"] = "bogus"
-    return subprocess.run([sys.executable, "-m", "sim", *args], env=env, cwd=tmp_path,
-                          capture_output=True, text=True, timeout=300, check=False)
+    return run_limited([sys.executable, "-m", "sim", *args], env=env, cwd=tmp_path,
+                          capture_output=True, text=True, cpu_s=300, check=False)
 
 
 def test_commands_that_do_not_render_ignore_a_bogus_mujoco_gl(tmp_path):

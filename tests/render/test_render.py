@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation, Slerp
+from support.limits import run_limited
 
 import sim.render.gl as gl
 from sim.errors import RenderError
@@ -125,8 +125,8 @@ def test_backend_is_switched_when_mujoco_was_imported_first() -> None:
     env = _subprocess_env()
     env.pop("MUJOCO_GL", None)
     env.pop("PYOPENGL_PLATFORM", None)
-    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
-                          timeout=300, check=False)
+    proc = run_limited([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                          cpu_s=300, check=False)
     assert proc.returncode == 0, proc.stderr
     before, name, after, peak = proc.stdout.split()
     assert before == "mujoco.glfw"
@@ -147,8 +147,8 @@ def test_pyopengl_bound_elsewhere_is_reported_clearly() -> None:
     env = _subprocess_env()
     env.pop("MUJOCO_GL", None)
     env["PYOPENGL_PLATFORM"] = "glx"
-    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
-                          timeout=300, check=False)
+    proc = run_limited([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                          cpu_s=300, check=False)
     assert proc.returncode == 0, proc.stderr
     assert "already imported with MUJOCO_GL='glfw'" in proc.stdout
     assert "PyOpenGL is already bound to the 'glx' platform" in proc.stdout

@@ -5,12 +5,12 @@ frame, a clean interpreter exit."""
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 
 import imageio.v3 as iio
 import numpy as np
 import pytest
+from support.limits import run_limited
 
 from sim.render import gl
 
@@ -32,11 +32,11 @@ def test_some_backend_works():
 @pytest.mark.parametrize("backend", AVAILABLE)
 def test_cellsim_run_writes_video(backend, tmp_path):
     out = tmp_path / "run"
-    res = subprocess.run(
+    res = run_limited(
         [sys.executable, "-m", "sim", "run", "kacso_lrmate100ib_sequence1", "--out", str(out),
          "--gl", backend, "--width", str(W), "--height", str(H), "--fps", str(FPS),
          "--camera", "overview", "--quiet"],
-        capture_output=True, text=True, timeout=600)
+        capture_output=True, text=True, cpu_s=600)
     assert res.returncode == 0, res.stderr
     assert "Exception ignored" not in res.stderr and "Traceback" not in res.stderr, res.stderr
     summary = json.loads((out / "summary.json").read_text())
@@ -56,9 +56,9 @@ def test_cellsim_run_writes_video(backend, tmp_path):
 
 def test_unknown_camera_refused_before_simulating(tmp_path):
     out = tmp_path / "run"
-    res = subprocess.run(
+    res = run_limited(
         [sys.executable, "-m", "sim", "run", "kacso_lrmate100ib_sequence1", "--out", str(out),
-         "--camera", "front", "--quiet"], capture_output=True, text=True, timeout=600)
+         "--camera", "front", "--quiet"], capture_output=True, text=True, cpu_s=600)
     assert res.returncode == 2
     assert res.stderr.strip() == ("cellsim: error: unknown camera 'front'; the model's cameras: "
                                   "overview, tool")

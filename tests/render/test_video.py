@@ -8,13 +8,13 @@ checks that the interpreter exits cleanly (no "Exception ignored" from unfreed r
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
 import pytest
+from support.limits import run_limited
 
 import sim.render.gl as gl
 from sim.cli import main
@@ -61,8 +61,8 @@ def test_video_with_each_available_backend(backend: str, run_dir: Path, tmp_path
         f" gl={backend!r})\n"
         "print(r.frames, r.backend)\n"
     )
-    proc = subprocess.run([sys.executable, "-c", code, str(run_dir), str(out)], env=_env(),
-                          capture_output=True, text=True, timeout=300, check=False)
+    proc = run_limited([sys.executable, "-c", code, str(run_dir), str(out)], env=_env(),
+                          capture_output=True, text=True, cpu_s=300, check=False)
     assert proc.returncode == 0, proc.stderr
     assert "Exception ignored" not in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
     assert proc.stdout.split() == [str(int(DURATION * FPS) + 1), backend]
@@ -110,8 +110,8 @@ def test_clean_exit_after_an_error_inside_the_render_loop(run_dir: Path, tmp_pat
         "    print('RenderError', exc)\n"
     )
     out = tmp_path / "bad.mp4"
-    proc = subprocess.run([sys.executable, "-c", code, str(run_dir), str(out)], env=_env(),
-                          capture_output=True, text=True, timeout=300, check=False)
+    proc = run_limited([sys.executable, "-c", code, str(run_dir), str(out)], env=_env(),
+                          capture_output=True, text=True, cpu_s=300, check=False)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == f"RenderError video encoding of {out} failed: encoder says no\n"
     assert proc.stderr == ""  # ffmpeg is quiet; nothing ignored at exit
@@ -137,9 +137,9 @@ def test_ffmpeg_errors_reach_the_message_through_its_log(tmp_path: Path) -> None
     before = os.environ.get("FFREPORT")
     with _ffmpeg_log() as log:
         assert log is not None and log.is_file()
-        proc = subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-v", "quiet", "-f", "lavfi",
+        proc = run_limited([imageio_ffmpeg.get_ffmpeg_exe(), "-v", "quiet", "-f", "lavfi",
                                "-i", "color=size=16x16:duration=0.1", str(target)],
-                              capture_output=True, text=True, timeout=60)
+                              capture_output=True, text=True, cpu_s=60)
         said = _ffmpeg_said(log)
     assert proc.returncode != 0 and proc.stderr == ""
     assert str(target) in said and "No such file or directory" in said
@@ -196,10 +196,10 @@ def test_cli_render_odd_width_exits_2(run_dir: Path, capsys: pytest.CaptureFixtu
 
 def test_cli_render_writes_video(run_dir: Path, tmp_path: Path) -> None:
     out = tmp_path / "cli.mp4"
-    proc = subprocess.run(
+    proc = run_limited(
         [sys.executable, "-m", "sim", "render", str(run_dir), "--out", str(out), "--width", "80",
          "--height", "60", "--fps", "5", "--camera", "tool", "--quiet"],
-        env=_env(), capture_output=True, text=True, timeout=300, check=False,
+        env=_env(), capture_output=True, text=True, cpu_s=300, check=False,
     )
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == ""  # --quiet

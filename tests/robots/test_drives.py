@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.limits import run_limited
 from support.scenarios import joint_phase, write_scenario
 
 from sim.pipeline.run import RunOptions, evaluate_scenario
@@ -141,7 +142,6 @@ def test_a_drive_that_cannot_hold_the_arm_is_refused_with_its_numbers(tmp_path):
     message names), what the drive gives (peak x ratio x efficiency from the file's numbers)
     and the motor peak that would hold it; exit 2."""
     import re
-    import subprocess
     import sys
 
     weak = UR5_TOML.replace("rated_torque_nm = 1.6\npeak_torque_nm = 5.0",
@@ -149,8 +149,8 @@ def test_a_drive_that_cannot_hold_the_arm_is_refused_with_its_numbers(tmp_path):
     assert weak != UR5_TOML
     path = ur5(tmp_path)
     (tmp_path / "robots" / "ur5" / "robot.toml").write_text(weak)
-    r = subprocess.run([sys.executable, "-m", "sim", "check", str(path)], capture_output=True,
-                       text=True, timeout=600)
+    r = run_limited([sys.executable, "-m", "sim", "check", str(path)], capture_output=True,
+                       text=True, cpu_s=600)
     assert r.returncode == 2, r.stderr
     line = r.stderr.strip()
     assert "\n" not in line and "Traceback" not in line, line

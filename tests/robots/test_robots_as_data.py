@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from support import DATA, ROOT
+from support.limits import run_limited
 from support.robots import DH_ROBOT, DH_SCENARIO, DRIVES_6
 
 from sim.errors import KinematicsError
@@ -271,8 +272,8 @@ def test_a_shipped_arms_drives_hold_it_against_gravity_with_the_rated_payload(na
 def test_the_shipped_generated_models_and_readmes_are_what_the_generator_writes():
     """models/build_data_robots.py --check: each shipped URDF arm's MJCF, scene.xml and README
     tables are what cellsim generates from its robot.toml (no hand edits, no stale file)."""
-    r = subprocess.run([sys.executable, str(MODELS / "build_data_robots.py"), "--check"],
-                       capture_output=True, text=True, timeout=600)
+    r = run_limited([sys.executable, str(MODELS / "build_data_robots.py"), "--check"],
+                       capture_output=True, text=True, cpu_s=600)
     assert r.returncode == 0, r.stdout + r.stderr
 
 
@@ -376,8 +377,8 @@ def test_numeric_ik_solves_99_percent_of_reachable_poses(tmp_path):
 
 # ---------------------------------------------------------------------------- bad input
 def _cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "sim", "ik", *args, "500", "0", "500"],
-                          capture_output=True, text=True, timeout=120)
+    return run_limited([sys.executable, "-m", "sim", "ik", *args, "500", "0", "500"],
+                          capture_output=True, text=True, cpu_s=120)
 
 
 def _urdf_with(joint_type: str = "revolute", lower: str = "-1", upper: str = "1") -> str:
@@ -413,9 +414,9 @@ def test_bad_robot_data_is_one_line_and_exit_2(case, content, needle, tmp_path):
 
 
 def test_cellsim_ik_of_a_urdf_lists_the_closed_form_solutions():
-    r = subprocess.run([sys.executable, "-m", "sim", "ik", str(DATA / "kuka_kr6r700sixx.urdf"),
+    r = run_limited([sys.executable, "-m", "sim", "ik", str(DATA / "kuka_kr6r700sixx.urdf"),
                         "500", "100", "600", "--all", "--json"], capture_output=True, text=True,
-                       timeout=120)
+                       cpu_s=120)
     assert r.returncode == 0, r.stderr
     import json
 
@@ -671,9 +672,9 @@ def test_a_robot_from_a_dh_table_runs_with_no_self_collision(dh_robot):
 def test_a_dh_robot_without_its_data_is_one_line(dh_robot, edit, needle):
     old, new = edit
     (dh_robot / "robots" / "dh_arm" / "robot.toml").write_text(DH_ROBOT.replace(old, new, 1))
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(dh_robot / "scn.toml"),
+    r = run_limited([sys.executable, "-m", "sim", "run", str(dh_robot / "scn.toml"),
                         "--no-video", "--out", str(dh_robot / "out")], capture_output=True,
-                       text=True, timeout=300, env={**__import__("os").environ,
+                       text=True, cpu_s=300, env={**__import__("os").environ,
                                                     "XDG_CACHE_HOME": str(dh_robot / "cache")})
     assert r.returncode == 2, r.stderr
     lines = r.stderr.strip().splitlines()
@@ -886,8 +887,8 @@ def test_a_bare_urdf_that_cannot_run_as_it_is_is_one_line(edit, needle, tmp_path
     what is missing (and the robot.toml keys that supply it), exit 2."""
     (tmp_path / "ur5.urdf").write_text(edit(ur5_urdf_with_inertials()))
     (tmp_path / "s.toml").write_text(BARE_SCENARIO.format(robot="ur5.urdf"))
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
-                        str(tmp_path / "out")], capture_output=True, text=True, timeout=300,
+    r = run_limited([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
+                        str(tmp_path / "out")], capture_output=True, text=True, cpu_s=300,
                        env={**__import__("os").environ, "XDG_CACHE_HOME": str(tmp_path / "c")})
     assert r.returncode == 2, r.stderr
     lines = r.stderr.strip().splitlines()
@@ -1004,8 +1005,8 @@ def test_a_second_load_of_a_dh_robot_reuses_its_cache_without_mujoco(dh_robot):
     code = ("import sys, json; from sim.robots.robotfile import load_robot_folder; "
             f"s = load_robot_folder({str(dh_robot / 'robots' / 'dh_arm')!r}); "
             "print(json.dumps([list(s.max_accel), 'mujoco' in sys.modules]))")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                       timeout=300, env={**os.environ})
+    r = run_limited([sys.executable, "-c", code], capture_output=True, text=True,
+                       cpu_s=300, env={**os.environ})
     assert r.returncode == 0, r.stderr
     import json
 

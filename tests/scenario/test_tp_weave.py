@@ -8,12 +8,12 @@ FFT peak) against the numbers written in the program and its weave table.
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from support.limits import run_limited
 
 from sim.errors import ScenarioError
 from sim.scenario import load_scenario
@@ -217,9 +217,9 @@ def test_an_exported_weaving_scenario_runs_back_to_the_same_motion(tmp_path):
     0.01 mm of travel at these speeds); an amplitude off by 1 % (0.02 mm) or a frequency off
     by 0.1 % (0.1 mm after 15 cycles) is outside it."""
     (tmp_path / "s.toml").write_text(weave_rt_scenario())
-    r = subprocess.run([sys.executable, "-m", "sim", "export", str(tmp_path / "s.toml"),
+    r = run_limited([sys.executable, "-m", "sim", "export", str(tmp_path / "s.toml"),
                         "--out", str(tmp_path / "prog.ls")], capture_output=True, text=True,
-                       timeout=300)
+                       cpu_s=300)
     assert r.returncode == 0, r.stderr
     assert "prog.weave.toml" in r.stdout and "note" not in r.stdout, r.stdout
     text = (tmp_path / "prog.ls").read_text()
@@ -290,8 +290,8 @@ def test_a_bad_weave_is_one_line_naming_the_file_and_line(case, tmp_path):
 
 def test_an_unknown_schedule_exits_2_with_one_line(tmp_path):
     path = write_program(tmp_path, PROGRAM.replace("Weave Sine[1]", "Weave Sine[3]"))
-    r = subprocess.run([sys.executable, "-m", "sim", "check", str(path)], capture_output=True,
-                       text=True, timeout=300)
+    r = run_limited([sys.executable, "-m", "sim", "check", str(path)], capture_output=True,
+                       text=True, cpu_s=300)
     assert r.returncode == 2, r.stdout + r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and "w.ls: line 10" in lines[0] and "schedule 3" in lines[0], lines

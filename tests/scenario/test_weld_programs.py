@@ -7,7 +7,6 @@ lateral offset computed here.
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from support import DATA
+from support.limits import run_limited
 from support.scenarios import TP_SCENARIO
 
 from sim.pipeline.run import evaluate_scenario
@@ -127,8 +127,8 @@ def test_a_blend_between_two_speeds_changes_speed_inside_the_corner_only(tmp_pat
 ])
 def test_a_blend_that_does_not_fit_is_one_line_and_exit_2(blend, needle, tmp_path):
     (tmp_path / "s.toml").write_text(corner(blend))
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
-                        str(tmp_path / "out")], capture_output=True, text=True, timeout=300)
+    r = run_limited([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
+                        str(tmp_path / "out")], capture_output=True, text=True, cpu_s=300)
     assert r.returncode == 2
     err = [ln for ln in r.stderr.splitlines() if not ln.startswith("cellsim: ") or "error" in ln]
     assert len(err) == 1 and needle in err[0] and "leg1" in err[0], r.stderr
@@ -299,8 +299,8 @@ speed_mm_s = 8.0
 {weave}
 """
     (tmp_path / "s.toml").write_text(text)
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
-                        str(tmp_path / "out")], capture_output=True, text=True, timeout=300)
+    r = run_limited([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
+                        str(tmp_path / "out")], capture_output=True, text=True, cpu_s=300)
     assert r.returncode == 2
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0] and "s.toml" in lines[0], r.stderr
@@ -477,9 +477,9 @@ def test_export_then_import_reproduces_the_tool_path_at_every_programmed_point(t
     program runs at the original phase's speed."""
     from sim.core.resources import shipped_scenarios
 
-    r = subprocess.run([sys.executable, "-m", "sim", "export", "lrmate200ic_weld_plate",
+    r = run_limited([sys.executable, "-m", "sim", "export", "lrmate200ic_weld_plate",
                         "--out", str(tmp_path / "prog.ls")], capture_output=True, text=True,
-                       timeout=300)
+                       cpu_s=300)
     assert r.returncode == 0, r.stderr
     from sim.scenario.fanuc_ls import read_ls
 
@@ -514,9 +514,9 @@ def test_export_then_import_reproduces_the_tool_path_at_every_programmed_point(t
 
 def test_export_never_replaces_a_file(tmp_path):
     (tmp_path / "prog.ls").write_text("mine")
-    r = subprocess.run([sys.executable, "-m", "sim", "export", "lrmate200ic_weld_plate",
+    r = run_limited([sys.executable, "-m", "sim", "export", "lrmate200ic_weld_plate",
                         "--out", str(tmp_path / "prog.ls")], capture_output=True, text=True,
-                       timeout=300)
+                       cpu_s=300)
     assert r.returncode == 2 and "exists" in r.stderr
     assert (tmp_path / "prog.ls").read_text() == "mine"
 
@@ -549,8 +549,8 @@ def test_a_bad_program_is_one_line_with_its_line_number_and_exit_2(case, tmp_pat
     edit, needle = BAD_PROGRAMS[case]
     (tmp_path / "weld1.ls").write_text(edit((DATA / "weld1.ls").read_text()))
     (tmp_path / "s.toml").write_text(TP_SCENARIO)
-    r = subprocess.run([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
-                        str(tmp_path / "out")], capture_output=True, text=True, timeout=300)
+    r = run_limited([sys.executable, "-m", "sim", "run", str(tmp_path / "s.toml"), "--out",
+                        str(tmp_path / "out")], capture_output=True, text=True, cpu_s=300)
     assert r.returncode == 2, r.stderr
     err = [ln for ln in r.stderr.splitlines() if "error" in ln]
     assert len(err) == 1 and needle in err[0], r.stderr
@@ -801,9 +801,9 @@ def test_a_5r_cycle_exports_and_runs_back(tmp_path):
     run passes through every Cartesian point of the program."""
     from sim.scenario.fanuc_ls import LSMotion, read_ls
 
-    r = subprocess.run([sys.executable, "-m", "sim", "export", "bugnar_5r_weld_cycle",
+    r = run_limited([sys.executable, "-m", "sim", "export", "bugnar_5r_weld_cycle",
                         "--out", str(tmp_path / "b.ls")], capture_output=True, text=True,
-                       timeout=300)
+                       cpu_s=300)
     assert r.returncode == 0, r.stderr
     prog = read_ls(tmp_path / "b.ls")
     assert sum(isinstance(m, LSMotion) and m.kind == "C" for m in prog.instructions) >= 2

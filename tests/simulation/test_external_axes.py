@@ -54,6 +54,7 @@ from support.axes_cells import (
 from support.axes_loads import axes_scenario, loads, positioner_torques
 from support.axes_tracks import TrackCase, momentum_balance, track_cases
 from support.axes_welds import WeldCase, judge_coordinated, weld_cases
+from support.limits import run_limited
 from support.scenarios import joint_phase, scenario_text
 from support.seam_oracle import rot_zyx
 
@@ -276,8 +277,8 @@ def test_the_shortest_track_seam_is_out_of_the_arms_reach_without_the_track(tmp_
 
 # ------------------------------------------------------------------ 4. hostile inputs
 def _check(path: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "sim", "check", str(path)],
-                          capture_output=True, text=True, timeout=300)
+    return run_limited([sys.executable, "-m", "sim", "check", str(path)],
+                          capture_output=True, text=True, cpu_s=300)
 
 
 BASE_OBJECTS = [dict(name="pipe", role="workpiece", on="positioner",

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
+from support.limits import cpu_seconds, popen_limited, run_limited, wait_until
 from support.scenarios import joint_phase, scenario_text
 
 from sim.cli import main
@@ -23,22 +24,16 @@ QUICK = "bugnar_5r_phase1"
 
 
 def _start(out: Path, scenario: str = SLOW) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-I", "-m", "sim", "run", scenario, "--out",
-                             str(out), "--no-video", "--no-plots", "--quiet"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            cwd=Path(__file__).resolve().parents[2])
+    return popen_limited([sys.executable, "-I", "-m", "sim", "run", scenario, "--out",
+                          str(out), "--no-video", "--no-plots", "--quiet"], cpu_s=600,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         cwd=Path(__file__).resolve().parents[2])
 
 
 def _hidden(out: Path) -> list[Path]:
     return sorted(p for p in out.parent.iterdir() if p.name.startswith(f".{out.name}."))
 
 
-def _wait_for(cond, timeout: float = 60.0) -> None:
-    end = time.monotonic() + timeout
-    while not cond():
-        if time.monotonic() > end:
-            raise AssertionError("timed out")
-        time.sleep(0.05)
 
 
 @pytest.mark.slow
@@ -46,10 +41,11 @@ def test_sigkill_mid_run_leaves_nothing_taken_for_a_result(tmp_path, capsys):
     out = tmp_path / "run"
     proc = _start(out)
     # the hidden temporary folder appears with the model: the simulation is under way
-    _wait_for(lambda: any((p / "model.xml").is_file() for p in _hidden(out) if p.is_dir()))
+    wait_until(lambda: any((p / "model.xml").is_file() for p in _hidden(out) if p.is_dir()),
+               proc)
     time.sleep(1.0)
     proc.send_signal(signal.SIGKILL)
-    proc.wait(timeout=30)
+    proc.wait()
     left = [p for p in _hidden(out) if p.is_dir()]
     assert left and all(marker_state(p) == "writing" for p in left)
     assert not out.exists()
@@ -68,13 +64,13 @@ def test_a_second_run_into_a_busy_folder_refuses_cleanly(tmp_path, capsys):
     out = tmp_path / "run"
     first = _start(out)
     lock = out.with_name(f".{out.name}.lock")
-    _wait_for(lambda: lock.is_file() and lock.read_text().strip() == str(first.pid))
+    wait_until(lambda: lock.is_file() and lock.read_text().strip() == str(first.pid), first)
     rc = main(["run", QUICK, "--out", str(out), "--no-video", "--no-plots", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2
     assert f"being written by another cellsim run (pid {first.pid})" in err
     assert err.count("\n") == 1
-    assert first.wait(timeout=300) == 0  # the first run is untouched and completes
+    assert first.wait() == 0  # the first run is untouched and completes
     summary = load_run(out).summary
     assert summary["scenario"] == SLOW
     assert _hidden(out) == []  # its lock is gone too
@@ -360,20 +356,19 @@ def test_sigkill_mid_video_then_rerun(tmp_path, capsys):
     import select
 
     out = tmp_path / "run"
-    proc = subprocess.Popen([sys.executable, "-I", "-m", "sim", "run", QUICK, "--out", str(out),
-                             "--no-plots", "--width", "160", "--height", "120"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=Path(__file__).resolve().parents[2])
+    proc = popen_limited([sys.executable, "-I", "-m", "sim", "run", QUICK, "--out", str(out),
+                          "--no-plots", "--width", "160", "--height", "120"], cpu_s=600,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         cwd=Path(__file__).resolve().parents[2])
     seen = ""
-    end = time.monotonic() + 120
     while "cellsim: sizing" not in seen:  # the next stage is the video
-        assert time.monotonic() < end and proc.poll() is None, seen
+        assert cpu_seconds(proc.pid) < 300 and proc.poll() is None, seen
         ready, _, _ = select.select([proc.stderr], [], [], 1.0)
         if ready:
             seen += proc.stderr.readline()
     time.sleep(0.5)
     proc.send_signal(signal.SIGKILL)
-    proc.wait(timeout=30)
+    proc.wait()
     assert not out.exists() and [p for p in _hidden(out) if p.is_dir()]
     assert main(["run", QUICK, "--out", str(out), "--no-plots", "--quiet", "--width", "160",
                  "--height", "120"]) == 0
@@ -417,9 +412,9 @@ def _namespace_mounts() -> bool:
     if shutil.which("unshare") is None:
         return False
     try:
-        probe = subprocess.run(["unshare", "-rm", "sh", "-c",
+        probe = run_limited(["unshare", "-rm", "sh", "-c",
                                 "mount -t tmpfs -o size=1m tmpfs /mnt"],
-                               capture_output=True, timeout=30)
+                               capture_output=True, cpu_s=30)
     except (OSError, subprocess.TimeoutExpired):
         return False
     return probe.returncode == 0
@@ -486,8 +481,8 @@ def test_a_real_full_disk_and_a_read_only_parent(tmp_path):
     (tmp_path / "ro").mkdir()
     driver = tmp_path / "driver.py"
     driver.write_text(_DRIVER)
-    done = subprocess.run(["unshare", "-rm", sys.executable, "-I", str(driver), str(tmp_path),
-                           QUICK], capture_output=True, text=True, timeout=600,
+    done = run_limited(["unshare", "-rm", sys.executable, "-I", str(driver), str(tmp_path),
+                           QUICK], capture_output=True, text=True, cpu_s=600,
                           cwd=Path(__file__).resolve().parents[2])
     assert done.returncode == 0, done.stderr
     seen = json.loads(done.stdout)
