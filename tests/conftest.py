@@ -22,21 +22,36 @@ import pytest  # noqa: E402
 
 
 @pytest.fixture(scope="session")
-def scenario_run(tmp_path_factory):
+def scenario_run(tmp_path_factory, worker_id):
     """``scenario_run(name) -> (run_dir, summary)``: each shipped scenario simulated once per
-    test session (no video, no plots), shared by every test that checks its results."""
+    test session (no video, no plots), shared by every test that checks its results.
+
+    Under pytest-xdist the workers share one folder of runs (this session's base temporary
+    folder): the first worker that needs a scenario runs it while holding a lock on its folder,
+    the others wait for the lock and read the finished run. ``summary`` is always the written
+    ``summary.json`` read back, whichever worker ran it.
+    """
+    import fcntl
+    import json
+
     from sim.pipeline.run import RunOptions, run_scenario
     from sim.scenario import load_scenario
+    from sim.simulation.runfolder import is_run_folder, marker_state
 
-    root = tmp_path_factory.mktemp("scenario_runs")
+    base = tmp_path_factory.getbasetemp()
+    root = (base if worker_id == "master" else base.parent) / "scenario_runs"
+    root.mkdir(parents=True, exist_ok=True)
     cache: dict = {}
 
     def get(name: str):
         if name not in cache:
             out = root / name
-            summary = run_scenario(load_scenario(name), RunOptions(
-                out_dir=out, video=False, plots=False, progress=False))
-            cache[name] = (out, summary)
+            with open(root / f"{name}.lock", "w") as lock:
+                fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+                if not (is_run_folder(out) and marker_state(out) == "complete"):
+                    run_scenario(load_scenario(name), RunOptions(
+                        out_dir=out, video=False, plots=False, progress=False))
+            cache[name] = (out, json.loads((out / "summary.json").read_text()))
         return cache[name]
 
     return get
