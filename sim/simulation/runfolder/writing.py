@@ -1,7 +1,7 @@
 """Writing a run folder's files: its text files, ``summary.json``, ``trajectory.npz`` and
 ``trajectory.csv``, and what of the recorded samples ``trajectory.npz`` keeps.
 
-Owns the files' formats as written (one-space-indented JSON, compressed npz, the CSV's
+Owns the files' formats as written (one-space-indented JSON, deflated npz, the CSV's
 columns); the marker, lock and the folder's place are :mod:`~sim.simulation.runfolder.place`'s.
 May import: :mod:`sim.core.files` and the run folder's schema.
 """
@@ -31,11 +31,23 @@ def write_summary(folder: str | Path, summary: Mapping[str, Any]) -> Path:
     return write_text(folder, SUMMARY_JSON, json.dumps(summary, indent=1) + "\n")
 
 
+#: zlib level of ``trajectory.npz``'s members: level 1 writes the default weld cycle's 50 MB in
+#: less than half the time of numpy's ``savez_compressed`` (level 6), 1.5 % larger.
+NPZ_LEVEL = 1
+
+
 def write_trajectory(folder: str | Path, arrays: Mapping[str, np.ndarray]) -> Path:
-    """Write ``trajectory.npz`` (compressed) from the recorded arrays (see ``ARRAYS``)."""
+    """Write ``trajectory.npz`` from the recorded arrays (see ``ARRAYS``): an ``.npz`` as
+    :func:`numpy.savez_compressed` writes it (one deflated ``NAME.npy`` per array, read by
+    :func:`numpy.load`), at zlib level :data:`NPZ_LEVEL`."""
+    import zipfile
+
     path = Path(folder) / TRAJECTORY_NPZ
-    with naming(path):
-        np.savez_compressed(path, **arrays)
+    with naming(path), zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED,
+                                       compresslevel=NPZ_LEVEL, allowZip64=True) as zf:
+        for name, value in arrays.items():
+            with zf.open(f"{name}.npy", "w", force_zip64=True) as fh:
+                np.lib.format.write_array(fh, np.asanyarray(value), allow_pickle=False)
     return path
 
 
