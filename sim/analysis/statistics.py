@@ -51,7 +51,7 @@ def time_integral(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64] | float:
     # an exactly rounded sum (math.fsum): the same bits whatever BLAS, its thread count or the
     # arrays' alignment (a sweep on Ray, one thread per task, gives the pool's table exactly);
     # numpy's sum where a term is not finite (fsum raises on inf - inf and on overflow)
-    out = np.array([math.fsum(col) if np.all(np.isfinite(col)) else float(np.sum(col))
+    out = np.array([math.fsum(col.tolist()) if np.all(np.isfinite(col)) else float(np.sum(col))
                     for col in flat.T])
     return float(out[0]) if terms.ndim == 1 else out.reshape(terms.shape[1:])
 
