@@ -101,7 +101,8 @@ def _run_arm(args: argparse.Namespace) -> int:
     else:
         R = euler_zyx_to_matrix(*np.deg2rad(args.euler_zyx_deg))
     sols = arm.ik(make_transform(R, p))
-    how = {"opw": "closed form (OPW)", "five_r": "closed form (seed 000's 5R)"}.get(
+    how = {"opw": "closed form (OPW)", "offset_wrist": "closed form (offset wrist, UR-type)",
+           "five_r": "closed form (seed 000's 5R)"}.get(
         arm.solver, f"numeric ({arm.why_numeric})")
     if not sols:
         _no_solution(arm.name, args, "numeric solver: none found in the joint ranges"

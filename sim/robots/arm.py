@@ -3,7 +3,9 @@
 :func:`load_arm` reads ``*.urdf`` files and ``robot.toml`` files (or the folder holding one);
 :class:`Arm` solves inverse kinematics with the closed form when the arm is ortho-parallel with
 a spherical wrist (:mod:`sim.robots.kinematics.opw`: all 8 branches, plus the whole-turn variants of
-joints whose range exceeds 360 deg), with seed 000's 5R closed form when a 5-axis arm has its
+joints whose range exceeds 360 deg), with the offset-wrist closed form when J2-J4 are parallel
+and J5, J6 meet off them (UR-type, :mod:`sim.robots.kinematics.offset_wrist`: 8 branches and
+their whole-turn variants), with seed 000's 5R closed form when a 5-axis arm has its
 structure (:mod:`sim.robots.kinematics.five_axis`: 4 branches), and numerically otherwise
 (:mod:`sim.robots.kinematics.numeric_ik`).
 
@@ -36,7 +38,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sim.core.tomlschema import load_toml
 from sim.errors import KinematicsError
-from sim.robots.kinematics import opw
+from sim.robots.kinematics import offset_wrist, opw
 from sim.robots.kinematics.chain import (
     Chain,
     chain_from_dh,
@@ -64,7 +66,8 @@ class Arm:
 
     Attributes:
         name: The arm's name. chain: Its kinematics. opw: OPW parameters when it is one (else
-        None, and ``why_numeric`` says why). source: The file it came from.
+        None, and ``why_numeric`` says why). source: The file it came from. five: seed 000's
+        5R map when it is one. offset: The offset-wrist parameters when it is one (UR-type).
     """
 
     name: str
@@ -73,12 +76,16 @@ class Arm:
     why_numeric: str = ""
     source: Path | None = None
     five: FiveAxisMap | None = None
+    offset: offset_wrist.OffsetWristParameters | None = None
 
     @property
     def solver(self) -> str:
-        """``"opw"`` (6 axes), ``"five_r"`` (5 axes, seed 000's closed form) or ``"numeric"``."""
+        """``"opw"`` (6 axes), ``"offset_wrist"`` (6 axes, UR-type), ``"five_r"`` (5 axes,
+        seed 000's closed form) or ``"numeric"``."""
         if self.opw is not None:
             return "opw"
+        if self.offset is not None:
+            return "offset_wrist"
         return "five_r" if self.five is not None else "numeric"
 
     def fk(self, q: ArrayLike) -> NDArray[np.float64]:
@@ -91,6 +98,16 @@ class Arm:
         for path inverse kinematics, which picks each joint's turn itself."""
         cur = np.zeros(self.chain.n) if current is None else np.asarray(current, dtype=float)
         return _branch_solutions(self, np.asarray(T, dtype=float), cur)
+
+    def labelled_branches(self, T: ArrayLike, current: ArrayLike | None = None
+                          ) -> list[tuple[NDArray[np.float64], str]]:
+        """An offset-wrist arm's solutions of a flange pose, one per branch with its label
+        (no whole-turn variants): what :func:`sim.robots.kinematics.ik.solve_ik` expands
+        (each joint's turns in its range) and ranks. Other solvers: :meth:`ik`'s."""
+        cur = np.zeros(self.chain.n) if current is None else np.asarray(current, dtype=float)
+        if self.offset is not None:
+            return _offset_solutions(self, np.asarray(T, dtype=float), cur)
+        return [(s.q, s.branch) for s in self.ik(T, cur)]
 
     def ik(self, T: ArrayLike, current: ArrayLike | None = None) -> list[Solution]:
         """Every solution of a flange pose: in the limits first, then nearest ``current``.
@@ -120,6 +137,9 @@ class Arm:
                 if np.max(np.abs(self.chain.fk(q) - T)) > 1e-7:
                     continue  # a branch the arm's geometry makes spurious
                 add_with_turns(q, opw.configuration(self.opw, q))
+        elif self.offset is not None:
+            for q, label in _offset_solutions(self, T, cur):
+                add_with_turns(q, label)
         elif self.five is not None:
             for q, label in self.five.inverse(T):
                 if np.abs(self.chain.fk(q)[:3, 3] - T[:3, 3]).max() > 1e-7:
@@ -145,10 +165,25 @@ def _branch_solutions(arm: Arm, T: NDArray[np.float64], current: NDArray[np.floa
             return []
         ok = np.abs(arm.chain.fk_many(Q) - T).max(axis=(1, 2)) <= 1e-7
         return list(Q[ok])
+    if arm.offset is not None:
+        return [q for q, _ in _offset_solutions(arm, T, current)]
     if arm.five is not None:
         return [q for q, _ in arm.five.inverse(T)
                 if np.abs(arm.chain.fk(q)[:3, 3] - T[:3, 3]).max() <= 1e-7]
     return list(numeric_solve(arm.chain, T, current))
+
+
+def _offset_solutions(arm: Arm, T: NDArray[np.float64], current: NDArray[np.float64]
+                      ) -> list[tuple[NDArray[np.float64], str]]:
+    """The offset-wrist closed form's solutions with their branch labels, each checked against
+    the forward kinematics (J6 keeps ``current``'s value at the wrist singularity)."""
+    assert arm.offset is not None
+    Q = offset_wrist.inverse(arm.offset, T, float(current[5]))
+    keep = np.flatnonzero(~np.isnan(Q).any(axis=1))
+    if len(keep) == 0:
+        return []
+    ok = np.abs(arm.chain.fk_many(Q[keep]) - T).max(axis=(1, 2)) <= 1e-7
+    return [(Q[i], offset_wrist.LABELS[i]) for i in keep[ok]]
 
 
 def _turns(q: float, lo: float, hi: float) -> list[float]:
@@ -165,22 +200,31 @@ def _turns(q: float, lo: float, hi: float) -> list[float]:
 
 
 def _dedupe(sols: list[Solution]) -> list[Solution]:
+    """``sols`` without any within 1e-9 (every joint) of one kept before it."""
     out: list[Solution] = []
+    kept: list[NDArray[np.float64]] = []
     for s in sols:
-        if not any(np.max(np.abs(s.q - o.q)) < 1e-9 for o in out):
+        if not kept or not bool((np.abs(np.array(kept) - s.q).max(axis=1) < 1e-9).any()):
             out.append(s)
+            kept.append(s.q)
     return out
 
 
 def arm_from_chain(chain: Chain, source: Path | None = None) -> Arm:
-    """An :class:`Arm`: OPW when its axes at q = 0 make one, else numeric."""
+    """An :class:`Arm`: OPW when its axes at q = 0 make one, else offset-wrist (UR-type) when
+    they make that, else numeric."""
     if chain.n == 6:
         axes, points, F = chain.frames(np.zeros(6))
         try:
             return Arm(chain.name, chain, opw.opw_from_axes(axes, points, F, chain.name),
                        source=source)
         except KinematicsError as exc:
-            return Arm(chain.name, chain, None, why_numeric=str(exc), source=source)
+            why_opw = str(exc)
+        try:
+            return Arm(chain.name, chain, None, source=source,
+                       offset=offset_wrist.offset_wrist_from_axes(axes, points, F, chain.name))
+        except KinematicsError as exc:
+            return Arm(chain.name, chain, None, why_numeric=f"{why_opw}; {exc}", source=source)
     if chain.n == 5:
         try:
             return Arm(chain.name, chain, None, source=source, five=five_axis_from_chain(chain))

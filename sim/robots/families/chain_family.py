@@ -3,12 +3,19 @@
 The seed tool frame is the arm's flange frame (z out of the flange, the approach axis) moved
 ``tool`` metres along its z axis: a straight tool, as for the seeds' families. Inverse
 kinematics is the arm's: the OPW closed form (all branches) when the arm is ortho-parallel with
-a spherical wrist, seed 000's 5R closed form for a 5-axis arm of that structure, the numeric
-solver otherwise. Singular factors: for an OPW arm ``wrist`` =
-sin(theta5), ``elbow`` = sin(theta3 + atan2(a2, c3)) (upper arm and the line to the wrist centre
-aligned), ``shoulder`` = the wrist centre's distance from the J1 axis less ``|b|`` (m), in the
-model's angles (``theta = sign * q - offset``); a numeric arm has none beyond the Jacobian's
-smallest singular value.
+a spherical wrist, the offset-wrist closed form (all branches) for a UR-type arm, seed 000's 5R
+closed form for a 5-axis arm of that structure, the numeric solver otherwise. Singular factors:
+for an OPW arm ``wrist`` = sin(theta5), ``elbow`` = sin(theta3 + atan2(a2, c3)) (upper arm and
+the line to the wrist centre aligned), ``shoulder`` = the wrist centre's distance from the J1
+axis less ``|b|`` (m), in the model's angles (``theta = sign * q - offset``); for an
+offset-wrist arm those of :func:`sim.robots.kinematics.offset_wrist.singular_factors` (their
+product is ``det J`` up to a constant); a numeric arm has none beyond the Jacobian's smallest
+singular value.
+
+Along a path (:func:`sim.robots.kinematics.ik.ik_path`) a closed form lists every branch at
+every point (microseconds to a millisecond), and the path takes the one nearest the point
+before; a numeric arm continues from the point before by one local Newton run
+(:meth:`ChainFamily.ik_continue`) and searches globally only where that leaves its branch.
 """
 
 from __future__ import annotations
@@ -79,15 +86,19 @@ class ChainFamily(KinematicFamily):
                                 f"({self.arm.solver} solver)", 0.0)
 
     def ik(self, T, current):
-        sols = self.arm.ik(self._flange(T), current)
+        # an offset-wrist arm gives its branches only: solve_ik lists each joint's turns (its
+        # UR-style +-360 deg ranges give each branch 32 of them)
+        sols = self.arm.labelled_branches(self._flange(T), current)
         if not sols:
             raise self._none()
-        return [(s.q, s.branch) for s in sols]
+        return sols
 
     def ik_continue(self, T, current):
         """A numeric arm's next path point: damped Newton from ``current``, kept when it
         converges within :data:`CONTINUE_STEP` of it on every joint (the branch it is on);
-        otherwise None (the global search decides)."""
+        otherwise None (the global search decides). A closed-form arm returns None: its
+        "global search" is the closed form itself, every branch at once, as cheap as a
+        Newton run, and the path picks among them exactly as before."""
         if self.arm.solver != "numeric":
             return None
         from sim.robots.kinematics.numeric_ik import solve_one
@@ -109,6 +120,10 @@ class ChainFamily(KinematicFamily):
         return J
 
     def singular_factors(self, Q):
+        if self.arm.offset is not None:
+            from sim.robots.kinematics.offset_wrist import singular_factors
+
+            return singular_factors(self.arm.offset, Q)
         p = self.arm.opw
         if p is None:
             return {}

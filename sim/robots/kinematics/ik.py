@@ -102,10 +102,12 @@ def solve_ik(model: KinematicModel, pose: ArrayLike, current: ArrayLike | None =
     T_seed = T @ invert_transform(model.tcp_offset)
     raw = model.family.ik(T_seed, cur)
     out: list[IKSolution] = []
+    kept = np.empty((0, model.n_joints))  # the q of ``out``, stacked: one test per candidate
     for q, branch in raw:
         for rep in _representations(model, q, cur):
-            if any(np.abs(rep - s.q).max() < 1e-9 for s in out):
+            if len(kept) and bool((np.abs(kept - rep).max(axis=1) < 1e-9).any()):
                 continue
+            kept = np.vstack([kept, rep])
             out.append(IKSolution(q=rep, within_limits=bool(model.within_limits(rep)),
                                   branch=branch, cost=ranking_cost(model, rep, cur)))
     out.sort(key=lambda s: (not s.within_limits, s.cost))

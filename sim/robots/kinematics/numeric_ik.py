@@ -1,6 +1,7 @@
 """Numeric inverse kinematics for any serial chain: Newton steps with damping, from many seeds.
 
-For arms without a closed form (an offset wrist, a URDF that is not ortho-parallel). Each seed
+For arms without a closed form (neither OPW, offset-wrist nor 5R: e.g. a URDF with a tilted
+wrist). Each seed
 (the current configuration first, then seeds spread over the joint ranges by a fixed-seed
 generator, so results repeat) runs damped Gauss-Newton steps on the 6-d pose error (position m,
 orientation as the rotation vector of ``R_target R^T``), ``dq = J^T (J J^T + lambda^2 I)^-1 e``
@@ -12,7 +13,6 @@ limits are kept, deduplicated modulo 2 pi, nearest to the current configuration 
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -87,7 +87,7 @@ def _wrap_into(q: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.f
 
 
 def solve_ik(chain: Chain, target: ArrayLike, current: ArrayLike | None = None, *,
-             seeds: int = 32, tol: float = 1e-12, time_budget_s: float | None = None,
+             seeds: int = 32, tol: float = 1e-12,
              first: bool = False, seed: int = 0) -> list[NDArray[np.float64]]:
     """All configurations found for a flange pose, within the joint limits.
 
@@ -97,7 +97,6 @@ def solve_ik(chain: Chain, target: ArrayLike, current: ArrayLike | None = None, 
         current: The configuration to start from (and rank by), rad, (n,).
         seeds: Random seeds tried after ``current``.
         tol: Pose error accepted (position m + rotation rad, 2-norm).
-        time_budget_s: Stop seeding after this long (the solutions found so far return).
         first: Return as soon as one solution is found.
         seed: Random generator seed.
 
@@ -110,7 +109,6 @@ def solve_ik(chain: Chain, target: ArrayLike, current: ArrayLike | None = None, 
     rng = np.random.default_rng(seed)
     span_lo = np.where(np.isfinite(lo), lo, -np.pi)
     span_hi = np.where(np.isfinite(hi), hi, np.pi)
-    t0 = time.perf_counter()
     found: list[NDArray[np.float64]] = []
     for k in range(seeds + 1):
         q0 = q_cur if k == 0 else rng.uniform(span_lo, span_hi)
@@ -123,8 +121,6 @@ def solve_ik(chain: Chain, target: ArrayLike, current: ArrayLike | None = None, 
                     found.append(q)
                     if first:
                         break
-        if time_budget_s is not None and time.perf_counter() - t0 > time_budget_s:
-            break
     found.sort(key=lambda s: float(np.sum(np.abs(s - q_cur))))
     return found
 
