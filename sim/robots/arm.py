@@ -176,9 +176,9 @@ def _branch_solutions(arm: Arm, T: NDArray[np.float64], current: NDArray[np.floa
 def _offset_solutions(arm: Arm, T: NDArray[np.float64], current: NDArray[np.float64]
                       ) -> list[tuple[NDArray[np.float64], str]]:
     """The offset-wrist closed form's solutions with their branch labels, each checked against
-    the forward kinematics (J6 keeps ``current``'s value at the wrist singularity)."""
+    the forward kinematics (a joint a singular pose leaves free keeps ``current``'s value)."""
     assert arm.offset is not None
-    Q = offset_wrist.inverse(arm.offset, T, float(current[5]))
+    Q = offset_wrist.inverse(arm.offset, T, current)
     keep = np.flatnonzero(~np.isnan(Q).any(axis=1))
     if len(keep) == 0:
         return []

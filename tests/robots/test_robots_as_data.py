@@ -354,10 +354,21 @@ def test_a_joint_beyond_360_degrees_gets_its_whole_turn_variants():
 
 
 # ---------------------------------------------------------------------------- numeric IK
-def test_an_offset_wrist_arm_falls_back_to_the_numeric_solver(tmp_path):
+def test_an_offset_wrist_arm_gets_the_offset_wrist_closed_form(tmp_path):
+    """A UR5 is not OPW (its wrist axes do not meet) but has the UR-type closed form
+    (tests/robots/test_offset_wrist_ik.py)."""
     (tmp_path / "robot.toml").write_text(robot_toml(UR5_DH, "ur5"))
     arm = load_arm(tmp_path)
-    assert arm.solver == "numeric" and "wrist" in arm.why_numeric
+    assert arm.solver == "offset_wrist" and arm.opw is None
+
+
+def test_an_arm_with_neither_closed_form_falls_back_to_the_numeric_solver(tmp_path):
+    """The UR5 with its J4 tilted 10 deg off J2-J3: neither OPW nor offset-wrist."""
+    rows = UR5_DH.copy()
+    rows[2, 1] = np.radians(10.0)
+    (tmp_path / "robot.toml").write_text(robot_toml(rows, "ur5_tilted"))
+    arm = load_arm(tmp_path)
+    assert arm.solver == "numeric" and "wrist" in arm.why_numeric and "J4" in arm.why_numeric
 
 
 def test_numeric_ik_solves_99_percent_of_reachable_poses(tmp_path):
@@ -846,7 +857,7 @@ def test_a_bare_urdf_runs_with_its_own_inertials_and_efforts(tmp_path, monkeypat
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     (tmp_path / "ur5.urdf").write_text(ur5_urdf_with_inertials())
     spec = resolve_robot("ur5.urdf", tmp_path)
-    assert spec.family.arm.solver == "numeric"
+    assert spec.family.arm.solver == "offset_wrist"  # the UR-type closed form, from a URDF
     assert [d.peak_torque for d in spec.drives] == [150, 150, 150, 28, 28, 28]
     np.testing.assert_allclose(spec.max_speed, [3.14159] * 3 + [3.2] * 3)
     ours = mujoco.MjModel.from_xml_path(str(spec.robot_path))
@@ -1016,15 +1027,17 @@ def test_a_second_load_of_a_dh_robot_reuses_its_cache_without_mujoco(dh_robot):
 
 
 def test_a_numeric_arms_path_ik_continues_its_branch_as_the_global_search_would(tmp_path):
-    """Along generated smooth paths of a UR5 (numeric IK), ``ik_path`` continues each point
-    from the one before with one local Newton run: every pose is reached (FK of the result),
-    and each point's joints are those the global search (every seed, the nearest taken)
-    gives from the point before."""
+    """Along generated smooth paths of a UR5 with its J4 tilted 10 deg (neither closed form:
+    numeric IK), ``ik_path`` continues each point from the one before with one local Newton
+    run: every pose is reached (FK of the result), and each point's joints are those the
+    global search (every seed, the nearest taken) gives from the point before."""
     from sim.robots.families.chain_family import ChainFamily
     from sim.robots.kinematics.ik import ik_path
     from sim.robots.kinematics.model import KinematicModel
 
-    (tmp_path / "robot.toml").write_text(robot_toml(UR5_DH, "ur5"))
+    rows = UR5_DH.copy()
+    rows[2, 1] = np.radians(10.0)
+    (tmp_path / "robot.toml").write_text(robot_toml(rows, "ur5_tilted"))
     arm = load_arm(tmp_path)
     assert arm.solver == "numeric"
     model = KinematicModel("ur5", ChainFamily(arm), lower=arm.chain.lower,

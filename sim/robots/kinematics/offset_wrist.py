@@ -117,9 +117,17 @@ class OffsetWristParameters:
         return np.cross(self.w[2], self.r)
 
     @functools.cached_property
-    def q3_coef(self) -> tuple[float, float, float]:
-        e, r = self.e, self.r
-        return float(e @ r), float(e @ self.w3r), 0.5 * float(e @ e + r @ r)
+    def q3_coef(self) -> tuple[float, float]:
+        """``e . R3 r = a cos q3 + b sin q3``: (a, b)."""
+        return float(self.e @ self.r), float(self.e @ self.w3r)
+
+    @functools.cached_property
+    def e_len(self) -> float:
+        return float(np.linalg.norm(self.e))
+
+    @functools.cached_property
+    def r_len(self) -> float:
+        return float(np.linalg.norm(self.r))
 
 
 def _rot(w: NDArray[np.float64], c: float, s: float) -> NDArray[np.float64]:
@@ -152,6 +160,21 @@ def _roots(a: float, b: float, c: float) -> list[float]:
     return [d + base, d - base]
 
 
+def _elbow(prm: OffsetWristParameters, dist: float) -> list[float]:
+    """The two q3 (plus root first, as :func:`_roots`) that put the J4 axis ``dist`` from
+    J2's: the triangle of sides |e|, |r| (J2-J3, J3-J4) and ``dist`` has the angle
+    ``gamma`` at J3, from the half-angle form (exact at a stretched or folded arm, where
+    arccos would lose 1e-8 rad), and ``e . R3 r = -|e| |r| cos gamma``; [] out of reach."""
+    a, b = prm.e_len, prm.r_len
+    num = (dist - (a - b)) * (dist + (a - b))  # dist^2 - (a - b)^2
+    den = ((a + b) - dist) * ((a + b) + dist)  # (a + b)^2 - dist^2
+    if min(num, den) < -1e-10 * a * b:
+        return []
+    half = math.atan2(math.sqrt(max(num, 0.0)), math.sqrt(max(den, 0.0)))
+    beta = math.atan2(prm.q3_coef[1], prm.q3_coef[0])
+    return [beta + (math.pi - 2.0 * half), beta - (math.pi - 2.0 * half)]
+
+
 def _angle_about(w: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]
                  ) -> float | None:
     """Subproblem 1: the angle about the unit ``w`` that turns ``a`` onto ``b`` (their parts
@@ -163,19 +186,31 @@ def _angle_about(w: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.f
     return math.atan2(float(w @ _cross(a1, b1)), float(a1 @ b1))
 
 
-def inverse(prm: OffsetWristParameters, T: ArrayLike, q6_free: float = 0.0
+def inverse(prm: OffsetWristParameters, T: ArrayLike, free: ArrayLike | None = None
             ) -> NDArray[np.float64]:
     """The 8 solutions of a flange pose (4, 4) in the chain's joint values (rad, (8, 6),
     wrapped to (-pi, pi]), a row of NaN where a branch has none; rows in :data:`LABELS`'
-    order. ``q6_free``: J6's value at the wrist singularity (where only q4 + q6 is fixed)."""
+    order.
+
+    ``free`` (rad, (6,), default zeros; the current configuration): the values of the joints
+    a singular pose leaves undetermined: J6 at the wrist singularity (only q4 + q6 is fixed),
+    J1 where the J5/J6 point lies on the J1 axis with the offset along ``u`` zero, J2 where
+    the J4 axis lies on J2's (the arm folded onto itself).
+    """
     w, p, u, s = prm.w, prm.p, prm.u, prm.s
+    q1_free, q2_free, q6_free = (0.0, 0.0, 0.0) if free is None else (
+        float(np.asarray(free)[0]), float(np.asarray(free)[1]), float(np.asarray(free)[5]))
     g = np.asarray(T, dtype=float) @ prm.Minv
     Rg, tg = g[:3, :3], g[:3, 3]
     out = np.full((8, 6), np.nan)
     # 1. q1 from the J5/J6 point's component along u
     P = Rg @ prm.W + tg - p[0]
     C = prm.w1_u * float(w[0] @ P)
-    q1s = _roots(float(P @ u) - C, float(P @ prm.w1xu), prm.W_u - C)
+    a1, b1, c1 = float(P @ u) - C, float(P @ prm.w1xu), prm.W_u - C
+    if math.hypot(a1, b1) < 1e-12:  # the J5/J6 point on the J1 axis: q1 free or none
+        q1s = [q1_free] if abs(c1) < 1e-12 else []
+    else:
+        q1s = _roots(a1, b1, c1)
     z6 = Rg @ w[5]
     a5, b5, c5 = prm.q5_coef
     e, r, w3r = prm.e, prm.r, prm.w3r
@@ -184,7 +219,13 @@ def inverse(prm: OffsetWristParameters, T: ArrayLike, q6_free: float = 0.0
         N = R1.T @ Rg
         Nu = N.T @ u
         # 2. q5 from the J6 axis's component along u
-        q5s = _roots(a5 - c5, b5, float(u @ (R1.T @ z6)) - c5)
+        z1 = R1.T @ z6
+        if abs(math.hypot(a5, b5) - 1.0) < 1e-12:  # J5 normal to u: the angle between u and
+            # the J6 axis, by atan2, exact where the roots meet (acos would lose 1e-8 there)
+            base5 = math.atan2(float(np.linalg.norm(_cross(u, z1))), float(u @ z1))
+            q5s = [math.atan2(b5, a5) + base5, math.atan2(b5, a5) - base5]
+        else:
+            q5s = _roots(a5 - c5, b5, float(u @ z1) - c5)
         for i5, q5 in enumerate(q5s):
             R5 = _rot(w[4], math.cos(q5), math.sin(q5))
             # 3. q6: R6^T (R5^T u) = N^T u
@@ -201,12 +242,12 @@ def inverse(prm: OffsetWristParameters, T: ArrayLike, q6_free: float = 0.0
             x = p[5] + R6.T @ (x - p[5])
             d = p[0] + R1.T @ (Rg @ x + tg - p[0]) - p[1]
             d = d - float(d @ u) * u
-            q3s = _roots(prm.q3_coef[0], prm.q3_coef[1], 0.5 * float(d @ d) - prm.q3_coef[2])
+            q3s = _elbow(prm, math.sqrt(float(d @ d)))
             for i3, q3 in enumerate(q3s):
                 X = e + math.cos(q3) * r + math.sin(q3) * w3r
                 q2 = _angle_about(w[1], X, d)
-                if q2 is None:
-                    continue
+                if q2 is None:  # the J4 axis on J2's: q2 free
+                    q2 = q2_free
                 q4 = s[2] * (phi - s[0] * q2 - s[1] * q3)
                 out[4 * i1 + 2 * i5 + i3] = [q1, q2, q3, q4, q5, q6]
     return np.where(np.isnan(out), np.nan, np.mod(out + np.pi, 2 * np.pi) - np.pi)
