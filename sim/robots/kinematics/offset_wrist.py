@@ -32,8 +32,13 @@ With ``R_i`` the rotation of joint ``i`` about its axis (``w_i``, through ``p_i`
    the distance from J2 gives ``q3`` (subproblem 3, 2 roots: *elbow*), then ``q2``
    (subproblem 1), and ``q4 = s4 (phi - s2 q2 - s3 q3)``.
 
-A root whose equation has no solution (out of reach, the J5/J6 point on the J1 axis) gives
-fewer solutions, never an exception.
+A root whose equation has no solution (out of reach) gives fewer solutions, never an
+exception; a joint a singular pose leaves undetermined (J6 at the wrist singularity, J1 with
+the J5/J6 point on its axis, J2 with the arm folded onto it) keeps the given ``free`` value.
+Where two roots meet (the wrist or the elbow singularity) the angle comes from ``atan2`` of
+exact components (the angle between ``u`` and the J6 axis; the half-angle form of the elbow
+triangle) rather than ``arccos``, which would lose half the digits there; the shoulder's
+double root keeps ``arccos`` (its error moves the pose only to second order).
 """
 
 from __future__ import annotations
