@@ -28,8 +28,9 @@ clear, and the wire only beyond its allowed depth (:func:`collision_failures`).
 Arms: the shipped 6-axis arms (the welding-robot library's five among them); the 5-axis
 LR Mate 100iB on lines radial to J1 (work
 angle 90 and the surface pitched in the vertical plane through J1: its torch stays in that
-plane, the only postures it has); a UR5 DH table in a robot folder (numeric IK: its seams are
-short, fast and without a weave, each of its path's poses costing about 0.2 s to solve). A case
+plane, the only postures it has); a UR5 DH table in a robot folder (the offset-wrist closed
+form since issue 29; its seams are still drawn short, fast and without a weave, as when numeric
+IK cost about 0.2 s per pose, so the campaign's cases stay the same). A case
 cellsim may refuse (:func:`refusal`: out of reach or not followable in one arm configuration,
 a corner too sharp for its blend, a reference past a joint's speed or acceleration limit, which
 ``cellsim run`` refuses before simulating) must be refused with one line; it is counted (printed at the end of the module's run) and another is
@@ -68,7 +69,7 @@ UR5_DH = ((0.0, 90.0, 89.159, 0.0), (-425.0, 0.0, 0.0, 0.0), (-392.25, 0.0, 0.0,
 UR5_DRIVES = ((101, 2.0e-5, 0.8, 3.0), (101, 4.5e-5, 1.6, 5.0), (101, 2.0e-5, 0.8, 3.0),
               (101, 5.0e-6, 0.3, 1.0), (101, 5.0e-6, 0.3, 1.0), (101, 5.0e-6, 0.3, 1.0))
 UR5_TOML = (
-    'name = "ur5_dh"\ndescription = "a UR5-like arm from its DH table (offset wrist: numeric IK)"'
+    'name = "ur5_dh"\ndescription = "a UR5-like arm from its DH table (offset wrist: closed form)"'
     '\n[kinematics]\nconvention = "dh"\ndh = [\n'
     + ",\n".join(f"  [{a!r}, {al!r}, {d!r}, {o!r}]" for a, al, d, o in UR5_DH)
     + "\n]\n[joints]\nrange_deg = [[-360, 360], [-360, 360], [-180, 180], [-360, 360], "
@@ -306,8 +307,8 @@ def _segments_apart(p: np.ndarray, q: np.ndarray, r: np.ndarray, s: np.ndarray) 
 @st.composite
 def cases(draw: Any, arm: Arm, kind: str) -> Case:
     """A weld for ``arm`` of ``kind`` (module docstring), in mm and deg. The DH arm's are
-    short (at most 60 mm, a circle 80 mm), fast (12-20 mm/s) and without a weave: its numeric
-    IK solves each of the path's poses in about 0.2 s."""
+    short (at most 60 mm, a circle 80 mm), fast (12-20 mm/s) and without a weave (drawn so when
+    numeric IK solved each pose in about 0.2 s; kept so the drawn cases stay the same)."""
     def fl(lo: float, hi: float) -> float:
         return draw(st.floats(lo, hi, allow_nan=False, allow_infinity=False))
 
