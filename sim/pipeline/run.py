@@ -226,9 +226,10 @@ def simulate_batch(scenarios: list[Scenario], prepared: list[tuple[BuiltCell, An
 
 def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOptions,
            stages: Stages, *, on_failure: Any = None, model_path: Path | None = None,
-           rec: Any = None) -> Evaluation:
+           rec: Any = None, collide: Any = None) -> Evaluation:
     """Simulate (unless ``rec``, a record simulated already, is given), check (collisions,
-    clearance, limits), size, select, judge; writes nothing."""
+    clearance, limits; ``collide``: instead of :func:`add_collisions`, same arguments), size,
+    select, judge; writes nothing."""
     feedforward = _feedforward(scenario, options)
     if options.backend not in ("mujoco", "warp"):
         from sim.errors import SimulationError
@@ -246,7 +247,7 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
         summary = make_summary(scenario, built, motion, rec, feedforward)
         if motion.lanes:  # a cell's other robots measured as the first is
             add_robots(summary, scenario, built, motion, rec)
-        add_collisions(summary, built, motion, arrays)
+        (collide or add_collisions)(summary, built, motion, arrays)
     # post-processing reads the record in memory, never the files a run writes
     record = runfolder.RunRecord.from_arrays(
         arrays, joints=list(summary["joints"]), phases=summary["phases"],
@@ -318,10 +319,12 @@ def evaluate_scenario(scenario: Scenario, options: RunOptions | None = None) -> 
 
 
 def evaluate_scenarios(scenarios: list[Scenario], options: RunOptions | None = None,
-                       labels: list[str] | None = None) -> list[Evaluation]:
+                       labels: list[str] | None = None, collide: Any = None
+                       ) -> list[Evaluation]:
     """:func:`evaluate_scenario` for several scenarios; with ``options.backend == "warp"``
     their simulations run as MuJoCo Warp batches (one per model structure), the rest (plans,
-    checks, sizing) one by one on the host. ``labels`` name the scenarios in errors.
+    checks, sizing) one by one on the host. ``labels`` name the scenarios in errors;
+    ``collide`` replaces :func:`add_collisions` (a sweep's reuse of its plan's scan).
 
     Raises:
         CellsimError: A user mistake or an unstable simulation (one-line message).
@@ -342,7 +345,7 @@ def evaluate_scenarios(scenarios: list[Scenario], options: RunOptions | None = N
             st.timings["simulate_batch"] = share
     out = []
     for s, (built, motion), st, rec in zip(scenarios, prepared, staged, records):
-        evaluation = _judge(s, built, motion, options, st, rec=rec)
+        evaluation = _judge(s, built, motion, options, st, rec=rec, collide=collide)
         evaluation.summary["timings_s"] = dict(st.timings)
         evaluation.summary["total_wall_s"] = st.total_s
         evaluation.summary["backend"] = options.backend

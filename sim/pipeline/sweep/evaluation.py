@@ -28,7 +28,8 @@ def evaluate_variant(variant: Variant, selection: Any = None, keep_runs: bool = 
     acceleration limits are not enforced): it stays in the tables with negative margins and a
     failed verdict instead of being dropped.
     """
-    from sim.pipeline.run import RunOptions, evaluate_scenario, run_and_write
+    from sim.pipeline.run import RunOptions, evaluate_scenarios, run_and_write
+    from sim.pipeline.sweep.reuse import collide_hook
 
     scenario = _variant_scenario(variant)
     if keep_runs:
@@ -36,8 +37,11 @@ def evaluate_variant(variant: Variant, selection: Any = None, keep_runs: bool = 
                                                 plots=plots, progress=False,
                                                 selection=selection))
         return _metrics(variant, ev, run_dir=str(variant.run_dir))
-    return _metrics(variant, evaluate_scenario(scenario, RunOptions(
-        video=False, plots=False, progress=False, selection=selection)))
+    # metrics only: the plan and its reference scan are reused by the variants of one plan
+    # (sim.pipeline.sweep.reuse; the same rows, no clearance)
+    return _metrics(variant, evaluate_scenarios([scenario], RunOptions(
+        video=False, plots=False, progress=False, selection=selection),
+        collide=collide_hook())[0])
 
 
 def _variant_scenario(variant: Variant) -> Any:
