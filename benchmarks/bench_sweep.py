@@ -13,10 +13,27 @@ compared (they must be identical, bit for bit).
 MuJoCo Warp backend (Warp's CPU device without a GPU: for parity, not speed) and on the pool,
 and prints the largest relative difference of the peak and RMS torques.
 
+By default (issue 29's acceptance) it prints instead, for the weld plate:
+
+* the pool's start-up on its own (start ``--workers`` warmed workers, one no-op each);
+* one metrics-only variant's wall time against its ``simulate`` stage (target <= 1.3): the
+  first variant of a plan in a process (it scans the plan's reference) and a variant that
+  reuses its plan (another payload at the same speed: what every further variant of a plan
+  costs), each also without the reuse (a variant checked as a run checks it);
+* a 6-variant sweep on 2 workers, its wall time against the bound
+  ``1.5 x (6 x one variant's simulate) / 2 + the pool's start-up``: 6 payloads at one speed
+  (one plan: each worker scans its reference once and reuses it) and a 2 x 3 grid (three plans
+  over two workers: a reference scan per plan and worker), each with and without the reuse;
+  the tables with and without the reuse must be identical.
+
+Wall times on a machine shared with other jobs say little: CPU times (this process's, and the
+workers' from ``getrusage``) and the load average are printed beside them.
+
 Usage::
 
-    .venv/bin/python benchmarks/bench_sweep.py                  # 8, 64, 256 on pool and ray
-    .venv/bin/python benchmarks/bench_sweep.py --sizes 8 --engines pool
+    .venv/bin/python benchmarks/bench_sweep.py                  # the acceptance figures
+    .venv/bin/python benchmarks/bench_sweep.py --scale          # 8, 64, 256 on pool and ray
+    .venv/bin/python benchmarks/bench_sweep.py --scale --sizes 8 --engines pool
     .venv/bin/python benchmarks/bench_sweep.py --warp
 """
 
@@ -28,6 +45,7 @@ import json
 import math
 import os
 import platform
+import resource
 import sys
 import tempfile
 import time
@@ -37,7 +55,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from sim.pipeline.sweep import run_sweep  # noqa: E402
+from sim.pipeline.sweep import Variant, run_sweep  # noqa: E402
+from sim.pipeline.sweep import reuse as sweep_reuse  # noqa: E402
+from sim.pipeline.sweep.engines import pool_startup_s  # noqa: E402
 from sim.pipeline.sweep.evaluation import evaluate_batch, evaluate_variant  # noqa: E402
 
 GRIDS = {8: (2, 4), 64: (8, 8), 256: (16, 16)}
@@ -99,7 +119,7 @@ def warp_parity(scenario: str, workers: int) -> dict:
             v = (r["payload_kg"], r["speed_scale"])
             big[v] = max(big.get(v, 0.0), abs(r[key]))
         worst[key] = max(abs(a[key] - b[key]) / abs(a[key])
-                         for a, b in zip(out["pool"]["rows"], out["warp"]["rows"])
+                         for a, b in zip(out["pool"]["rows"], out["warp"]["rows"], strict=True)
                          if abs(a[key]) >= 0.02 * big[(a["payload_kg"], a["speed_scale"])])
     return {"variants": len(payloads) * len(speeds), "scenario": scenario,
             "pool_variants_per_min": out["pool"]["variants_per_min"],
@@ -107,12 +127,113 @@ def warp_parity(scenario: str, workers: int) -> dict:
             "max_relative_difference": worst}
 
 
+def evaluate_without_reuse(variant: Variant) -> object:
+    """A variant checked as a run checks it (no plan scan reused): the figures before."""
+    sweep_reuse.ENABLED = False
+    return evaluate_variant(variant)
+
+
+def load() -> str:
+    return f"load average {os.getloadavg()[0]:.2f}, {os.getloadavg()[1]:.2f} (1, 5 min)"
+
+
+def children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def one_variant(scenario: str, payload: float, speed: float) -> dict:
+    """A metrics-only variant in this process: wall, CPU, stages; and its simulation's CPU
+    alone (the same simulate call, timed on its own)."""
+    from sim.pipeline.run import RunOptions, _drives, _prepare
+    from sim.pipeline.stages import Stages
+    from sim.pipeline.sweep.evaluation import _variant_scenario
+    from sim.simulation.simulate import simulate
+
+    v = Variant(payload, speed, scenario)
+    c0, w0 = time.process_time(), time.perf_counter()
+    m = evaluate_variant(v)
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    sc = _variant_scenario(v)
+    built, motion, _ = _prepare(sc, RunOptions(video=False, plots=False, progress=False),
+                                Stages(enabled=False))
+    c1 = time.process_time()
+    simulate(built, motion, feedforward=sc.simulation.feedforward,
+             settle_s=sc.simulation.settle_s, progress=False, drives=_drives(sc))
+    sim_cpu = time.process_time() - c1
+    return {"wall_s": wall, "cpu_s": cpu, "stages_s": m.timings_s,
+            "simulate_s": m.timings_s["simulate"], "simulate_cpu_s": sim_cpu,
+            "wall_over_simulate": wall / m.timings_s["simulate"],
+            "cpu_over_simulate_cpu": cpu / sim_cpu}
+
+
+def acceptance(scenario: str, workers: int) -> dict:
+    out: dict = {"scenario": scenario, "workers": workers, "load_start": load()}
+    print(f"{scenario}, {workers} workers, {os.cpu_count()} CPUs; {load()}", flush=True)
+    c0 = children_cpu()
+    start = pool_startup_s(workers, "spawn", scenario)
+    out["pool_startup_s"], out["pool_startup_cpu_s"] = start, children_cpu() - c0
+    print(f"pool start-up ({workers} warmed workers, one no-op each): {start:.2f} s wall, "
+          f"{out['pool_startup_cpu_s']:.2f} s CPU (workers)", flush=True)
+    evaluate_variant(Variant(0.5, 0.9, scenario))  # imports, in this process
+    for label, enabled, payloads in (("without reuse", False, (1.0, 3.0)),
+                                     ("with reuse", True, (1.0, 3.0))):
+        sweep_reuse.ENABLED = enabled
+        from sim.simulation.collision_reuse import clear_cache
+
+        clear_cache()
+        for k, p in enumerate(payloads):
+            r = one_variant(scenario, p, 1.0)
+            kind = "first of its plan" if k == 0 else "reusing its plan"
+            out[f"variant {label}, {kind}"] = r
+            st = ", ".join(f"{a} {b:.2f}" for a, b in r["stages_s"].items())
+            print(f"one variant {label} ({kind}, {p:g} kg): {r['wall_s']:.2f} s wall = "
+                  f"{r['wall_over_simulate']:.2f}x its simulate stage (target <= 1.3); CPU "
+                  f"{r['cpu_s']:.2f} s = {r['cpu_over_simulate_cpu']:.2f}x the simulation's CPU "
+                  f"{r['simulate_cpu_s']:.2f} s (stages s: {st})", flush=True)
+    sweep_reuse.ENABLED = True
+    sim_one = out["variant with reuse, reusing its plan"]["simulate_s"]
+    sim_cpu = out["variant with reuse, reusing its plan"]["simulate_cpu_s"]
+    tables = {}
+    for grid_label, payloads, speeds in (("6 payloads x 1 speed", [1.0, 1.5, 2.0, 2.5, 3.0, 3.5],
+                                          [1.0]),
+                                         ("2 payloads x 3 speeds", [1.0, 3.0], [0.8, 0.9, 1.0])):
+        for label, runner in (("with reuse", evaluate_variant),
+                              ("without reuse", evaluate_without_reuse)):
+            with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
+                c0, w0 = children_cpu(), time.perf_counter()
+                res = run_sweep(scenario, payloads, speeds, runner, workers=workers,
+                                out_dir=Path(tmp) / "sweep", progress=False,
+                                raise_on_failure=False)
+                wall, cpu = time.perf_counter() - w0, children_cpu() - c0
+            tables[(grid_label, label)] = table(res)
+            n = len(res.outcomes)
+            bound = 1.5 * (n * sim_one) / workers + start
+            cpu_bound = 1.5 * n * sim_cpu
+            out[f"sweep {grid_label} {label}"] = {"wall_s": wall, "bound_s": bound,
+                                                  "cpu_s": cpu, "cpu_bound_s": cpu_bound,
+                                                  "failures": len(res.failures)}
+            print(f"sweep {grid_label} {label}: {wall:.1f} s wall vs bound {bound:.1f} s "
+                  f"(1.5 x {n} x {sim_one:.2f} s / {workers} + {start:.2f} s start-up): "
+                  f"{wall / bound:.2f}x the bound; workers' CPU {cpu:.1f} s vs 1.5 x {n} x "
+                  f"{sim_cpu:.2f} s = {cpu_bound:.1f} s ({cpu / cpu_bound:.2f}x); {load()}",
+                  flush=True)
+        same = tables[(grid_label, "with reuse")] == tables[(grid_label, "without reuse")]
+        out[f"sweep {grid_label} identical tables"] = same
+        print(f"  {grid_label}: tables with and without reuse identical: {same}", flush=True)
+    out["load_end"] = load()
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", default="lrmate200ic_weld_plate")
     ap.add_argument("--sizes", default="8,64,256", help="variant counts (default 8,64,256)")
     ap.add_argument("--engines", default="pool,ray", help="pool, ray or both (default)")
-    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--workers", type=int, default=None,
+                    help="worker processes (default 2 for the acceptance, else every CPU)")
+    ap.add_argument("--scale", action="store_true",
+                    help="the 8/64/256-variant table of --sizes and --engines instead")
     ap.add_argument("--warp", action="store_true",
                     help="Warp-CPU parity on 8 variants of --warp-scenario instead")
     ap.add_argument("--warp-scenario", default="kacso_lrmate100ib_sequence1")
@@ -120,6 +241,12 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     info = {"python": platform.python_version(), "cpu_count": os.cpu_count(),
             "machine": platform.machine()}
+    if not args.warp and not args.scale:
+        out = acceptance(args.scenario, args.workers or 2)
+        if args.json:
+            args.json.write_text(json.dumps({**info, **out}, indent=2) + "\n")
+        return 0
+    args.workers = args.workers or os.cpu_count() or 1
     if args.warp:
         out = warp_parity(args.warp_scenario, args.workers)
         print(f"{out['variants']} variants of {out['scenario']}: pool "

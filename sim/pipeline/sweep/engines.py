@@ -8,6 +8,7 @@ from __future__ import annotations
 import logging
 import math
 import multiprocessing
+import os
 import socket
 import time
 import traceback
@@ -53,6 +54,40 @@ def task_groups(variants: Sequence[Variant], workers: int) -> list[list[Variant]
     return groups
 
 
+def warm_worker(scenario: Any = None) -> None:
+    """A pool worker's initializer: import what every variant needs (cellsim's pipeline,
+    MuJoCo) and load the base scenario once, so that the first variant does not pay for it."""
+    import mujoco  # noqa: F401
+
+    import sim.pipeline.run  # noqa: F401
+    import sim.pipeline.sweep.evaluation  # noqa: F401
+    import sim.simulation.collision_reuse  # noqa: F401
+
+    if isinstance(scenario, (str, os.PathLike)):
+        from sim.scenario import load_scenario
+
+        try:
+            load_scenario(scenario)
+        except Exception:  # noqa: BLE001 - the variants report it, each as its error
+            pass
+
+
+def _noop() -> int:
+    return os.getpid()
+
+
+def pool_startup_s(workers: int, mp_context: str = "spawn", scenario: Any = None) -> float:
+    """Wall time to start a sweep's pool of ``workers`` (each warmed by :func:`warm_worker`)
+    and run one no-op on each, s: what a sweep pays before its first variant."""
+    ctx = multiprocessing.get_context(mp_context)
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=warm_worker,
+                             initargs=(scenario,)) as pool:
+        for fut in [pool.submit(_noop) for _ in range(workers)]:
+            fut.result()
+    return time.perf_counter() - t0
+
+
 def run_group(runner: Callable[[Variant], Any], variants: Sequence[Variant]) -> list[Outcome]:
     """Run variants one after the other in this process (a task of a parallel sweep)."""
     return [run_variant(runner, v) for v in variants]
@@ -79,7 +114,7 @@ def _run_batch(batch: Callable[[Sequence[Variant]], Sequence[Any]],
             results[v.index] = Outcome(v, None, (), msg)
         return
     share = (time.perf_counter() - t0) / max(len(variants), 1)
-    for v, item in zip(variants, got):
+    for v, item in zip(variants, got, strict=True):
         try:
             results[v.index] = outcome_of(v, item, share)
         except Exception as exc:  # noqa: BLE001 - reported per variant
@@ -170,7 +205,11 @@ def run_variants(runner: Callable[[Variant], Any], variants: list[Variant], work
                     bar.update()
         else:
             ctx = multiprocessing.get_context(mp_context)
-            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+            # started once per sweep, each worker warmed once; the variants of a plan follow
+            # each other (task_groups) so a worker reuses the plan and its reference scan
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                     initializer=warm_worker,
+                                     initargs=(variants[0].scenario,)) as pool:
                 futures = {pool.submit(run_group, runner, g): g
                            for g in task_groups(variants, workers)}
                 for fut in as_completed(futures):
@@ -188,4 +227,5 @@ def run_variants(runner: Callable[[Variant], Any], variants: list[Variant], work
                        wall_s=time.perf_counter() - t0)
 
 
-__all__ = ["ENGINES", "check_reachable", "import_ray", "run_group", "run_variants", "task_groups"]
+__all__ = ["ENGINES", "check_reachable", "import_ray", "pool_startup_s", "run_group",
+           "run_variants", "task_groups", "warm_worker"]
