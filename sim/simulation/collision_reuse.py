@@ -46,6 +46,7 @@ from sim.simulation.collision_model import (
     CLEARANCE_RANGE_M,
     DETECTION_MARGIN_M,
     PENETRATION_TOLERANCE_M,
+    AllowedContact,
     CollisionModel,
     Contacts,
     MotionSamples,
@@ -64,6 +65,9 @@ SLACK_M = 5e-5
 KEPT = 4
 
 _CACHE: OrderedDict[str, ReferenceScan] = OrderedDict()
+#: Reference scans made and found in the cache by this process, and variants whose
+#: collisions were checked in full after all (a contact not ruled out, or a cell not reusable).
+STATS = {"scans": 0, "hits": 0, "full": 0}
 
 
 @dataclass(frozen=True)
@@ -151,15 +155,20 @@ def _near_scan(model: Any, qpos: NDArray[np.float64], samples: NDArray[np.int64]
 
 
 def reference_scan(cm: CollisionModel, samples: MotionSamples, coarse: NDArray[np.int64],
-                   q_ref: NDArray[np.float64]) -> ReferenceScan:
+                   q_ref: NDArray[np.float64], *, make: bool = True) -> ReferenceScan | None:
     """The reference's scan (module docstring), from the cache when the same reference was
-    scanned on the same geometry in this process. ``q_ref``: the robot's joint positions of the
-    reference at the coarse samples, (len(coarse), n)."""
+    scanned on the same geometry in this process; None when it was not and not ``make``.
+    ``q_ref``: the robot's joint positions of the reference at the coarse samples,
+    (len(coarse), n)."""
     key = reference_key(cm, samples, coarse, q_ref)
     hit = _CACHE.get(key)
     if hit is not None:
         _CACHE.move_to_end(key)
+        STATS["hits"] += 1
         return hit
+    if not make:
+        return None
+    STATS["scans"] += 1
     qpos = np.tile(cm.built.model.qpos0, (samples.t.size, 1))
     qpos[np.ix_(coarse, np.asarray(cm.built.robot_qpos))] = q_ref
     std = coarse_scan(cm, qpos, coarse)
@@ -193,27 +202,32 @@ def deviation(cm: CollisionModel, qpos: NDArray[np.float64], q_ref: NDArray[np.f
 def collisions_from_reference(built: BuiltCell, samples: MotionSamples,
                               phase_names: Sequence[str], phase_seams: Sequence[str | None],
                               weaves: Sequence[float], q_ref: NDArray[np.float64],
-                              cm: CollisionModel | None = None
+                              cm: CollisionModel | None = None, *, scan: bool = True
                               ) -> tuple[list[dict[str, Any]], list[str]]:
     """The collisions :func:`~sim.simulation.collisions.check_motion` reports for ``samples``
     (the variant's simulated motion) and the allowed contacts' reasons, using the reference's
     scan (module docstring). ``q_ref``: the reference's joint positions at
-    ``coarse_samples(samples)``."""
+    ``coarse_samples(samples)``; ``scan``: scan the reference when it is not in the cache
+    (else check in full: a scan pays off from the second variant of a plan)."""
     cm = cm or CollisionModel(built)
     allowed = allowed_contacts(cm, samples, phase_seams, weaves)
     reasons = sorted({a.reason for a in allowed})
     coarse = _col.coarse_samples(samples)
     if len(coarse) < 2 or not reusable(built):
-        return _col.find_collisions(cm, samples, phase_names, allowed), reasons
-    ref = reference_scan(cm, samples, coarse, q_ref)
-    dev = 2.0 * deviation(cm, samples.qpos[coarse], q_ref) + SLACK_M
+        return _full(cm, samples, phase_names, allowed), reasons
+    ref = reference_scan(cm, samples, coarse, q_ref, make=scan)
+    if ref is None or ref.qpos.shape[0] != coarse.size:
+        return _full(cm, samples, phase_names, allowed), reasons
+    # against the positions the scan was made at (whatever the cache gave back)
+    scanned_q = ref.qpos[:, np.asarray(built.robot_qpos)]
+    dev = 2.0 * deviation(cm, samples.qpos[coarse], scanned_q) + SLACK_M
     bounds = _col.motion_bound(cm, samples, coarse)
     move = 2.0 * bounds["link"]
     # a pair missing from the reference's rows: its own geoms at NEAR_RANGE_M at least, the
     # cell at CLEARANCE_RANGE_M; unless the deviation bounds both, check it all in full
     if np.any(dev >= NEAR_RANGE_M - PENETRATION_TOLERANCE_M) or np.any(
             move + np.maximum(dev[:-1], dev[1:]) >= CLEARANCE_RANGE_M - PENETRATION_TOLERANCE_M):
-        return _col.find_collisions(cm, samples, phase_names, allowed), reasons
+        return _full(cm, samples, phase_names, allowed), reasons
     rows = ref.rows
     k = np.searchsorted(coarse, rows.s)
     lower = rows.dist - dev[k]
@@ -224,15 +238,22 @@ def collisions_from_reference(built: BuiltCell, samples: MotionSamples,
                                     or [np.zeros(0, int)])).astype(int)
     c = cm.scan(samples.qpos, fine)
     if c.select(~allowed_mask(c, allowed)).s.size:  # a collision, or one not ruled out
-        return _col.find_collisions(cm, samples, phase_names, allowed), reasons
+        return _full(cm, samples, phase_names, allowed), reasons
     return [], reasons
 
 
 def clear_cache() -> None:
-    """Forget every reference scan of this process."""
+    """Forget every reference scan of this process (and zero :data:`STATS`)."""
     _CACHE.clear()
+    STATS.update(scans=0, hits=0, full=0)
 
 
-__all__ = ["KEPT", "NEAR_RANGE_M", "SLACK_M", "ReferenceScan", "clear_cache",
+def _full(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
+          allowed: list[AllowedContact]) -> list[dict[str, Any]]:
+    STATS["full"] += 1
+    return _col.find_collisions(cm, samples, phase_names, allowed)
+
+
+__all__ = ["KEPT", "NEAR_RANGE_M", "SLACK_M", "STATS", "ReferenceScan", "clear_cache",
            "collisions_from_reference", "deviation", "geometry_key", "reference_key",
            "reference_scan", "reusable"]

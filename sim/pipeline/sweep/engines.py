@@ -41,16 +41,19 @@ def task_groups(variants: Sequence[Variant], workers: int) -> list[list[Variant]
     """The variants cut into tasks for ``workers`` parallel workers: the variants of one speed
     scale run together, in one worker, one after the other (a plan depends on the speed scale,
     not on the payload, so the worker plans once and reuses it), split into enough tasks that
-    every worker has at least two to take. The results do not depend on the grouping (they
-    are gathered by variant index)."""
+    every worker has at least two to take, of sizes that differ by one at most (6 variants of
+    one plan on 2 workers: 2, 2, 1, 1, so that each worker runs 3). The results do not depend
+    on the grouping (they are gathered by variant index)."""
     by_speed: dict[float, list[Variant]] = {}
     for v in variants:
         by_speed.setdefault(v.speed_scale, []).append(v)
     per_speed = max(1, math.ceil(2 * max(workers, 1) / len(by_speed)))
     groups: list[list[Variant]] = []
     for members in by_speed.values():
-        size = max(1, math.ceil(len(members) / per_speed))
-        groups.extend(members[k:k + size] for k in range(0, len(members), size))
+        n = min(per_speed, len(members))
+        size, extra = divmod(len(members), n)
+        cuts = [k * size + min(k, extra) for k in range(n + 1)]
+        groups.extend(members[a:b] for a, b in zip(cuts[:-1], cuts[1:], strict=True))
     return groups
 
 
@@ -89,8 +92,20 @@ def pool_startup_s(workers: int, mp_context: str = "spawn", scenario: Any = None
 
 
 def run_group(runner: Callable[[Variant], Any], variants: Sequence[Variant]) -> list[Outcome]:
-    """Run variants one after the other in this process (a task of a parallel sweep)."""
-    return [run_variant(runner, v) for v in variants]
+    """Run variants one after the other in this process (a task of a parallel sweep). Each is
+    told how many variants of its plan follow it in the group
+    (:data:`sim.pipeline.sweep.reuse.PEERS_AHEAD`): a plan's reference is worth scanning for
+    reuse only when another variant of it follows."""
+    from sim.pipeline.sweep import reuse
+
+    out = []
+    try:
+        for i, v in enumerate(variants):
+            reuse.PEERS_AHEAD = sum(w.speed_scale == v.speed_scale for w in variants[i + 1:])
+            out.append(run_variant(runner, v))
+    finally:
+        reuse.PEERS_AHEAD = None
+    return out
 
 
 def _run_batch(batch: Callable[[Sequence[Variant]], Sequence[Any]],
@@ -200,8 +215,8 @@ def run_variants(runner: Callable[[Variant], Any], variants: list[Variant], work
             _run_on_ray(runner, variants, results, address, workers, bar)
         elif workers == 1:  # in this process, a speed scale's variants one after the other
             for group in task_groups(variants, 1):
-                for v in group:
-                    results[v.index] = run_variant(runner, v)
+                for o in run_group(runner, group):
+                    results[o.variant.index] = o
                     bar.update()
         else:
             ctx = multiprocessing.get_context(mp_context)
