@@ -27,6 +27,10 @@ The package, one concept per module, each importing only those before it:
 <- :mod:`~sim.pipeline.sweep.engines` (where variants run: a process pool, Ray, a batch) <-
 :mod:`~sim.pipeline.sweep.run` (:func:`run_sweep`: the sweep folder, its lock and its move
 into place). Parsing the command line's value lists is :mod:`sim.cli.size`'s.
+:mod:`~sim.pipeline.sweep.evaluation` is what runs a variant (metrics only by default), and
+:mod:`~sim.pipeline.sweep.reuse` what a metrics-only variant reuses from the other variants of
+its plan in the same worker (the plan, the reference's collision scan: the same rows, bit for
+bit, without clearance, a warning no row depends on).
 """
 
 from sim.errors import SweepError

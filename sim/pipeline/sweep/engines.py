@@ -67,10 +67,12 @@ def warm_worker(scenario: Any = None) -> None:
     import sim.simulation.collision_reuse  # noqa: F401
 
     if isinstance(scenario, (str, os.PathLike)):
+        from pathlib import Path
+
         from sim.scenario import load_scenario
 
         try:
-            load_scenario(scenario)
+            load_scenario(scenario if isinstance(scenario, str) else Path(scenario))
         except Exception:  # noqa: BLE001 - the variants report it, each as its error
             pass
 
