@@ -89,6 +89,23 @@ def resolve_cameras(model: Any, cameras: Sequence[str]) -> list[int]:
     return ids
 
 
+def frame_times(record: RunRecord, fps: float) -> np.ndarray:
+    """Video frame times of ``record``: ``t0 + k / fps`` for ``k = 0 .. floor(duration * fps)``
+    (see :meth:`FrameRenderer.frame_times`).
+
+    Raises:
+        RenderError: ``fps`` not positive and finite, or more than :data:`MAX_FRAMES` frames.
+    """
+    if not np.isfinite(fps) or fps <= 0:
+        raise RenderError(f"fps must be a positive number, got {fps!r}")
+    count = record.duration * fps
+    if not np.isfinite(count) or count + 1 > MAX_FRAMES:
+        raise RenderError(f"--fps {fps:g} over the run's {record.duration:.4g} s gives "
+                          f"{count + 1:.3g} frames, more than {MAX_FRAMES:,}: lower --fps")
+    n = int(np.floor(count + 1e-9)) + 1
+    return record.t0 + np.arange(n) / float(fps)
+
+
 class FrameRenderer:
     """Renders a run's frames at chosen times.
 
@@ -213,14 +230,7 @@ class FrameRenderer:
         Raises:
             RenderError: ``fps`` not positive and finite.
         """
-        if not np.isfinite(fps) or fps <= 0:
-            raise RenderError(f"fps must be a positive number, got {fps!r}")
-        count = self.record.duration * fps
-        if not np.isfinite(count) or count + 1 > MAX_FRAMES:
-            raise RenderError(f"--fps {fps:g} over the run's {self.record.duration:.4g} s gives "
-                              f"{count + 1:.3g} frames, more than {MAX_FRAMES:,}: lower --fps")
-        n = int(np.floor(count + 1e-9)) + 1
-        return self.record.t0 + np.arange(n) / float(fps)
+        return frame_times(self.record, fps)
 
     def set_state(self, time: float) -> None:
         """Puts the interpolated state at ``time`` into ``self.data`` (positions only)."""
