@@ -4,8 +4,9 @@ Reads ``RUN_DIR/model.xml`` and ``RUN_DIR/trajectory.npz`` (see :mod:`sim.simula
 renders the recorded states at the video's frame times with the tool-point trails, weld bead
 and caption, and writes ``RUN_DIR/video.mp4`` (or ``--out``). ``--plots`` also writes the
 PNG plots into ``RUN_DIR/plots/``. The OpenGL backend is chosen before mujoco is imported
-(``--gl`` forces one). A progress bar is shown on long renders when stderr is a terminal;
-``--quiet`` hides it and the summary line.
+(``--gl`` forces one). The frames are rendered by one process per core (``--jobs``), each
+with its own OpenGL context, and encoded in order as they arrive. A progress bar is shown on
+long renders when stderr is a terminal; ``--quiet`` hides it and the summary line.
 """
 
 from __future__ import annotations
@@ -39,6 +40,18 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _jobs(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number of processes, got {text!r}"
+        ) from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected at least 1 process, got {value}")
+    return value
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "render",
@@ -61,6 +74,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="frames per second (default 30); frames = floor(duration*fps)+1")
     p.add_argument("--camera", action="append", metavar="NAME", dest="cameras", default=None,
                    help="camera of the cell to render (repeatable; default: overview)")
+    p.add_argument("--jobs", type=_jobs, metavar="N", default=None,
+                   help="processes rendering frames, each with its own OpenGL context "
+                        "(default: one per core; 1: in this process)")
     p.add_argument("--plots", action="store_true",
                    help="also write the PNG plots into RUN_DIR/plots/")
     p.add_argument("--quiet", action="store_true", help="no progress bar, no summary line")
@@ -85,13 +101,14 @@ def run(args: argparse.Namespace) -> int:
         check_plots_dir(Path(args.run_dir) / PLOTS_DIR)
     result = write_video(
         record, out, cameras=tuple(args.cameras or ("overview",)), width=args.width,
-        height=args.height, fps=args.fps, gl=backend, progress=not args.quiet,
+        height=args.height, fps=args.fps, gl=backend, progress=not args.quiet, jobs=args.jobs,
     )
     if not args.quiet:
         print(
             f"wrote {result.path} ({result.frames} frames, {result.width}x{result.height}, "
             f"{result.fps:g} fps, {result.seconds:.1f} s, {result.frames_per_second:.1f} "
-            f"frames/s, OpenGL {result.backend})"
+            f"frames/s, {result.jobs} process{'es' if result.jobs > 1 else ''}, OpenGL "
+            f"{result.backend})"
         )
     if args.plots:
         from sim.analysis.plots import write_plots

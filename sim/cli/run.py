@@ -52,6 +52,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fps", type=float, help="video frames per second")
     p.add_argument("--camera", action="append", metavar="NAME",
                    help="cell camera to film (repeat to tile several side by side)")
+    p.add_argument("--video-jobs", type=_jobs, metavar="N",
+                   help="processes rendering the video's frames, each with its own OpenGL "
+                        "context (default: one per core; 1: in the cellsim process)")
     p.add_argument("--backend", choices=("mujoco", "warp"), default="mujoco",
                    help="physics: MuJoCo in C (default) or MuJoCo Warp (float32, on a GPU "
                         "where there is one; pip install 'cellsim[warp]')")
@@ -64,6 +67,18 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     add_selection_args(p)
     p.set_defaults(func=run)
+
+
+def _jobs(text: str) -> int:
+    """A positive whole number of processes (``--video-jobs``)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number of processes, got {text!r}"
+                                         ) from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected at least 1 process, got {value}")
+    return value
 
 
 def run(args: argparse.Namespace) -> int:
@@ -88,7 +103,8 @@ def run(args: argparse.Namespace) -> int:
         plots=not args.no_plots,
         feedforward=False if args.no_feedforward else None,
         video_args={"width": args.width, "height": args.height, "fps": args.fps,
-                    "cameras": tuple(args.camera) if args.camera else None, "gl": args.gl},
+                    "cameras": tuple(args.camera) if args.camera else None, "gl": args.gl,
+                    "jobs": args.video_jobs},
         progress=not args.quiet,
         selection=selection,
         csv=args.csv,

@@ -61,7 +61,7 @@ class RunOptions:
         video: Write ``video.mp4``.
         feedforward: Override the scenario's ``simulation.feedforward``.
         video_args: Keyword arguments for :func:`sim.render.video.write_video` (cameras, width,
-            height, fps, gl).
+            height, fps, gl, jobs).
         plots: Write ``plots/*.png``.
         sizing: Write the actuator-sizing report.
         progress: Show progress bars (they are silent anyway when stderr is not a terminal).
@@ -174,6 +174,9 @@ def _prepare(scenario: Scenario, options: RunOptions, stages: Stages, *, reuse_p
             fps = video_args.get("fps", 30.0)
             if not (np.isfinite(fps) and fps > 0):
                 raise RenderError(f"--fps must be a positive number, got {fps!r}")
+            from sim.render.video import resolve_jobs
+
+            resolve_jobs(video_args.get("jobs"), 1)  # a bad process count: refused now too
     with stages.stage("plan"):
         key = _plan_key(scenario) if reuse_plan else None
         motion = _PLANS.get(key) if key is not None else None

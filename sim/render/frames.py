@@ -9,9 +9,10 @@ visualiser needs (``mj_kinematics``, ``mj_comPos``, ``mj_camlight``, and ``mj_te
 renders each camera with the overlay (:mod:`sim.render.overlay`) and draws the caption.
 
 ``width`` and ``height`` are the size of ONE camera tile; the frame is
-``(height, width * len(cameras), 3)``. If the model's offscreen framebuffer
-(``<visual><global offwidth offheight>``) is smaller than the tile, it is enlarged on the
-loaded model (the file is not changed).
+``(height, width * len(cameras), 3)``. The model's offscreen framebuffer
+(``<visual><global offwidth offheight>``) is set to the tile's size on the loaded model (the
+file is not changed): larger costs software OpenGL time for the same pixels, smaller cannot
+hold the tile.
 """
 
 from __future__ import annotations
@@ -153,8 +154,11 @@ class FrameRenderer:
                 f"{self.record.where}: trajectory.npz 'qpos' has shape {qpos.shape} but model.xml "
                 f"has nq={model.nq}"
             )
-        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), int(width))
-        model.vis.global_.offheight = max(int(model.vis.global_.offheight), int(height))
+        # the offscreen framebuffer is the tile's size: the renderer renders into its corner
+        # anyway, and software OpenGL pays for the whole (multisampled) buffer every frame
+        # (a cell's 1920 x 1080 buffer: ~16 % more CPU per 480 x 360 frame, same pixels)
+        model.vis.global_.offwidth = int(width)
+        model.vis.global_.offheight = int(height)
         self.views = self._views(model, qpos, width / height)
         self.model = model
         self.data = mujoco.MjData(model)
@@ -184,7 +188,7 @@ class FrameRenderer:
 
         views: list[Any] = []
         tcp = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "robot/tcp")
-        for name, cid in zip(self.cameras, self.camera_ids):
+        for name, cid in zip(self.cameras, self.camera_ids, strict=True):
             if name == "overview":
                 views.append(overview_view(model, qpos, cid, aspect))
             elif name == "tool" and tcp >= 0:

@@ -196,6 +196,20 @@ def _activate(backend: str) -> None:
         mujoco_module.GLContext = backend_cls
 
 
+def adopt_backend(name: str) -> str:
+    """Activates ``name`` without probing it: for a process started by one whose
+    :func:`configure_gl` chose it on this machine (the video's worker processes), which would
+    otherwise probe again (a subprocess, about a second each).
+
+    Raises:
+        RenderError: Unknown name, or mujoco imported earlier with a backend that cannot be
+            switched.
+    """
+    key = _check_name(name)
+    _probe_cache.setdefault(key, ProbeResult(key, True))
+    return configure_gl(key)
+
+
 def configure_gl(preferred: str | None = None) -> str:
     """Chooses and activates a headless OpenGL backend; call before importing mujoco.
 

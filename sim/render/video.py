@@ -2,12 +2,13 @@
 
 :func:`write_video` renders the run at the video's own frame times ``t0 + k / fps``,
 ``k = 0 .. floor(duration * fps)`` (so ``floor(duration * fps) + 1`` frames), interpolating
-the recorded states between samples (it does not render every physics step). Frames go
-through a bounded queue to a background thread that feeds imageio's ffmpeg writer
-(imageio-ffmpeg's static ffmpeg, libx264), so encoding (and drawing the caption) overlaps
-rendering. The file is
-written under a temporary name in the same folder and renamed when complete; on error or
-interruption the partial file is removed.
+the recorded states between samples (it does not render every physics step). The frames are
+rendered by ``jobs`` processes (default: one per usable core; :mod:`sim.render.workers`), each
+with its own OpenGL context, or in this process with ``jobs=1``. They go, in order and as they
+arrive, through a bounded queue to a background thread that draws the caption and feeds
+imageio's ffmpeg writer (imageio-ffmpeg's static ffmpeg, libx264), so encoding overlaps
+rendering. The file is written under a temporary name in the same folder and renamed when
+complete; on error or interruption the partial file is removed (and the workers stopped).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,8 +28,16 @@ from typing import Any
 import numpy as np
 
 from sim.errors import RenderError
-from sim.render.overlay import OverlayStyle, draw_caption
+from sim.render.overlay import OverlayStyle, caption_text, draw_caption
 from sim.simulation.runfolder import RunRecord
+
+#: ``frame_sink(index, frame)``: sees every frame as it goes to the encoder (caption drawn).
+FrameSink = Callable[[int, np.ndarray], None]
+
+#: Fewest frames per worker process when ``jobs`` is left to the default: a process costs
+#: a second or two of CPU to start (interpreter, model, OpenGL context), a software frame
+#: 0.02-0.2 s: a short video is rendered in one process.
+MIN_FRAMES_PER_JOB = 64
 
 
 @dataclass(frozen=True)
@@ -45,6 +54,7 @@ class VideoResult:
             rendering, encoding), s.
         loop_seconds: Wall-clock time from the first frame to the encoder's last, s.
         backend: OpenGL backend used.
+        jobs: Processes that rendered the frames (1: this one).
     """
 
     path: Path
@@ -55,6 +65,7 @@ class VideoResult:
     seconds: float
     loop_seconds: float
     backend: str
+    jobs: int = 1
 
     @property
     def frames_per_second(self) -> float:
@@ -70,18 +81,22 @@ class VideoResult:
 class _Encoder:
     """Background thread appending frames to an imageio writer, fed by a bounded queue.
 
-    Items are ``(frame, caption)``; a non-empty caption is drawn in this thread (Pillow), in
-    parallel with the next frame's rendering (MuJoCo releases the GIL while rendering).
+    Items are ``(index, frame, caption)``; a non-empty caption is drawn in this thread
+    (Pillow), in parallel with the next frame's rendering (MuJoCo releases the GIL while
+    rendering); ``sink`` then sees the frame.
     """
 
     _STOP = object()
 
-    def __init__(self, writer: Any, maxsize: int, path: Path, log: Path | None = None) -> None:
+    def __init__(self, writer: Any, maxsize: int, path: Path, log: Path | None = None,
+                 sink: FrameSink | None = None) -> None:
         self.writer = writer
         self.path = path
         self.log = log
+        self.sink = sink
         self.queue: queue.Queue[Any] = queue.Queue(maxsize=max(1, maxsize))
         self.error: BaseException | None = None
+        self.sink_error: BaseException | None = None  # raised as itself, not as encoding's
         self.thread = threading.Thread(target=self._run, name="cellsim-video-encoder", daemon=True)
         self.thread.start()
 
@@ -93,23 +108,33 @@ class _Encoder:
             if self.error is not None:
                 continue  # drain after a failure so put() never blocks forever
             try:
-                frame, caption = item
+                index, frame, caption = item
                 if caption:
                     draw_caption(frame, caption)
+                if self.sink is not None:
+                    try:
+                        self.sink(index, frame)
+                    except BaseException as exc:  # noqa: BLE001 - reported to the producer
+                        self.sink_error = exc
+                        raise
                 self.writer.append_data(frame)
             except BaseException as exc:  # noqa: BLE001 - reported to the producer
                 self.error = exc
 
-    def put(self, frame: np.ndarray, caption: str = "") -> None:
+    def _raise(self) -> None:
+        if self.sink_error is not None:
+            raise self.sink_error
         if self.error is not None:
             raise _encoding_error(self.error, self.path, self.log) from self.error
-        self.queue.put((frame, caption))
+
+    def put(self, index: int, frame: np.ndarray, caption: str = "") -> None:
+        self._raise()
+        self.queue.put((index, frame, caption))
 
     def finish(self) -> None:
         self.queue.put(self._STOP)
         self.thread.join()
-        if self.error is not None:
-            raise _encoding_error(self.error, self.path, self.log) from self.error
+        self._raise()
 
 
 #: x264's speed presets, fastest first.
@@ -183,6 +208,43 @@ def _partial_path(path: Path) -> Path:
     return path.with_name(f".{path.stem}.partial{path.suffix}")
 
 
+def resolve_jobs(jobs: int | None, frames: int) -> int:
+    """Processes that render ``frames`` frames: ``jobs`` (at most one per frame), or by default
+    one per usable core and at most one per :data:`MIN_FRAMES_PER_JOB` frames.
+
+    Raises:
+        RenderError: ``jobs`` not a positive integer.
+    """
+    from sim.render.workers import usable_cores
+
+    if jobs is None:
+        return max(1, min(usable_cores(), frames // MIN_FRAMES_PER_JOB))
+    if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
+        raise RenderError(f"video jobs must be a positive whole number of processes, got "
+                          f"{jobs!r}")
+    return max(1, min(int(jobs), frames))
+
+
+@contextmanager
+def _frame_source(record: RunRecord, times: np.ndarray, jobs: int, backend: str,
+                  **render: Any) -> Iterator[Iterator[tuple[int, np.ndarray]]]:
+    """``(index, frame)`` in order, without caption: rendered here (``jobs == 1``: one
+    renderer, closed on leaving) or by worker processes (stopped on leaving)."""
+    if jobs == 1:
+        from sim.render.frames import FrameRenderer
+
+        with FrameRenderer(record, caption=False, gl=backend, **render) as frames:
+            yield ((k, frames.render(float(t), caption=False)) for k, t in enumerate(times))
+        return
+    from sim.render.workers import FrameJob, FramePool
+
+    job = FrameJob(record=record, times=times, gl=backend, cameras=tuple(render["cameras"]),
+                   width=render["width"], height=render["height"], overlay=render["overlay"],
+                   style=render["style"])
+    with FramePool(job, jobs) as pool:
+        yield pool.frames()
+
+
 def write_video(
     run: str | Path | RunRecord,
     path: str | Path,
@@ -199,6 +261,8 @@ def write_video(
     crf: int = 20,
     preset: str = "veryfast",
     queue_size: int = 8,
+    jobs: int | None = None,
+    frame_sink: FrameSink | None = None,
 ) -> VideoResult:
     """Renders a recorded run into an H.264 MP4.
 
@@ -218,19 +282,26 @@ def write_video(
         crf: x264 constant rate factor (0 lossless .. 51 worst; 18-23 looks good).
         preset: x264 speed preset (``ultrafast`` .. ``veryslow``).
         queue_size: Frames buffered between renderer and encoder.
+        jobs: Processes rendering frames, each with its own OpenGL context (1: this process
+            alone); None: one per usable core, at most one per :data:`MIN_FRAMES_PER_JOB`
+            frames. The frames are the same whatever the number.
+        frame_sink: Called as ``frame_sink(index, frame)`` with every frame, in order, as it
+            goes to the encoder (caption drawn); the frame must not be kept without a copy.
 
     Returns:
         A :class:`VideoResult`.
 
     Raises:
-        RenderError: Bad path/size/fps/camera, no OpenGL backend, or the encoder failed.
+        RenderError: Bad path/size/fps/camera/jobs, no OpenGL backend, a worker process that
+            failed, or the encoder failed.
         RunFolderError: The run folder is missing or malformed.
     """
     import imageio.v2 as imageio
     from tqdm import tqdm
 
-    from sim.render.frames import FrameRenderer
-    from sim.render.gl import active_backend
+    from sim.render.frames import frame_times, validate_size
+    from sim.render.gl import configure_gl
+    from sim.simulation.runfolder import REQUIRED_FOR_VIDEO, as_record
 
     out_path = Path(path)
     if out_path.suffix.lower() != ".mp4":
@@ -240,12 +311,16 @@ def write_video(
     if preset not in PRESETS:
         raise RenderError(f"unknown x264 preset {preset!r}; valid: {', '.join(PRESETS)}")
     started = time.perf_counter()
-    with FrameRenderer(
-        run, cameras=cameras, width=width, height=height, overlay=overlay, caption=caption,
-        gl=gl, style=style,
-    ) as frames:
-        times = frames.frame_times(fps)
-        h, w, _ = frames.frame_shape
+    validate_size(width, height)
+    record = as_record(run)
+    record.require(REQUIRED_FOR_VIDEO)
+    backend = configure_gl(gl)
+    times = frame_times(record, fps)
+    n_jobs = resolve_jobs(jobs, len(times))
+    cams = [str(cameras)] if isinstance(cameras, str) else [str(c) for c in cameras]
+    render = {"cameras": cams, "width": width, "height": height, "overlay": overlay,
+              "style": style}
+    with _frame_source(record, times, n_jobs, backend, **render) as frames:
         out_path.parent.mkdir(parents=True, exist_ok=True)
         tmp = _partial_path(out_path)
         ok = False
@@ -260,15 +335,14 @@ def write_video(
                 )
                 loop_start = time.perf_counter()
                 try:
-                    encoder = _Encoder(writer, queue_size, out_path, log)
+                    encoder = _Encoder(writer, queue_size, out_path, log, frame_sink)
                     bar = tqdm(total=len(times), unit="frame", desc="render", file=sys.stderr,
                                disable=not (progress and sys.stderr.isatty()), leave=False,
                                delay=1.0)  # only renders longer than a second show a bar
                     try:
-                        for t in times:
-                            t = float(t)
-                            text = frames.caption_at(t) if caption else ""
-                            encoder.put(frames.render(t, caption=False), text)
+                        for k, frame in frames:
+                            text = caption_text(record, float(times[k])) if caption else ""
+                            encoder.put(k, frame, text)
                             bar.update(1)
                     finally:
                         bar.close()
@@ -290,7 +364,7 @@ def write_video(
             if not ok and tmp.exists():
                 tmp.unlink()
     return VideoResult(
-        path=out_path, frames=len(times), fps=float(fps), width=w, height=h,
-        seconds=time.perf_counter() - started, loop_seconds=loop_seconds,
-        backend=active_backend() or "",
+        path=out_path, frames=len(times), fps=float(fps), width=width * len(cams), height=height,
+        seconds=time.perf_counter() - started, loop_seconds=loop_seconds, backend=backend,
+        jobs=n_jobs,
     )
