@@ -17,7 +17,9 @@ stays bounded; :meth:`FramePool.frames` yields ``(index, frame)`` for ``index = 
 each exactly once, as soon as each is there. A worker must send the frames of its chunk, in
 order, then say the chunk is done: a frame twice, one missing or one not asked for is a
 :class:`~sim.errors.RenderError`, as is a worker that fails (its error's message; a cellsim
-error, such as an unknown camera, keeps its class and message) or dies.
+error, such as an unknown camera, keeps its class and message) or dies (its exit code and the
+last line it wrote: a worker's standard error goes to a temporary file, so that a crash is
+still one line).
 
 Closing the pool (always: use it as a context manager) stops the workers: the parent closes
 its ends of their pipes (a worker waiting for work or sending a frame then ends, closing its
@@ -37,6 +39,7 @@ import multiprocessing as mp
 import os
 import subprocess
 import sys
+import tempfile
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, replace
@@ -201,6 +204,7 @@ class FramePool:
         self.chunk_renderer = chunk_renderer or render_chunk
         self.processes: list[subprocess.Popen[bytes]] = []
         self.conns: list[Connection] = []
+        self.logs: list[Any] = []  # each worker's stderr (the last line explains a crash)
         self._done = False
 
     # -- life cycle ---------------------------------------------------------------------
@@ -211,24 +215,28 @@ class FramePool:
             env.setdefault("LP_NUM_THREADS", "1")
         for _ in range(self.jobs):
             parent, child = mp.Pipe(duplex=True)
+            log = tempfile.TemporaryFile()
             try:
                 process = subprocess.Popen(
                     [sys.executable, "-c", _BOOT, str(child.fileno())], env=env,
-                    pass_fds=(child.fileno(),), stdin=subprocess.DEVNULL, process_group=0)
+                    pass_fds=(child.fileno(),), stdin=subprocess.DEVNULL, stderr=log,
+                    process_group=0)
             except BaseException:
                 parent.close()
+                log.close()
                 raise
             finally:
                 child.close()  # the parent's copy: a worker that ends closes the pipe
             self.processes.append(process)
             self.conns.append(parent)
+            self.logs.append(log)
         for w, conn in enumerate(self.conns):  # each reads it once its interpreter is up
             try:
                 conn.send(list(sys.path))
                 conn.send((self.job, self.chunk_renderer))
             except OSError:
-                raise RenderError(f"video {self._who(w)} did not start (exit code "
-                                  f"{self.processes[w].wait()})") from None
+                raise RenderError(f"video {self._who(w)} did not start{self._said(w)}"
+                                  ) from None
 
     def close(self) -> None:
         """Stops every worker (idempotent): pipes closed, waited for, terminated if need be."""
@@ -248,7 +256,9 @@ class FramePool:
                     break
                 except subprocess.TimeoutExpired:
                     continue
-        self.processes, self.conns = [], []
+        for log in self.logs:
+            log.close()
+        self.processes, self.conns, self.logs = [], [], []
 
     def __enter__(self) -> FramePool:
         try:
@@ -318,12 +328,8 @@ class FramePool:
         try:
             message = conn.recv()
         except (EOFError, ConnectionResetError):  # reset: it ended with work still unread
-            try:
-                code: int | None = self.processes[w].wait(JOIN_S)
-            except subprocess.TimeoutExpired:
-                code = None
-            raise RenderError(f"video {self._who(w)} ended unexpectedly (exit code "
-                              f"{code})") from None
+            raise RenderError(f"video {self._who(w)} ended unexpectedly{self._said(w)}"
+                              ) from None
         kind = message[0] if isinstance(message, tuple) and message else None
         if kind == "error":
             raise _worker_error(self._who(w), str(message[1]), str(message[2]))
@@ -353,6 +359,22 @@ class FramePool:
         else:
             raise RenderError(f"video {self._who(w)} sent an unexpected message "
                               f"{str(message)[:80]}")
+
+    def _said(self, w: int) -> str:
+        """`` (exit code N: <its last line on stderr>)`` of an ended worker."""
+        try:
+            code: int | None = self.processes[w].wait(JOIN_S)
+        except subprocess.TimeoutExpired:
+            code = None
+        last = ""
+        try:
+            log = self.logs[w]
+            log.seek(max(0, log.seek(0, os.SEEK_END) - 4096))
+            lines = [ln.strip() for ln in log.read().decode(errors="replace").splitlines()]
+            last = next((ln for ln in reversed(lines) if ln), "")
+        except (OSError, IndexError):
+            pass
+        return f" (exit code {code}{': ' + last[:200] if last else ''})"
 
     def _misfit(self, w: int, k: int, expected: int | None) -> str:
         """Why frame ``k`` from worker ``w`` is refused (``expected``: the one it owed)."""

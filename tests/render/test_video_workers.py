@@ -104,8 +104,8 @@ SLOW = pytest.mark.slow  # a worker process each (1-2 s of CPU): the fast share 
                  "for", id="unasked", marks=SLOW),
     pytest.param(faults.fails, "video worker 1 of 1 failed: ValueError: planted failure at "
                  "frame 5", id="fails", marks=SLOW),
-    pytest.param(faults.dies, "video worker 1 of 1 ended unexpectedly (exit code 7)",
-                 id="dies"),
+    pytest.param(faults.dies, "video worker 1 of 1 ended unexpectedly (exit code 7: planted "
+                 "crash at frame 5)", id="dies"),
 ])
 def test_a_worker_that_breaks_the_protocol_is_caught(run_dir: Path, fault: object,
                                                      message: str) -> None:

@@ -8,6 +8,7 @@ module because a worker process receives its chunk renderer by name (pickled).
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterator, Sequence
 from typing import Any
 
@@ -56,9 +57,12 @@ def fails(frames: Any, times: np.ndarray, indices: Sequence[int]
 
 def dies(frames: Any, times: np.ndarray, indices: Sequence[int]
          ) -> Iterator[tuple[int, np.ndarray]]:
-    """The process ends without a word at frame AT (a crash in the driver, an OOM kill)."""
+    """The process ends at frame AT with a line on stderr and no reply (a crash in the driver,
+    an OOM kill)."""
     for k, frame in render_chunk(frames, times, indices):
         if k == AT:
+            sys.stderr.write(f"some warning\nplanted crash at frame {k}\n\n")
+            sys.stderr.flush()
             os._exit(7)
         yield k, frame
 
