@@ -71,7 +71,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--height", type=_positive_int, default=480,
                    help="height, pixels, even (default 480)")
     p.add_argument("--fps", type=_positive_float, default=30.0,
-                   help="frames per second (default 30); frames = floor(duration*fps)+1")
+                   help="frames per second (default 30); frames = floor(duration*fps/speed)+1")
+    p.add_argument("--speed", type=_positive_float, default=1.0,
+                   help="playback speed, simulated seconds per second of video (default 1; "
+                        "4: a time-lapse four times faster than real time)")
     p.add_argument("--camera", action="append", metavar="NAME", dest="cameras", default=None,
                    help="camera of the cell to render (repeatable; default: overview)")
     p.add_argument("--jobs", type=_jobs, metavar="N", default=None,
@@ -101,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
         check_plots_dir(Path(args.run_dir) / PLOTS_DIR)
     result = write_video(
         record, out, cameras=tuple(args.cameras or ("overview",)), width=args.width,
-        height=args.height, fps=args.fps, gl=backend, progress=not args.quiet, jobs=args.jobs,
+        height=args.height, fps=args.fps, speed=args.speed, gl=backend, progress=not args.quiet, jobs=args.jobs,
     )
     if not args.quiet:
         print(

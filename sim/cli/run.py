@@ -50,6 +50,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--width", type=int, help="video width per camera, pixels")
     p.add_argument("--height", type=int, help="video height, pixels")
     p.add_argument("--fps", type=float, help="video frames per second")
+    p.add_argument("--video-speed", type=float, metavar="X",
+                   help="video playback speed, simulated seconds per second of video (4: a "
+                        "time-lapse four times faster than real time)")
     p.add_argument("--camera", action="append", metavar="NAME",
                    help="cell camera to film (repeat to tile several side by side)")
     p.add_argument("--video-jobs", type=_jobs, metavar="N",
@@ -103,6 +106,7 @@ def run(args: argparse.Namespace) -> int:
         plots=not args.no_plots,
         feedforward=False if args.no_feedforward else None,
         video_args={"width": args.width, "height": args.height, "fps": args.fps,
+                    "speed": args.video_speed,
                     "cameras": tuple(args.camera) if args.camera else None, "gl": args.gl,
                     "jobs": args.video_jobs},
         progress=not args.quiet,

@@ -174,6 +174,9 @@ def _prepare(scenario: Scenario, options: RunOptions, stages: Stages, *, reuse_p
             fps = video_args.get("fps", 30.0)
             if not (np.isfinite(fps) and fps > 0):
                 raise RenderError(f"--fps must be a positive number, got {fps!r}")
+            speed = video_args.get("speed", 1.0)
+            if not (np.isfinite(speed) and speed > 0):
+                raise RenderError(f"--video-speed must be a positive number, got {speed!r}")
             from sim.render.video import resolve_jobs
 
             resolve_jobs(video_args.get("jobs"), 1)  # a bad process count: refused now too
@@ -544,7 +547,7 @@ def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:
     args: dict[str, Any] = {}
     if v.cameras:
         args["cameras"] = tuple(v.cameras)
-    for key in ("width", "height", "fps"):
+    for key in ("width", "height", "fps", "speed"):
         if getattr(v, key) is not None:
             args[key] = getattr(v, key)
     args.update({k: val for k, val in options.video_args.items() if val is not None})

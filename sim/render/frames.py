@@ -90,21 +90,28 @@ def resolve_cameras(model: Any, cameras: Sequence[str]) -> list[int]:
     return ids
 
 
-def frame_times(record: RunRecord, fps: float) -> np.ndarray:
-    """Video frame times of ``record``: ``t0 + k / fps`` for ``k = 0 .. floor(duration * fps)``
-    (see :meth:`FrameRenderer.frame_times`).
+def frame_times(record: RunRecord, fps: float, speed: float = 1.0) -> np.ndarray:
+    """Video frame times of ``record``: ``t0 + k speed / fps`` for
+    ``k = 0 .. floor(duration * fps / speed)`` (see :meth:`FrameRenderer.frame_times`).
+
+    ``speed`` is the playback speed, simulated seconds per second of video (4: a time-lapse
+    four times faster than real time; 0.5: slow motion).
 
     Raises:
-        RenderError: ``fps`` not positive and finite, or more than :data:`MAX_FRAMES` frames.
+        RenderError: ``fps`` or ``speed`` not positive and finite, or more than
+            :data:`MAX_FRAMES` frames.
     """
     if not np.isfinite(fps) or fps <= 0:
         raise RenderError(f"fps must be a positive number, got {fps!r}")
-    count = record.duration * fps
+    if isinstance(speed, bool) or not np.isfinite(speed) or speed <= 0:
+        raise RenderError(f"the video's playback speed must be a positive number, got {speed!r}")
+    count = record.duration * fps / speed
     if not np.isfinite(count) or count + 1 > MAX_FRAMES:
-        raise RenderError(f"--fps {fps:g} over the run's {record.duration:.4g} s gives "
-                          f"{count + 1:.3g} frames, more than {MAX_FRAMES:,}: lower --fps")
+        raise RenderError(f"--fps {fps:g} at speed {speed:g} over the run's "
+                          f"{record.duration:.4g} s gives {count + 1:.3g} frames, more than "
+                          f"{MAX_FRAMES:,}: lower --fps or raise the speed")
     n = int(np.floor(count + 1e-9)) + 1
-    return record.t0 + np.arange(n) / float(fps)
+    return record.t0 + (np.arange(n) * float(speed)) / float(fps)
 
 
 class FrameRenderer:
@@ -225,16 +232,17 @@ class FrameRenderer:
         """Shape of one frame, (height, width * n_cameras, 3)."""
         return (self.height, self.width * len(self.camera_ids), 3)
 
-    def frame_times(self, fps: float) -> np.ndarray:
-        """Video frame times ``t0 + k / fps`` for ``k = 0 .. floor(duration * fps)``.
+    def frame_times(self, fps: float, speed: float = 1.0) -> np.ndarray:
+        """Video frame times ``t0 + k speed / fps`` for ``k = 0 .. floor(duration * fps /
+        speed)`` (``speed``: simulated seconds per second of video).
 
-        The frame count is ``floor(duration * fps) + 1``: the first frame shows the first
-        sample, the last one the state at most ``1 / fps`` before the end.
+        The frame count is ``floor(duration * fps / speed) + 1``: the first frame shows the
+        first sample, the last one the state at most ``speed / fps`` before the end.
 
         Raises:
-            RenderError: ``fps`` not positive and finite.
+            RenderError: ``fps`` or ``speed`` not positive and finite.
         """
-        return frame_times(self.record, fps)
+        return frame_times(self.record, fps, speed)
 
     def set_state(self, time: float) -> None:
         """Puts the interpolated state at ``time`` into ``self.data`` (positions only)."""

@@ -253,6 +253,7 @@ def write_video(
     width: int = 640,
     height: int = 480,
     fps: float = 30.0,
+    speed: float = 1.0,
     gl: str | None = None,
     progress: bool = False,
     overlay: bool = True,
@@ -274,6 +275,8 @@ def write_video(
         width: Width of one camera tile, pixels (even, 16..8192).
         height: Height, pixels (even, 16..8192).
         fps: Frames per second (> 0).
+        speed: Playback speed, simulated seconds per second of video (> 0; 4: a time-lapse
+            four times faster than real time).
         gl: OpenGL backend ``"egl"`` / ``"osmesa"``, or None for automatic.
         progress: Show a progress bar on stderr (only when stderr is a terminal).
         overlay: Draw the tool-point trails and the weld bead.
@@ -315,7 +318,7 @@ def write_video(
     record = as_record(run)
     record.require(REQUIRED_FOR_VIDEO)
     backend = configure_gl(gl)
-    times = frame_times(record, fps)
+    times = frame_times(record, fps, speed)
     n_jobs = resolve_jobs(jobs, len(times))
     cams = [str(cameras)] if isinstance(cameras, str) else [str(c) for c in cameras]
     render = {"cameras": cams, "width": width, "height": height, "overlay": overlay,

@@ -213,6 +213,7 @@ class VideoSpec(_Strict):
     width: int | None = Field(None, gt=0)
     height: int | None = Field(None, gt=0)
     fps: float | None = Field(None, gt=0)
+    speed: float | None = Field(None, gt=0)
 
 
 class DriveOverrideSpec(_Strict):

@@ -362,6 +362,24 @@ def test_frame_count_is_floor_duration_times_fps_plus_one(run_dir: Path, fps: fl
     assert times[0] == 0.0 and times[-1] <= 2.0
 
 
+@pytest.mark.parametrize(("fps", "speed", "expected"), [(12.0, 4.0, 7), (3.0, 1.0, 7),
+                                                      (10.0, 0.5, 41), (30.0, 3.0, 21)])
+def test_a_time_lapse_takes_a_frame_every_speed_over_fps_seconds(run_dir: Path, fps: float,
+                                                                  speed: float,
+                                                                  expected: int) -> None:
+    """Playback ``speed`` (simulated seconds per second of video): the 2 s run's frames lie
+    ``speed / fps`` apart, ``floor(2 fps / speed) + 1`` of them; speed 1 is the plain video."""
+    from sim.render.frames import FrameRenderer
+
+    with FrameRenderer(run_dir, width=32, height=32) as fr:
+        times = fr.frame_times(fps, speed)
+        plain = fr.frame_times(fps)
+        assert np.array_equal(fr.frame_times(fps, 1.0), plain)
+    assert len(times) == expected == int(np.floor(2.0 * fps / speed + 1e-9)) + 1
+    np.testing.assert_allclose(np.diff(times), speed / fps)
+    assert times[0] == 0.0 and times[-1] <= 2.0
+
+
 def test_bad_fps_is_rejected(run_dir: Path) -> None:
     from sim.render.frames import FrameRenderer
 
@@ -369,6 +387,9 @@ def test_bad_fps_is_rejected(run_dir: Path) -> None:
         for fps in (0.0, -5.0, float("nan")):
             with pytest.raises(RenderError, match="fps must be a positive"):
                 fr.frame_times(fps)
+        for speed in (0.0, -1.0, float("nan"), float("inf")):
+            with pytest.raises(RenderError, match="playback speed must be a positive"):
+                fr.frame_times(10.0, speed)
 
 
 # ----------------------------------------------------------------------------- caption
