@@ -380,6 +380,18 @@ def test_a_time_lapse_takes_a_frame_every_speed_over_fps_seconds(run_dir: Path, 
     assert times[0] == 0.0 and times[-1] <= 2.0
 
 
+def test_the_shadow_map_is_sized_to_the_tile_and_never_above_the_model():
+    """Twice the tile's longer side, a power of two, capped by the model's own map."""
+    from sim.render.frames import shadow_size
+
+    for w, h in ((320, 240), (480, 360), (640, 480), (1280, 720), (1920, 1080), (16, 16)):
+        side = shadow_size(w, h, 4096)
+        assert side & (side - 1) == 0 and side <= 4096
+        assert side >= min(4096, 2 * max(w, h)) and (side == 256 or side < 4 * max(w, h)
+                                                     or side == 4096)
+    assert shadow_size(480, 360, 512) == 512
+
+
 def test_bad_fps_is_rejected(run_dir: Path) -> None:
     from sim.render.frames import FrameRenderer
 
