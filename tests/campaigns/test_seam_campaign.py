@@ -655,21 +655,22 @@ MIX = [
     *((arm, kind, 1) for arm in LIBRARY for kind in ("line", "polyline", "arc")),
 ]
 assert sum(n for *_, n in MIX) == 115
-#: The fast share (``make test``): 105 cases on the reference motion, the mix with one full
-#: circle per seed 6-axis arm (the costliest draws: about 20 refused per circle), the saved
-#: draws given to lines, and a line per arm of the welding-robot library.
+#: The fast share (``make test``): 46 cases on the reference motion, every arm and kind of the
+#: mix with one full circle per seed 6-axis arm but the KUKA's (the costliest draws: about 20
+#: refused per circle) and a line per arm of the welding-robot library. It was 105 cases; issue
+#: 29 (the fast share in ten minutes on two cores) moved the rest to the slow share, which
+#: draws :data:`SLOW_FACTOR` times :data:`MIX` (1150 cases).
 FAST_SHARE = [
-    ("lrmate200ic5l", "line", 9), ("lrmate200ic5l", "polyline", 10),
-    ("lrmate200ic5l", "arc", 6), ("lrmate200ic5l", "circle", 1),
-    ("kr6r900_2", "line", 8), ("kr6r900_2", "polyline", 7), ("kr6r900_2", "arc", 6),
-    ("kr6r900_2", "circle", 1),
-    ("irb2400", "line", 8), ("irb2400", "polyline", 7), ("irb2400", "arc", 6),
+    ("lrmate200ic5l", "line", 4), ("lrmate200ic5l", "polyline", 4),
+    ("lrmate200ic5l", "arc", 3), ("lrmate200ic5l", "circle", 1),
+    ("kr6r900_2", "line", 3), ("kr6r900_2", "polyline", 3), ("kr6r900_2", "arc", 2),
+    ("irb2400", "line", 3), ("irb2400", "polyline", 3), ("irb2400", "arc", 2),
     ("irb2400", "circle", 1),
     ("ur5_dh", "line", 1), ("ur5_dh", "polyline", 1), ("ur5_dh", "arc", 1), ("ur5_dh", "circle", 1),
-    ("lrmate100ib", "line", 26),
+    ("lrmate100ib", "line", 8),
     *((arm, "line", 1) for arm in LIBRARY),
 ]
-assert sum(n for *_, n in FAST_SHARE) == 105
+assert sum(n for *_, n in FAST_SHARE) == 46
 #: The simulated share: (arm, kind), one case each; 10 in all.
 SIM_SHARE = [("lrmate200ic5l", "line"), ("lrmate200ic5l", "polyline"),
              ("lrmate200ic5l", "circle"), ("kr6r900_2", "arc"), ("kr6r900_2", "polyline"),
@@ -732,7 +733,7 @@ def _seed(*key: Any) -> int:
 
 @pytest.mark.parametrize("arm,kind,n", FAST_SHARE)
 def test_generated_seams_on_the_reference_motion(arm, kind, n):
-    """The fast share: 100 generated seams, each planned and checked on its reference motion
+    """The fast share: 46 generated seams, each planned and checked on its reference motion
     (tool point, torch angles, progress speed, ends, weave, collisions: module docstring)."""
     campaign(ARMS[arm], kind, n, _seed("fast", arm, kind), check_reference)
 
