@@ -25,8 +25,11 @@ run: setup
 
 # The fast share (every test but those marked slow); test-slow runs the slow share (larger
 # generated campaigns, convergence studies), which .ci/run runs after the fast one.
+# The fast share's workers take whole test files (--dist loadfile): a file's module fixtures
+# (its shared runs) are computed once, not once per worker; the slow share's long campaign
+# files are spread test by test.
 test: setup
-	@$(BIN)/python -m pytest -m "not slow" -n $(JOBS) $(PYTEST_ARGS); rc=$$?; \
+	@$(BIN)/python -m pytest -m "not slow" -n $(JOBS) --dist loadfile $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
 test-slow: setup
