@@ -471,8 +471,9 @@ def _collision_html(summary: Mapping[str, Any]) -> list[str]:
 
 
 def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapping[str, Any],
-                video: str | None = None, selection: Any = None) -> str:
-    """Text of the self-contained ``report.html`` (charts as base64 data URIs)."""
+                video: str | None = None, selection: Any = None, replay: str | None = None) -> str:
+    """Text of the self-contained ``report.html`` (charts as base64 data URIs; ``replay``: the
+    3D replay's section, :mod:`sim.analysis.replay`)."""
     esc = html.escape
     title = f"cellsim report: {result.scenario or 'run'}"
     out = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
@@ -480,6 +481,8 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
            f"<title>{esc(title)}</title><style>{_CSS}</style></head><body>",
            f"<h1>{esc(title)}</h1>"]
     out += summary_html(summary, result)
+    if replay:
+        out.append(replay)
     if video:
         out.append(f'<h2>Video</h2><video controls src="{esc(video)}"></video>'
                    f'<p><a href="{esc(video)}">{esc(video)}</a></p>')
@@ -538,7 +541,7 @@ def sizing_html(result: SizingResult, charts: Mapping[str, bytes], summary: Mapp
 
 def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = True,
                  summary: Mapping[str, Any] | None = None,
-                 selection: Any = None) -> dict[str, Path]:
+                 selection: Any = None, replay: str | None = None) -> dict[str, Path]:
     """Write the sizing files of a run into ``run_dir``.
 
     ``summary`` is the run's summary in memory (the runner's); without it the folder's
@@ -549,6 +552,8 @@ def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = Tr
             present).
         result: From :func:`sim.analysis.sizing.size_run`.
         charts: Draw the charts (PNG files in ``run_dir/sizing/``, embedded in the HTML).
+        replay: The 3D replay's HTML section (:func:`sim.analysis.replay.replay_html`), or
+            None for a report without it.
 
     Returns:
         Paths written, by name: ``csv``, ``json``, ``md``, ``html`` and one per chart.
@@ -570,5 +575,6 @@ def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = Tr
         video = summary.get("video")
     written["md"] = write_atomic(run_dir / SIZING_MD, sizing_markdown(result, list(pngs), summary))
     written["html"] = write_atomic(run_dir / REPORT_HTML,
-                                   sizing_html(result, pngs, summary, video, selection))
+                                   sizing_html(result, pngs, summary, video, selection,
+                                                       replay))
     return written

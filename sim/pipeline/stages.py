@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from typing import TextIO
 
 #: The stages in the order a run goes through them.
-STAGES = ("build", "plan", "simulate", "checks", "sizing", "plots", "video", "write")
+STAGES = ("build", "plan", "simulate", "checks", "sizing", "plots", "video", "replay", "write")
 
 
 class Stages:
