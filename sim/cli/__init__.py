@@ -24,7 +24,8 @@ from sim.core.text import printable
 from sim.errors import CellsimError, CellsimWarning, InternalError
 
 #: Sub-command modules, in the order ``--help`` lists them.
-COMMANDS = ("list", "plan", "ik", "workspace", "check", "run", "size", "render", "export")
+COMMANDS = ("list", "plan", "ik", "workspace", "check", "run", "size", "render", "view",
+            "export")
 
 
 def build_parser() -> argparse.ArgumentParser:

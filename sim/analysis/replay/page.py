@@ -12,6 +12,7 @@ May import: the standard library only (data comes in as a dict).
 from __future__ import annotations
 
 import base64
+import html
 import json
 from functools import cache
 from importlib import resources
@@ -24,6 +25,9 @@ VENDOR = {
     "uPlot.iife.min.js": "uPlot 1.6.32 (MIT), dist/uPlot.iife.min.js",
     "uPlot.min.css": "uPlot 1.6.32 (MIT), dist/uPlot.min.css",
 }
+
+#: Comments around the section, so that ``cellsim view`` can replace it.
+BEGIN, END = "<!-- cellsim-replay:begin -->", "<!-- cellsim-replay:end -->"
 
 _CSS = """
 #cellsim-replay{border:1px solid #ccd;border-radius:6px;padding:8px;margin:1em 0}
@@ -65,7 +69,7 @@ def replay_section(payload: dict[str, Any]) -> str:
     }}
     data = json.dumps(payload, separators=(",", ":"), allow_nan=False)
     return "\n".join([
-        "<h2>Replay</h2>",
+        BEGIN, "<h2>Replay</h2>",
         f"<style>{_vendor('uPlot.min.css')}{_CSS}</style>",
         '<div id="cellsim-replay">',
         '<canvas class="replay-canvas"></canvas>',
@@ -86,5 +90,21 @@ def replay_section(payload: dict[str, Any]) -> str:
         f"<script>{_script_safe(_vendor('uPlot.iife.min.js'))}</script>",
         f'<script type="application/json" id="cellsim-replay-data">{_script_safe(data)}'
         "</script>",
-        f'<script type="module">{_script_safe(_app())}</script>',
+        f'<script type="module">{_script_safe(_app())}</script>', END,
     ])
+
+
+def with_replay(report: str | None, section: str, title: str = "cellsim replay") -> str:
+    """``report.html``'s text with ``section`` in place of its replay (or after its title when
+    it has none); a page of its own when there is no report."""
+    if report is None:
+        return ('<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+                f"<title>{html.escape(title)}</title></head><body style=\"font-family:"
+                f'system-ui,sans-serif;max-width:1200px;margin:1em auto"><h1>{html.escape(title)}'
+                f"</h1>\n{section}\n</body></html>\n")
+    a, b = report.find(BEGIN), report.find(END)
+    if 0 <= a < b:
+        return report[:a] + section + report[b + len(END):]
+    at = report.find("</h1>")
+    at = at + len("</h1>") if at >= 0 else report.find("<body>") + len("<body>")
+    return report[:at] + "\n" + section + report[at:]
