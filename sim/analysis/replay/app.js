@@ -289,8 +289,18 @@ window.cellsimReplay = {
   frameTimes: () => Array.from(frameT),
   fps: F.fps,
   bodies: D.bodies,
+  movingBodies: F.bodies.map((b) => D.bodies[b]),
   cameras: D.cameras.map((c) => c.name),
   setView,
+  look: (eye, target, fovy) => { // place the camera: eye and target in world coordinates (m)
+    follow = null;
+    camera.position.set(eye[0], eye[1], eye[2]);
+    controls.target.set(target[0], target[1], target[2]);
+    if (fovy) camera.fov = fovy;
+    camera.updateProjectionMatrix();
+    controls.update();
+    draw();
+  },
   solo,
   canvas,
   camera: () => {
