@@ -431,8 +431,7 @@ def run_and_write(scenario: Scenario, options: RunOptions | None = None) -> Eval
                     write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
                                 **video_args)
                     summary["video"] = runfolder.VIDEO_MP4
-            saved = None
-            replay = None
+            replay, saved = None, None
             if sizing is not None:  # the 3D replay of report.html (sim.analysis.replay)
                 with stages.stage("replay"):
                     from sim.analysis.replay import replay_html
@@ -451,8 +450,7 @@ def run_and_write(scenario: Scenario, options: RunOptions | None = None) -> Eval
                 if sizing is not None:  # last: report.html links the video, shows the verdict
                     from sim.analysis.report import write_sizing
 
-                    write_sizing(tmp, sizing, summary=summary, selection=selected,
-                                 replay=replay)
+                    write_sizing(tmp, sizing, summary=summary, selection=selected, replay=replay)
             summary["timings_s"] = dict(stages.timings)
             summary["total_wall_s"] = stages.total_s
             summary["backend"] = options.backend
