@@ -47,6 +47,11 @@ def b64(a: NDArray[Any], dtype: str = "<f4") -> dict[str, str]:
     return {kind: base64.b64encode(raw).decode("ascii")}
 
 
+def _num(v: Any) -> float | None:
+    """A finite number, or None (JSON has no NaN)."""
+    return float(v) if isinstance(v, (int, float)) and np.isfinite(v) else None
+
+
 def chart_series(arrays: Mapping[str, NDArray[Any]]) -> dict[str, NDArray[np.float64]]:
     """The charted quantities per joint (n, k), from what the run recorded."""
     out: dict[str, NDArray[np.float64]] = {}
@@ -123,7 +128,7 @@ def build_payload(model: Any, arrays: Mapping[str, NDArray[Any]], summary: Mappi
     collisions = [{"t0": float(c["t0"]), "t1": float(c["t1"]),
                    "geoms": [str(g) for g in c.get("all_geoms", c.get("geoms", []))],
                    "bodies": [str(b) for b in c.get("bodies", [])],
-                   "depth_mm": float(c.get("depth_mm", float("nan")))}
+                   "depth_mm": _num(c.get("depth_mm"))}
                   for c in summary.get("collisions") or [] if isinstance(c, Mapping)
                   and isinstance(c.get("t0"), (int, float))
                   and isinstance(c.get("t1"), (int, float))]

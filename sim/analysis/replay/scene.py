@@ -78,13 +78,13 @@ _PRIMITIVES = frozenset({0, 2, 3, 4, 5, 6})
 def frame_indices(t: NDArray[np.float64], fps: float, max_frames: int) -> NDArray[np.int64]:
     """Indices of the recorded samples shown as display frames: one per ``1/fps`` seconds
     (the recorded sample at or just after each frame time), at most ``max_frames``, the first
-    and last sample always included."""
+    and last sample always included (so at least two frames when the run lasts)."""
     t = np.asarray(t, np.float64)
     if t.size == 0:
         return np.zeros(0, np.int64)
     duration = float(t[-1] - t[0])
     n = int(np.floor(duration * fps)) + 1 if duration > 0 else 1
-    n = max(1, min(n, max_frames))
+    n = max(2 if duration > 0 else 1, min(n, max_frames))
     want = np.linspace(t[0], t[-1], n) if n > 1 else t[:1]
     idx = np.searchsorted(t, want, side="left").clip(0, t.size - 1)
     idx[-1] = t.size - 1
