@@ -17,8 +17,11 @@ SLOW_JOBS ?= auto
 
 # Debian packages that headless rendering needs (EGL on Mesa, or OSMesa).
 SYSTEM_PACKAGES := libegl1 libgl1 libosmesa6 libglu1-mesa
+# The browser the replay's tests drive (tests/analysis/test_replay_browser.py, slow): optional,
+# installed by browser-deps (test-slow runs it); without it those tests are skipped.
+BROWSER_PACKAGES := chromium
 
-.PHONY: run test test-slow lint setup system-deps bench clean
+.PHONY: run test test-slow lint setup system-deps browser-deps bench clean
 
 run: setup
 	$(BIN)/cellsim run $(SCENARIO) $(if $(OUT),--out $(OUT),)
@@ -32,7 +35,7 @@ test: setup
 	@$(BIN)/python -m pytest -m "not slow" -n $(JOBS) --dist loadfile $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
-test-slow: setup
+test-slow: setup browser-deps
 	@$(BIN)/python -m pytest -m slow -n $(SLOW_JOBS) $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 
@@ -50,6 +53,9 @@ setup: system-deps $(VENV)/.installed
 
 system-deps:
 	@bash scripts/install-system-deps.sh $(SYSTEM_PACKAGES)
+
+browser-deps:
+	@bash scripts/install-system-deps.sh --optional $(BROWSER_PACKAGES)
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' || \

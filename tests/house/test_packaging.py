@@ -28,6 +28,9 @@ def test_wheel_ships_models_scenarios_and_packages(wheel):
     for xml in (ROOT / "models").rglob("*.xml"):
         assert f"sim/_data/models/{xml.relative_to(ROOT / 'models').as_posix()}" in names
     assert "sim/cli/__init__.py" in names and "planners/__init__.py" in names
+    vendor = ROOT / "sim/analysis/replay/vendor"  # the replay's scripts and their licences
+    assert {f"sim/analysis/replay/vendor/{p.name}" for p in vendor.iterdir()} <= names
+    assert "sim/analysis/replay/app.js" in names
     assert not any(n.startswith(("tests/", ".venv/")) for n in names)
 
 
