@@ -8,7 +8,6 @@ from __future__ import annotations
 import base64
 import os
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
@@ -16,6 +15,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.limits import run_limited
 
 from sim.analysis.replay.page import BEGIN, END, VENDOR, replay_section, with_replay
 from sim.analysis.replay.payload import build_payload
@@ -145,8 +145,8 @@ def test_default_report_is_under_10_mb_and_view_works_without_opengl(scenario_ru
     (copy / "report.html").unlink()
     env = dict(os.environ, MUJOCO_GL="bogus", PYOPENGL_PLATFORM="bogus")
     env.pop("DISPLAY", None)
-    res = subprocess.run([sys.executable, "-m", "sim", "view", str(copy)], env=env,
-                         capture_output=True, text=True)
+    res = run_limited([sys.executable, "-m", "sim", "view", str(copy)], cpu_s=120, env=env,
+                      capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
     text = (copy / "report.html").read_text()
     assert text.count(BEGIN) == 1 and "cellsim-replay-data" in text

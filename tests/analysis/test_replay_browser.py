@@ -25,6 +25,7 @@ CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 SCENARIO = "bugnar_5r_weld_cycle"
 BACKGROUND = np.array([0xEE, 0xF1, 0xF5])  # the page's scene background
 TOL_PX = 3.0
+READY_POLLS = 4000
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +49,7 @@ class Page:
                                        device_scale_factor=1)
         self.requests: list[str] = []
         self.errors: list[str] = []
+        self.ctx.set_default_timeout(0)  # no wall-clock limit (a loaded machine is no failure)
         self.ctx.route("**/*", self._route)
         self.page = self.ctx.new_page()
         self.page.on("console", lambda m: m.type in ("error", "warning")
@@ -55,8 +57,13 @@ class Page:
         self.page.on("pageerror", lambda e: self.errors.append(f"pageerror: {e}"))
         start = time.perf_counter()
         self.page.goto(path.resolve().as_uri())
-        self.page.wait_for_function("window.cellsimReplay && window.cellsimReplay.ready",
-                                    timeout=120_000)
+        for _ in range(READY_POLLS):  # bounded by a count of polls
+            if self.page.evaluate("!!(window.cellsimReplay && window.cellsimReplay.ready)"):
+                break
+            self.page.wait_for_timeout(50)
+        else:
+            raise AssertionError(f"the replay was not ready after {READY_POLLS} polls: "
+                                 f"{self.errors}")
         self.load_s = time.perf_counter() - start
 
     def _route(self, route):
