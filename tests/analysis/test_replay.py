@@ -151,3 +151,29 @@ def test_default_report_is_under_10_mb_and_view_works_without_opengl(scenario_ru
     text = (copy / "report.html").read_text()
     assert text.count(BEGIN) == 1 and "cellsim-replay-data" in text
     assert len(text) < 10e6
+
+
+def _tiny_run(folder: Path, qpos_cols: int = 2) -> Path:
+    folder.mkdir()
+    (folder / "model.xml").write_text(ARM)
+    t = np.linspace(0, 1, 101)
+    q = np.c_[t, -t]
+    np.savez(folder / "trajectory.npz", t=t, qpos=q[:, :qpos_cols], q=q, qd=np.ones_like(q),
+             tau=q)
+    return folder
+
+
+def test_view_writes_a_report_of_its_own_and_refuses_poses_that_do_not_fit(tmp_path, capsys):
+    from sim.cli import main
+
+    run = _tiny_run(tmp_path / "run")
+    assert main(["view", str(run)]) == 0
+    assert str(run / "report.html") in capsys.readouterr().out  # headless: the path
+    text = (run / "report.html").read_text()
+    assert text.count(BEGIN) == 1 and "<h1>cellsim replay: run</h1>" in text
+    assert main(["view", str(run)]) == 0  # refreshed in place, once
+    assert (run / "report.html").read_text().count(BEGIN) == 1
+    bad = _tiny_run(tmp_path / "bad", qpos_cols=1)
+    assert main(["view", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "trajectory.npz" in err and "qpos" in err and len(err.strip().splitlines()) == 1

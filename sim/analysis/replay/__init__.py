@@ -43,13 +43,17 @@ def replay_html(model_xml: str | Path, arrays: Mapping[str, Any],
 
 def replay_of_folder(run_dir: str | Path) -> str:
     """The replay section for a finished run folder (read with ``load_run``)."""
+    from sim.errors import RunFolderError
     from sim.simulation.runfolder import load_run
 
     record = load_run(run_dir)
     assert record.model_path is not None
     summary = dict(record.summary)
     summary.setdefault("joints", list(record.joints))
-    return replay_html(record.model_path, record.arrays, summary)
+    try:
+        return replay_html(record.model_path, record.arrays, summary)
+    except ValueError as exc:  # the recorded poses do not fit the model
+        raise RunFolderError(f"{record.where}: trajectory.npz: {exc}") from exc
 
 
 __all__ = ["build_payload", "replay_html", "replay_of_folder", "replay_section"]
