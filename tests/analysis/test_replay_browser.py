@@ -4,8 +4,8 @@ poses say (pixels checked against mujoco's own kinematics projected with the pag
 matrices), and a click on the torque chart moves the replay there.
 
 Skipped, with the reason, when chromium or Playwright is missing (``make browser-deps``
-installs chromium). One browser per module; every test here is slow (it needs a simulated
-run of the default scenario, shared through ``scenario_run``).
+installs chromium). One browser per module; the tests on the default scenario's run (shared
+through ``scenario_run``) are slow, one on a two-link arm's tiny run is in the fast share.
 """
 
 from __future__ import annotations
@@ -18,8 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-pytestmark = pytest.mark.slow
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 SCENARIO = "bugnar_5r_weld_cycle"
@@ -197,6 +195,7 @@ def _bbox_error(page: Page, model, t, qpos, bodies, when: float) -> tuple[float,
     return float(np.abs(want - got).max()), want
 
 
+@pytest.mark.slow
 def test_default_report_loads_offline_draws_and_stays_under_10_mb(browser, default_run):
     report = default_run / "report.html"
     size_mb = report.stat().st_size / 1e6
@@ -221,6 +220,7 @@ def _recorded(run_dir: Path):
     return model, z["t"], z["qpos"], z["tcp_pos"]
 
 
+@pytest.mark.slow
 def test_two_slider_positions_draw_the_robot_where_the_recorded_poses_put_it(browser,
                                                                                  default_run):
     model, t, qpos, tcp = _recorded(default_run)
@@ -240,6 +240,7 @@ def test_two_slider_positions_draw_the_robot_where_the_recorded_poses_put_it(bro
         page.close()
 
 
+@pytest.mark.slow
 def test_planted_faults_are_caught_by_the_pixel_check(browser, default_run, tmp_path):
     """Poses shifted by one display frame, and two bodies' poses swapped: the drawn robot is
     no longer where the recorded poses put it."""
@@ -276,6 +277,7 @@ def test_planted_faults_are_caught_by_the_pixel_check(browser, default_run, tmp_
             page.close()
 
 
+@pytest.mark.slow
 def test_a_click_on_the_torque_chart_moves_the_replay_there(browser, default_run):
     page = Page(browser, default_run / "report.html")
     try:
@@ -291,5 +293,33 @@ def test_a_click_on_the_torque_chart_moves_the_replay_there(browser, default_run
             slider = float(page.page.locator("input.replay-slider").input_value())
             assert abs(slider - got) < 1e-6
         assert page.errors == []
+    finally:
+        page.close()
+
+
+def test_a_tiny_run_replays_offline_with_the_arm_where_its_poses_put_it(browser, tmp_path):
+    """The fast share's browser check: a two-link arm's run (written here), viewed."""
+    import mujoco
+    from test_replay import ARM
+
+    from sim.cli import main
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "model.xml").write_text(ARM)
+    t = np.linspace(0, 2, 201)
+    qpos = np.c_[1.5 * t, -t]
+    np.savez(run / "trajectory.npz", t=t, qpos=qpos, q=qpos, qd=np.ones_like(qpos), tau=qpos)
+    assert main(["view", str(run)]) == 0
+    model = mujoco.MjModel.from_xml_string(ARM)
+    page = Page(browser, run / "report.html")
+    try:
+        assert page.errors == []
+        assert all(u.startswith(("file:", "data:")) for u in page.requests), page.requests
+        bodies = _robot_setup(page, model, qpos[0])
+        assert sorted(bodies) == ["l1", "l2", "tip"]  # tip: only a hidden (group 3) geom
+        boxes = [_bbox_error(page, model, t, qpos, bodies, when) for when in (0.4, 1.6)]
+        assert all(err <= TOL_PX for err, _ in boxes), boxes
+        assert np.abs(boxes[0][1] - boxes[1][1]).max() > 5 * TOL_PX
     finally:
         page.close()
