@@ -17,8 +17,8 @@ SLOW_JOBS ?= auto
 
 # Debian packages that headless rendering needs (EGL on Mesa, or OSMesa).
 SYSTEM_PACKAGES := libegl1 libgl1 libosmesa6 libglu1-mesa
-# The browser the replay's tests drive (tests/analysis/test_replay_browser.py, slow): optional,
-# installed by browser-deps (test-slow runs it); without it those tests are skipped.
+# The browser the replay's tests drive (tests/analysis/test_replay_browser.py): optional,
+# installed by browser-deps (test and test-slow run it); without it those tests are skipped.
 BROWSER_PACKAGES := chromium
 
 .PHONY: run test test-slow lint setup system-deps browser-deps bench clean
@@ -31,7 +31,7 @@ run: setup
 # The fast share's workers take whole test files (--dist loadfile): a file's module fixtures
 # (its shared runs) are computed once, not once per worker; the slow share's long campaign
 # files are spread test by test.
-test: setup
+test: setup browser-deps
 	@$(BIN)/python -m pytest -m "not slow" -n $(JOBS) --dist loadfile $(PYTEST_ARGS); rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no tests collected: failing" >&2; exit 1; fi; exit $$rc
 

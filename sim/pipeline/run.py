@@ -167,19 +167,9 @@ def _prepare(scenario: Scenario, options: RunOptions, stages: Stages, *, reuse_p
         _check_tcp_consistency(built, scenario)
         video_args = _video_args(scenario, options)
         if options.video:  # refuse bad video settings before simulating, not after
-            from sim.render.frames import resolve_cameras, validate_size
+            from sim.render.video import check_video_args
 
-            resolve_cameras(built.model, video_args.get("cameras", ("overview",)))
-            validate_size(video_args.get("width", 640), video_args.get("height", 480))
-            fps = video_args.get("fps", 30.0)
-            if not (np.isfinite(fps) and fps > 0):
-                raise RenderError(f"--fps must be a positive number, got {fps!r}")
-            speed = video_args.get("speed", 1.0)
-            if not (np.isfinite(speed) and speed > 0):
-                raise RenderError(f"--video-speed must be a positive number, got {speed!r}")
-            from sim.render.video import resolve_jobs
-
-            resolve_jobs(video_args.get("jobs"), 1)  # a bad process count: refused now too
+            check_video_args(built.model, video_args)
     with stages.stage("plan"):
         key = _plan_key(scenario) if reuse_plan else None
         motion = _PLANS.get(key) if key is not None else None
@@ -225,7 +215,7 @@ def simulate_batch(scenarios: list[Scenario], prepared: list[tuple[BuiltCell, An
                          feedforward=key[-2], settle_s=key[-1],
                          drives=[_drives(scenarios[i]) for i in members],
                          labels=[names[i] for i in members])
-        for i, rec in zip(members, got):
+        for i, rec in zip(members, got, strict=True):
             records[i] = rec
     return records
 
@@ -339,7 +329,7 @@ def evaluate_scenarios(scenarios: list[Scenario], options: RunOptions | None = N
     quiet = RunOptions(**{**options.__dict__, "video": False})
     staged = [Stages(enabled=False) for _ in scenarios]
     prepared = [_prepare(s, quiet, st, reuse_plan=True)[:2]
-                for s, st in zip(scenarios, staged)]
+                for s, st in zip(scenarios, staged, strict=True)]
     records: list[Any] = [None] * len(scenarios)
     if options.backend == "warp":
         import time
@@ -350,7 +340,7 @@ def evaluate_scenarios(scenarios: list[Scenario], options: RunOptions | None = N
         for st in staged:
             st.timings["simulate_batch"] = share
     out = []
-    for s, (built, motion), st, rec in zip(scenarios, prepared, staged, records):
+    for s, (built, motion), st, rec in zip(scenarios, prepared, staged, records, strict=True):
         evaluation = _judge(s, built, motion, options, st, rec=rec, collide=collide)
         evaluation.summary["timings_s"] = dict(st.timings)
         evaluation.summary["total_wall_s"] = st.total_s
@@ -431,18 +421,15 @@ def run_and_write(scenario: Scenario, options: RunOptions | None = None) -> Eval
                     write_video(record, tmp / runfolder.VIDEO_MP4, progress=options.progress,
                                 **video_args)
                     summary["video"] = runfolder.VIDEO_MP4
-            replay, saved = None, None
+            saved = runfolder.decimate(arrays, built.model.opt.timestep,
+                                       scenario.simulation.record_hz)
+            replay = None
             if sizing is not None:  # the 3D replay of report.html (sim.analysis.replay)
                 with stages.stage("replay"):
                     from sim.analysis.replay import replay_html
 
-                    saved = runfolder.decimate(arrays, built.model.opt.timestep,
-                                               scenario.simulation.record_hz)
                     replay = replay_html(tmp / runfolder.MODEL_XML, saved, summary)
             with stages.stage("write"):
-                if saved is None:
-                    saved = runfolder.decimate(arrays, built.model.opt.timestep,
-                                               scenario.simulation.record_hz)
                 summary["record_hz"] = runfolder.sample_rate(saved["t"])
                 runfolder.write_trajectory(tmp, saved)
                 if options.csv:
@@ -602,5 +589,6 @@ def _check_tcp_consistency(built: BuiltCell, scenario: Scenario) -> None:
     if err > 1e-6 or rerr > 1e-6:
         raise InternalError(f"closed-form tcp and MuJoCo tcp differ by "
                            f"{err * 1e3:.3f} mm / {rerr:.2e} in rotation for robot "
-                           f"{scenario.robot.name} with tool {None if scenario.tool is None else scenario.tool.name!r}")
+                           f"{scenario.robot.name} with tool "
+                           f"{None if scenario.tool is None else scenario.tool.name!r}")
 

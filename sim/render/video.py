@@ -19,7 +19,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -206,6 +206,26 @@ def _encoding_error(error: BaseException, path: Path, log: Path | None = None) -
 
 def _partial_path(path: Path) -> Path:
     return path.with_name(f".{path.stem}.partial{path.suffix}")
+
+
+def check_video_args(model: Any, video_args: Mapping[str, Any]) -> None:
+    """Refuses bad video settings of a run (:func:`write_video`'s keyword arguments) before it
+    is simulated: unknown cameras, a bad size, frame rate, playback speed or process count.
+
+    Raises:
+        RenderError: One line naming the setting.
+    """
+    from sim.render.frames import resolve_cameras, validate_size
+
+    resolve_cameras(model, video_args.get("cameras", ("overview",)))
+    validate_size(video_args.get("width", 640), video_args.get("height", 480))
+    fps = video_args.get("fps", 30.0)
+    if not (np.isfinite(fps) and fps > 0):
+        raise RenderError(f"--fps must be a positive number, got {fps!r}")
+    speed = video_args.get("speed", 1.0)
+    if not (np.isfinite(speed) and speed > 0):
+        raise RenderError(f"--video-speed must be a positive number, got {speed!r}")
+    resolve_jobs(video_args.get("jobs"), 1)  # a bad process count
 
 
 def resolve_jobs(jobs: int | None, frames: int) -> int:
