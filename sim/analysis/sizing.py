@@ -173,7 +173,8 @@ TRAJECTORY_KEYS = ("t", "q_ref", "qd_ref", "qdd_ref", "q", "qd", "tau", "tau_id"
 # --------------------------------------------------------------------------------------------
 
 def signal_stats(t: ArrayLike, tau: ArrayLike, qd: ArrayLike, qdd: ArrayLike,
-                 source: str = "id", window: float = 0.0) -> SignalStats:
+                 source: str = "id", window: float = 0.0,
+                 sustained_tau: ArrayLike | None = None) -> SignalStats:
     """Joint-side statistics of one joint.
 
     Args:
@@ -185,6 +186,8 @@ def signal_stats(t: ArrayLike, tau: ArrayLike, qd: ArrayLike, qdd: ArrayLike,
         window: Peaks of torque, acceleration and power of the signals sustained over this
             window, s (:func:`sustained`; 0: of the samples). RMS, speeds and energies are of
             the samples.
+        sustained_tau: ``sustained(t, tau, window)`` when the caller has it already (the
+            same values; computed here when None).
 
     Returns:
         The :class:`SignalStats`.
@@ -195,7 +198,8 @@ def signal_stats(t: ArrayLike, tau: ArrayLike, qd: ArrayLike, qdd: ArrayLike,
     qdd = np.asarray(qdd, dtype=float)
     T = t[-1] - t[0]
     power = tau * qd
-    tau_s = sustained(t, tau, window)
+    tau_s = (sustained(t, tau, window) if sustained_tau is None
+             else np.asarray(sustained_tau, dtype=float))
     pk_tau, t_tau = peak_abs(t, tau_s)
     mom, t_mom = peak_abs(t, tau)
     pk_qd, t_qd = peak_abs(t, qd)
@@ -258,7 +262,8 @@ def continuous_envelope(drive: Drive, speed_rpm: ArrayLike) -> NDArray[np.float6
     n = np.abs(np.asarray(speed_rpm, dtype=float))
     n_r, n_max = _rated_speed_rpm(drive), float(drive.max_speed_rpm)
     with np.errstate(divide="ignore"):
-        out = np.where(n <= n_r, drive.rated_torque, drive.rated_torque * n_r / np.maximum(n, 1e-300))
+        out = np.where(n <= n_r, drive.rated_torque,
+                       drive.rated_torque * n_r / np.maximum(n, 1e-300))
     return np.where(n <= n_max, out, 0.0)
 
 
@@ -426,7 +431,8 @@ def size_trajectory(
     names = tuple(joint_names)
     n = len(names)
     t = as_time(traj["t"])
-    arr = {k: np.asarray(traj[k], dtype=float) for k in ("tau_id", "qd_ref", "qdd_ref", "tau", "qd")}
+    arr = {k: np.asarray(traj[k], dtype=float)
+           for k in ("tau_id", "qd_ref", "qdd_ref", "tau", "qd")}
     for k, v in arr.items():
         if v.shape != (t.size, n):
             raise CellsimError(f"trajectory {k} has shape {v.shape}, expected ({t.size}, {n}) "
@@ -452,13 +458,14 @@ def size_trajectory(
         kind = "prismatic" if name in linear else "revolute"
         torque_unit, speed_unit, _ = JOINT_UNITS[kind]
         lo, hi = float(fr[j, 0]), float(fr[j, 1])
-        stats = {s: signal_stats(t, tau[:, j], qd[:, j], qdd[:, j], s, windows[s])
+        tau_w = {s: sustained(t, tau[:, j], windows[s]) for s, (tau, _, _) in sources.items()}
+        stats = {s: signal_stats(t, tau[:, j], qd[:, j], qdd[:, j], s, windows[s], tau_w[s])
                  for s, (tau, qd, qdd) in sources.items()}
         cands: dict[str, dict[str, Check]] = {}
-        for s, (tau, qd, qdd) in sources.items():
+        for s in sources:
             st = stats[s]
             cands.setdefault("joint_torque", {})[s] = _torque_check(
-                st, lo, hi, t, sustained(t, tau[:, j], windows[s]), torque_unit)
+                st, lo, hi, t, tau_w[s], torque_unit)
             cands.setdefault("joint_speed", {})[s] = _check(
                 "joint_speed", st.peak_speed, vmax[j], speed_unit, s, st.peak_speed_time)
         motor: dict[str, MotorStats] = {}

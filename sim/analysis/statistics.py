@@ -10,6 +10,7 @@ May import: numpy and :mod:`sim.errors` only.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -26,7 +27,8 @@ def as_time(t: ArrayLike) -> NDArray[np.float64]:
     """
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or t.size < 2:
-        raise CellsimError(f"time vector t must be 1-D with at least 2 samples, got shape {t.shape}")
+        raise CellsimError(f"time vector t must be 1-D with at least 2 samples, got shape "
+                           f"{t.shape}")
     if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise CellsimError("time vector t must be finite and strictly increasing")
     return t
@@ -107,21 +109,44 @@ def sustained(t: ArrayLike, x: ArrayLike, window: float) -> NDArray[np.float64]:
     flat = x.reshape(t.size, -1)
     c = np.concatenate([np.zeros((1, flat.shape[1])),
                         np.cumsum(0.5 * (flat[1:] + flat[:-1]) * np.diff(t)[:, None], axis=0)])
-    lo = np.maximum(t - 0.5 * window, t[0])
-    hi = np.minimum(t + 0.5 * window, t[-1])
+    (lo, k_lo), (hi, k_hi), width, inside = _windows(t, window)
 
-    def integral_to(s: NDArray[np.float64]) -> NDArray[np.float64]:
-        # int from t[0] to s: whole trapezoids up to the sample before s, then the part
+    def integral_to(s: NDArray[np.float64], k: NDArray[np.intp]) -> NDArray[np.float64]:
+        # int from t[0] to s: whole trapezoids up to the sample before s (k), then the part
         # trapezoid from that sample to s (x linear in between)
-        k = np.clip(np.searchsorted(t, s, side="right") - 1, 0, t.size - 2)
         xs = np.stack([np.interp(s, t, flat[:, m]) for m in range(flat.shape[1])], axis=1)
         return c[k] + (s - t[k])[:, None] * 0.5 * (flat[k] + xs)
 
+    out = flat.copy()
+    out[inside] = ((integral_to(hi, k_hi) - integral_to(lo, k_lo))[inside]
+                   / width[inside, None])
+    return out.reshape(x.shape)
+
+
+#: The latest window bounds of :func:`sustained` (times, window, bounds): a sizing takes
+#: every signal of a record over the same times and window.
+_WINDOWS: list[tuple[NDArray[np.float64], float, Any]] = []
+
+
+def _windows(t: NDArray[np.float64], window: float) -> Any:
+    """The window bounds of each sample for :func:`sustained`: ``(lo, k_lo)``, ``(hi, k_hi)``
+    (each end, clipped to the record, and the sample at or before it), the width and where it
+    is positive. Kept for the latest times and window (the same times, compared value by
+    value, give the same bounds)."""
+    for tt, w, got in _WINDOWS:
+        if w == window and tt.shape == t.shape and np.array_equal(tt, t):
+            return got
+    lo = np.maximum(t - 0.5 * window, t[0])
+    hi = np.minimum(t + 0.5 * window, t[-1])
+    ends = tuple((s, np.clip(np.searchsorted(t, s, side="right") - 1, 0, t.size - 2))
+                 for s in (lo, hi))
     width = hi - lo
     inside = width > 0.0  # else a window below the times' resolution: the sample itself
-    out = flat.copy()
-    out[inside] = ((integral_to(hi) - integral_to(lo))[inside] / width[inside, None])
-    return out.reshape(x.shape)
+    got = (*ends, width, inside)
+    for v in (lo, hi, width, inside, ends[0][1], ends[1][1]):
+        v.setflags(write=False)
+    _WINDOWS[:] = [(t.copy(), float(window), got)]
+    return got
 
 
 def margin_pct(limit: float, used: float) -> float:

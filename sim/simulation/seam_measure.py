@@ -10,7 +10,10 @@ May import: planners and :mod:`sim.core`.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import dataclasses
+import struct
+from collections import OrderedDict
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,6 +27,46 @@ from sim.core.intervals import true_runs
 #: Largest gap between the chords of a curved tool-point path (an arc) and the path itself,
 #: m: the arc is sampled every ``sqrt(8 R CURVE_SAGITTA)`` (0.2 mm at R = 0.5 m).
 CURVE_SAGITTA = 1e-8
+
+#: How many seams' tool-point paths (:meth:`ToolPointPath.of`) and how many nearest-point
+#: queries (:meth:`ToolPointPath.nearest`) this process keeps, most recent first: the variants
+#: of a sweep's plan measure the same seams, and the same reference tool points, again.
+PATH_CACHE_SIZE = 16
+NEAREST_CACHE_SIZE = 8
+_PATHS: OrderedDict[Hashable, ToolPointPath] = OrderedDict()
+_NEAREST: OrderedDict[Hashable, dict[str, NDArray[np.float64]]] = OrderedDict()
+
+
+def _value_key(v: Any) -> Hashable:
+    """An exact key of a value: arrays and floats by their bits (0.0 and -0.0 differ, a NaN
+    equals itself), anything else by type and ``repr``."""
+    if isinstance(v, np.ndarray):
+        return ("a", v.dtype.str, v.shape, np.ascontiguousarray(v).tobytes())
+    if isinstance(v, float | np.floating):
+        return ("f", struct.pack("<d", float(v)))
+    if isinstance(v, list | tuple):
+        return (type(v).__name__,) + tuple(_value_key(x) for x in v)
+    return (type(v).__name__, repr(v))
+
+
+def seam_key(seam: Any) -> Hashable:
+    """The exact key of a seam's geometry and torch posture: every field of the dataclass by
+    its value (:func:`_value_key`); what a :class:`ToolPointPath` is made of."""
+    return (type(seam).__qualname__,) + tuple(
+        (f.name, _value_key(getattr(seam, f.name))) for f in dataclasses.fields(seam))
+
+
+def _remember(cache: OrderedDict[Hashable, Any], key: Hashable, value: Any, size: int) -> None:
+    cache[key] = value
+    cache.move_to_end(key)
+    while len(cache) > size:
+        cache.popitem(last=False)
+
+
+def clear_caches() -> None:
+    """Forget the kept tool-point paths and nearest-point queries."""
+    _PATHS.clear()
+    _NEAREST.clear()
 
 
 def nearest_on_polyline(p: NDArray[np.float64], pts: NDArray[np.float64], k: int = 8
@@ -74,9 +117,23 @@ class ToolPointPath:
     tangent: NDArray[np.float64]
     axis: NDArray[np.float64]
     closed: bool
+    key: Hashable = None
 
     @classmethod
     def of(cls, seam: Any) -> ToolPointPath:
+        """The seam's tool-point path; kept per process by the seam's value
+        (:func:`seam_key`: the same seam again gives the same path, bit for bit)."""
+        key = seam_key(seam)
+        path = _PATHS.get(key)
+        if path is None:
+            path = cls._make(seam, key)
+            _remember(_PATHS, key, path, PATH_CACHE_SIZE)
+        else:
+            _PATHS.move_to_end(key)
+        return path
+
+    @classmethod
+    def _make(cls, seam: Any, key: Hashable = None) -> ToolPointPath:
         s_all, rows = [], []
         s0 = 0.0
         for seg in seam.segments():
@@ -90,8 +147,11 @@ class ToolPointPath:
             rows += [(seg.tcp_point(x), seg.tangent(x), seg.torch_axis(x)) for x in ss]
             s0 += L
         point, tangent, axis = (np.array(v) for v in zip(*rows, strict=True))
-        return cls(np.concatenate(s_all), point, tangent, axis,
-                   bool(np.linalg.norm(point[0] - point[-1]) < 1e-9))
+        s_arr = np.concatenate(s_all)
+        for v in (s_arr, point, tangent, axis):  # shared by every caller of a kept path
+            v.setflags(write=False)
+        return cls(s_arr, point, tangent, axis,
+                   bool(np.linalg.norm(point[0] - point[-1]) < 1e-9), key)
 
     @property
     def length(self) -> float:
@@ -102,7 +162,24 @@ class ToolPointPath:
         """For points ``p`` (N, 3, in time order): the nearest seam parameter ``s`` (m), and
         there the tool point, travel direction and commanded torch axis (interpolated along
         the chord; the directions made unit) and the distance ``dist`` (m). On a closed path
-        the points are followed round: the first near 0, the next ones continuing."""
+        the points are followed round: the first near 0, the next ones continuing.
+
+        A path made by :meth:`of` keeps its latest answers per process, by the points' exact
+        values (the reference's tool points are the same for every variant of a plan); each
+        call gets its own arrays."""
+        p = np.asarray(p, dtype=float)
+        if self.key is None:
+            return self._nearest(p)
+        key = (self.key, p.shape, np.ascontiguousarray(p).tobytes())
+        got = _NEAREST.get(key)
+        if got is None:
+            got = self._nearest(p)
+            _remember(_NEAREST, key, {k: v.copy() for k, v in got.items()}, NEAREST_CACHE_SIZE)
+            return got
+        _NEAREST.move_to_end(key)
+        return {k: v.copy() for k, v in got.items()}
+
+    def _nearest(self, p: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
         i0, u, dist = nearest_on_polyline(p, self.point)
         s = self.s[i0] + u * (self.s[i0 + 1] - self.s[i0])
         if self.closed and len(s):
@@ -255,7 +332,8 @@ def measure_seam(t: NDArray[np.float64], pos: NDArray[np.float64], rot: NDArray[
         weave_window: The weave's full-amplitude part, ``(t0, t1)`` s (default: ``cruise``).
 
     The nearest seam parameter ``s*`` of each tool point on the seam's tool-point path
-    (:class:`ToolPointPath`) gives the seam's local frame there (travel direction ``t``, reference normal ``n`` made
+    (:class:`ToolPointPath`) gives the seam's local frame there (travel direction ``t``,
+    reference normal ``n`` made
     perpendicular to it, lean direction ``e = side n x t``); with the recorded torch axis
     ``a`` the travel angle is ``asin(a . t)`` and the work angle ``atan2(-a . e, -a . n)``
     (:mod:`sim.cells.seam`). The travel speed is ``ds*/dt`` (:func:`progress_speed`), so a

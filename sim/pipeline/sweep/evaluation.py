@@ -61,8 +61,10 @@ def _metrics(variant: Variant, ev: Any, run_dir: str | None = None) -> Any:
 
     sized = ({j["joint"]: j for j in ev.sizing.to_dict()["joints"]}
              if ev.sizing is not None else {})
+    # the sizing's statistics of the same arrays (the same values, not computed again)
+    stats = ({j.joint: j.stats for j in ev.sizing.joints} if ev.sizing is not None else None)
     rows = rows_from(variant, ev.record.arrays, ev.summary["joints"], ev.summary["verdict"],
-                     sized, run_dir or "")
+                     sized, run_dir or "", stats=stats)
     return VariantMetrics(tuple(rows), ev.selection.to_dict() if ev.selection else None,
                           timings_s=dict(ev.summary.get("timings_s", {})), run_dir=run_dir)
 

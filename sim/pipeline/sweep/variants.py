@@ -145,8 +145,8 @@ class VariantMetrics:
 
 
 def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequence[str],
-              verdict: str, sized: Mapping[str, Mapping[str, Any]], run_dir: str = ""
-              ) -> list[dict[str, Any]]:
+              verdict: str, sized: Mapping[str, Mapping[str, Any]], run_dir: str = "",
+              stats: Mapping[str, Mapping[str, Any]] | None = None) -> list[dict[str, Any]]:
     """Rows of sweep.csv for one variant (one per joint), from its recorded arrays.
 
     Args:
@@ -158,6 +158,11 @@ def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequ
         sized: ``sizing.json``'s joints by name (``margin_pct``, ``pass``, ``limiting``);
             empty when the run was not sized.
         run_dir: The variant's run folder ("" when none was kept).
+        stats: The sizing's joint-side statistics of these arrays by joint and source
+            (:attr:`sim.analysis.sizing.JointSizing.stats`: ``"id"`` with no window, ``"sim"``
+            sustained over :data:`~sim.analysis.sizing.PEAK_WINDOW_S`), or None: the peaks,
+            RMS values, speeds and powers are taken from them instead of computed again (the
+            same functions of the same samples: the same values, bit for bit).
 
     Peak and RMS torques are computed from both sources; the unsuffixed value is the larger.
     The simulated peaks are of the torque sustained over
@@ -165,16 +170,16 @@ def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequ
     """
     t = np.asarray(arrays["t"], dtype=float)
     rows = []
+    given = _usable_stats(arrays, joints, stats)
     for k, name in enumerate(joints):
-        tau_id, tau = arrays["tau_id"][:, k], arrays["tau"][:, k]
-        pk_id, _ = peak_abs(t, tau_id)
-        # the simulated source's peaks as sizing takes them: sustained over PEAK_WINDOW_S
-        pk_sim, _ = peak_abs(t, sustained(t, tau, PEAK_WINDOW_S))
-        rms_id = float(rms(t, tau_id))
-        rms_sim = float(rms(t, tau))
-        speed = max(peak_abs(t, arrays["qd_ref"][:, k])[0], peak_abs(t, arrays["qd"][:, k])[0])
-        power = max(peak_abs(t, tau_id * arrays["qd_ref"][:, k])[0],
-                    peak_abs(t, sustained(t, tau * arrays["qd"][:, k], PEAK_WINDOW_S))[0])
+        if given is not None:
+            sid, ssim = given[name]["id"], given[name]["sim"]
+            pk_id, pk_sim = sid.peak_torque, ssim.peak_torque
+            rms_id, rms_sim = sid.rms_torque, ssim.rms_torque
+            speed = max(sid.peak_speed, ssim.peak_speed)
+            power = max(sid.peak_power, ssim.peak_power)
+        else:
+            pk_id, pk_sim, rms_id, rms_sim, speed, power = _joint_figures(t, arrays, k)
         s = sized.get(name, {})
         margin = s.get("margin_pct")
         rows.append({
@@ -191,6 +196,43 @@ def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequ
             "run_dir": str(run_dir),
         })
     return rows
+
+
+def _joint_figures(t: NDArray[np.float64], arrays: Mapping[str, NDArray[Any]], k: int
+                   ) -> tuple[float, float, float, float, float, float]:
+    """Column ``k``'s peak torques (reference, simulated), RMS torques (the same), peak speed
+    and peak power, as :func:`rows_from` gives them."""
+    tau_id, tau = arrays["tau_id"][:, k], arrays["tau"][:, k]
+    pk_id, _ = peak_abs(t, tau_id)
+    # the simulated source's peaks as sizing takes them: sustained over PEAK_WINDOW_S
+    pk_sim, _ = peak_abs(t, sustained(t, tau, PEAK_WINDOW_S))
+    rms_id = float(rms(t, tau_id))
+    rms_sim = float(rms(t, tau))
+    speed = max(peak_abs(t, arrays["qd_ref"][:, k])[0], peak_abs(t, arrays["qd"][:, k])[0])
+    power = max(peak_abs(t, tau_id * arrays["qd_ref"][:, k])[0],
+                peak_abs(t, sustained(t, tau * arrays["qd"][:, k], PEAK_WINDOW_S))[0])
+    return pk_id, pk_sim, rms_id, rms_sim, speed, power
+
+
+def _usable_stats(arrays: Mapping[str, NDArray[Any]], joints: Sequence[str],
+                  stats: Mapping[str, Mapping[str, Any]] | None
+                  ) -> Mapping[str, Mapping[str, Any]] | None:
+    """``stats`` when they are what :func:`_joint_figures` would compute: every joint with
+    both sources, the reference's without a window and the simulation's over
+    :data:`PEAK_WINDOW_S`, and float64 arrays (the sizing reads them as float64); else
+    None."""
+    if stats is None:
+        return None
+    if any(np.asarray(arrays[key]).dtype != np.float64
+           for key in ("t", "tau_id", "tau", "qd_ref", "qd")):
+        return None
+    for name in joints:
+        by_source = stats.get(name)
+        if (by_source is None or "id" not in by_source or "sim" not in by_source
+                or by_source["id"].window != 0.0
+                or by_source["sim"].window != PEAK_WINDOW_S):
+            return None
+    return stats
 
 
 def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
