@@ -128,13 +128,20 @@ def sustained(t: ArrayLike, x: ArrayLike, window: float) -> NDArray[np.float64]:
 _WINDOWS: list[tuple[NDArray[np.float64], float, Any]] = []
 
 
+def _same_times(a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
+    """Whether two float64 time vectors hold the same values, bit for bit (0.0 and -0.0
+    differ)."""
+    return (a.shape == b.shape and a.dtype == b.dtype == np.float64
+            and bool(np.array_equal(a.view(np.int64), b.view(np.int64))))
+
+
 def _windows(t: NDArray[np.float64], window: float) -> Any:
     """The window bounds of each sample for :func:`sustained`: ``(lo, k_lo)``, ``(hi, k_hi)``
     (each end, clipped to the record, and the sample at or before it), the width and where it
     is positive. Kept for the latest times and window (the same times, compared value by
     value, give the same bounds)."""
     for tt, w, got in _WINDOWS:
-        if w == window and tt.shape == t.shape and np.array_equal(tt, t):
+        if w == window and _same_times(tt, t):
             return got
     lo = np.maximum(t - 0.5 * window, t[0])
     hi = np.minimum(t + 0.5 * window, t[-1])

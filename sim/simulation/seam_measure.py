@@ -170,7 +170,7 @@ class ToolPointPath:
         p = np.asarray(p, dtype=float)
         if self.key is None:
             return self._nearest(p)
-        key = (self.key, p.shape, np.ascontiguousarray(p).tobytes())
+        key = (self.key, _value_key(p))
         got = _NEAREST.get(key)
         if got is None:
             got = self._nearest(p)
