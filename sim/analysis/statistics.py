@@ -149,17 +149,20 @@ def sustained(t: ArrayLike, x: ArrayLike, window: float) -> NDArray[np.float64]:
     flat = x.reshape(t.size, -1)
     c = np.concatenate([np.zeros((1, flat.shape[1])),
                         np.cumsum(0.5 * (flat[1:] + flat[:-1]) * np.diff(t)[:, None], axis=0)])
-    (lo, k_lo), (hi, k_hi), width, inside = _windows(t, window)
+    (lo, k_lo, half_lo), (hi, k_hi, half_hi), width, inside, everywhere = _windows(t, window)
 
-    def integral_to(s: NDArray[np.float64], k: NDArray[np.intp]) -> NDArray[np.float64]:
+    def integral_to(s: NDArray[np.float64], k: NDArray[np.intp],
+                    half: NDArray[np.float64]) -> NDArray[np.float64]:
         # int from t[0] to s: whole trapezoids up to the sample before s (k), then the part
-        # trapezoid from that sample to s (x linear in between)
+        # trapezoid from that sample to s (x linear in between; half = (s - t[k]) / 2)
         xs = np.stack([np.interp(s, t, flat[:, m]) for m in range(flat.shape[1])], axis=1)
-        return c[k] + (s - t[k])[:, None] * 0.5 * (flat[k] + xs)
+        return c[k] + half * (flat[k] + xs)
 
+    mean = integral_to(hi, k_hi, half_hi) - integral_to(lo, k_lo, half_lo)
+    if everywhere:  # every window has a width: the same quotients, without the masks
+        return (mean / width[:, None]).reshape(x.shape)
     out = flat.copy()
-    out[inside] = ((integral_to(hi, k_hi) - integral_to(lo, k_lo))[inside]
-                   / width[inside, None])
+    out[inside] = mean[inside] / width[inside, None]
     return out.reshape(x.shape)
 
 
@@ -176,21 +179,24 @@ def _same_times(a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
 
 
 def _windows(t: NDArray[np.float64], window: float) -> Any:
-    """The window bounds of each sample for :func:`sustained`: ``(lo, k_lo)``, ``(hi, k_hi)``
-    (each end, clipped to the record, and the sample at or before it), the width and where it
-    is positive. Kept for the latest times and window (the same times, compared value by
-    value, give the same bounds)."""
+    """The window bounds of each sample for :func:`sustained`: ``(lo, k_lo, half_lo)``,
+    ``(hi, k_hi, half_hi)`` (each end, clipped to the record, the sample at or before it and
+    half the time from that sample to the end, (N, 1)), the width, where it is positive and
+    whether it is everywhere. Kept for the latest times and window (the same times, compared
+    value by value, give the same bounds)."""
     for tt, w, got in _WINDOWS:
         if w == window and _same_times(tt, t):
             return got
     lo = np.maximum(t - 0.5 * window, t[0])
     hi = np.minimum(t + 0.5 * window, t[-1])
-    ends = tuple((s, np.clip(np.searchsorted(t, s, side="right") - 1, 0, t.size - 2))
-                 for s in (lo, hi))
+    ends = []
+    for s in (lo, hi):
+        k = np.clip(np.searchsorted(t, s, side="right") - 1, 0, t.size - 2)
+        ends.append((s, k, (s - t[k])[:, None] * 0.5))
     width = hi - lo
     inside = width > 0.0  # else a window below the times' resolution: the sample itself
-    got = (*ends, width, inside)
-    for v in (lo, hi, width, inside, ends[0][1], ends[1][1]):
+    got = (*ends, width, inside, bool(np.all(inside)))
+    for v in (width, inside, *ends[0], *ends[1]):
         v.setflags(write=False)
     _WINDOWS[:] = [(t.copy(), float(window), got)]
     return got
