@@ -65,10 +65,11 @@ SHIPPED = sorted(__import__("sim.core.resources", fromlist=["x"]).shipped_scenar
 
 #: The fast share's ten minutes (issue 29): the frames of the scenarios with mechanisms, a
 #: second robot or a ceiling mount (the costliest framings, 15-30 s of CPU each) are checked in
-#: the slow share; the fast share keeps the default weld cycle, the plate welds, pick and place
-#: and seed 000's sequence.
+#: the slow share; the fast share keeps the default weld cycle, pick and place and seed 000's
+#: sequence.
 FRAMES_SLOW = {"two_robot_tee_weld", "positioner_cylinder_downhand", "track_beam_weld",
-               "bugnar_5r_weld_cycle_ceiling"}
+               "bugnar_5r_weld_cycle_ceiling", "lrmate200ic_tp_weld_plate",
+               "lrmate200ic_weld_plate"}
 
 
 @pytest.mark.render

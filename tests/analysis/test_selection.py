@@ -293,6 +293,7 @@ def test_cli_bad_catalogue_exits_2_before_any_run(tmp_path, capsys):
     assert not out.exists()
 
 
+@pytest.mark.slow  # the fast share's ten minutes (issue 29): a sweep with run folders
 def test_size_select_writes_the_selection_in_each_variant(tmp_path, small_catalog, capsys):
     out = tmp_path / "sweep"
     rc = main(["size", "lrmate200ic_pick_place", "--select", "--catalog", str(small_catalog),

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import sys
 
+import pytest
 from support.limits import run_limited
 
 
@@ -15,6 +16,7 @@ def _cellsim(args, tmp_path):
                           capture_output=True, text=True, cpu_s=300, check=False)
 
 
+@pytest.mark.slow  # the fast share's ten minutes (issue 29): four commands in child processes
 def test_commands_that_do_not_render_ignore_a_bogus_mujoco_gl(tmp_path):
     assert _cellsim(["list"], tmp_path).returncode == 0
     assert _cellsim(["ik", "lrmate100ib", "660.56", "0", "5.17"], tmp_path).returncode == 0

@@ -302,6 +302,7 @@ def test_a_polyline_ends_exactly_on_its_last_point_with_its_blend(tmp_path):
     assert weld.corner_zones == [pytest.approx((0.115, 0.125))]
 
 
+@pytest.mark.slow  # the fast share's ten minutes (issue 29): two runs of the weld cycle's robot
 def test_a_joint_move_from_where_the_robot_is_to_one_target(tmp_path):
     """The first phase may be a single move from the cell's home to a pose target
     (``durations_s = [T]``, as the scenario above does), or a single move between two knot

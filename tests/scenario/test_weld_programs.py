@@ -795,6 +795,7 @@ def test_more_bad_programs(edit, needle, tmp_path):
         load_scenario(tmp_path / "s.toml")
 
 
+@pytest.mark.slow  # the fast share's ten minutes (issue 29): the 160 s cycle twice
 def test_a_5r_cycle_exports_and_runs_back(tmp_path):
     """bugnar_5r_weld_cycle (the 5-axis robot without a maker's convention, a 340 deg seam)
     exported and run back: the arc is split into circular moves of at most 170 deg, and the

@@ -83,6 +83,7 @@ def _peaks_agree(name: str, sim_rtol: float) -> None:
                                        "peak per joint")
 
 
+@pytest.mark.slow  # the fast share's ten minutes (issue 29): a convergence study
 def test_reported_peaks_agree_at_2_1_and_half_ms_through_contacts():
     """Issue 26's acceptance on the pick-and-place cycle, whose part contacts move the joints
     in a step or two (its simulated J3 torque at one step: 15.99 N m at 2 ms, 12.85 at 1 ms,
