@@ -51,6 +51,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sim.errors import KinematicsError
+from sim.robots.kinematics.opw import _closest
 
 #: Tolerance of the structure tests of :func:`offset_wrist_from_axes` (parallel,
 #: perpendicular, intersecting axes), m and rad.
@@ -309,14 +310,9 @@ def singular_factors(prm: OffsetWristParameters, Q: ArrayLike) -> dict[str, NDAr
 # ---------------------------------------------------------------------------- structure
 def _distance(p1: NDArray[np.float64], w1: NDArray[np.float64], p2: NDArray[np.float64],
               w2: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
-    """Distance between two lines and the point on line 2 closest to line 1."""
-    n = np.cross(w1, w2)
-    d = p2 - p1
-    if np.linalg.norm(n) < STRUCTURE_TOL:
-        return float(np.linalg.norm(d - (d @ w1) * w1)), p2
-    dist = abs(d @ n) / np.linalg.norm(n)
-    t = np.cross(d, w1) @ n / (n @ n)
-    return float(dist), p2 + t * w2
+    """Distance between two lines and the point on line 2 closest to line 1 (OPW's
+    :func:`~sim.robots.kinematics.opw._closest` with the lines swapped)."""
+    return _closest(p2, w2, p1, w1)
 
 
 def offset_wrist_from_axes(axes: ArrayLike, points: ArrayLike, flange: ArrayLike,
