@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from support.cell_files import (
     BASE_MM,
     BASE_YAW_DEG,
@@ -586,3 +588,34 @@ def test_a_scenario_with_a_cell_file_and_a_tool_file_travels_to_sweep_workers(tm
     b = build_cell(again.cell, again.robot, tool=again.tool).compile()
     np.testing.assert_array_equal(a.geom_pos, b.geom_pos)
     np.testing.assert_array_equal(a.body_mass, b.body_mass)
+
+
+@settings(max_examples=6, deadline=None, derandomize=True)
+@given(key=st.sampled_from(["home_deg", "start_deg"]), joint=st.integers(0, 5),
+       beyond_deg=st.floats(0.01, 400.0), upper=st.booleans())
+def test_the_first_robots_joint_values_are_checked_against_its_ranges(tmp_path_factory, key,
+                                                                        joint, beyond_deg, upper):
+    """``[robot] home_deg`` and ``start_deg`` outside a joint's range (the range read from the
+    robot's own MJCF here, not by the code under test) are one line naming the key, the joint
+    and the range, before anything is built."""
+    import xml.etree.ElementTree as ET
+
+    tmp_path = tmp_path_factory.mktemp("range")
+    spec = load_scenario(make_cell(tmp_path)).robot
+    root = ET.parse(spec.arm.robot_path).getroot()
+    limits = {j.get("name"): [float(v) for v in j.get("range").split()]
+              for j in root.iter("joint") if j.get("range")}
+    lo, hi = limits[spec.arm.joints[joint]]
+    if root.find("compiler").get("angle") != "radian":
+        lo, hi = np.deg2rad([lo, hi])
+    values = [0.0] * 6
+    values[joint] = float(np.rad2deg(hi if upper else lo) + (beyond_deg if upper
+                                                             else -beyond_deg))
+    cell = CELL.replace(f"base_euler_zyx_deg = [{BASE_YAW_DEG}, 0, 0]",
+                        f"base_euler_zyx_deg = [{BASE_YAW_DEG}, 0, 0]\n{key} = {values}")
+    path = make_cell(tmp_path, cell=cell)
+    sc = load_scenario(path)
+    with pytest.raises(CellError, match=rf"robot\.{key}\[{joint}\]: .* deg is outside joint "
+                                        rf"\w+'s range \[") as err:
+        build_cell(sc.cell, sc.robot, tool=sc.tool)
+    assert "\n" not in str(err.value)

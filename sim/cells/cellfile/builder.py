@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.cells.cellfile.reader import CellFile
+from sim.cells.cellfile.reader import CellFile, joint_values
 from sim.cells.cellfile.schema import ROLE_MATERIAL, ObjectBlock
 from sim.cells.cellfile.seams import seam_in_world, seam_points, seam_standoff
 from sim.cells.cellfile.solids import Solid
@@ -281,20 +281,16 @@ def _build(cf: CellFile, rig: RobotRig, mount: str) -> Layout:
         cams.append(c.name)
     cams = _default_cameras(world, rig, T0, cf, set(cams), tuple(others)) + cams
     rb = spec.robot
-    n = rig.spec.n_joints
     home_q = rig.home_q.copy()
-    for key in ("home_deg", "start_deg"):
-        v = getattr(rb, key)
-        if v is not None and len(v) != n:
-            raise CellError(f"{cf.where}: robot.{key}: {len(v)} values; robot "
-                            f"{rig.spec.name} has {n} joints")
-    if rb.home_deg is not None:
-        home_q = np.deg2rad(np.asarray(rb.home_deg, dtype=float))
+    given = {key: joint_values(getattr(rb, key), rig.spec, f"{cf.where}: robot.{key}")
+             for key in ("home_deg", "start_deg")}
+    if given["home_deg"] is not None:
+        home_q = given["home_deg"]
     first = next(iter(seams.values()), None)
     start_q = None
     own_tool = rig.tool == cf.default_tool  # start_deg is given for the cell's own tool
     if rb.start_deg is not None and own_tool:  # (given for the cell's own tool)
-        start_q = np.deg2rad(np.asarray(rb.start_deg, dtype=float))
+        start_q = given["start_deg"]
         if first is not None:
             tcp = T0 @ rig.kinematics().fk(start_q)
             gap = float(np.linalg.norm(tcp[:3, 3] - first.tcp_point(0.0)))

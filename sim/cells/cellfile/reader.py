@@ -227,6 +227,31 @@ def _check_base_clear(solids: dict[str, Solid], base: NDArray[np.float64], key: 
                             "the object, not in it")
 
 
+def joint_values(values_deg: list[float] | None, robot: Any, key: str
+                 ) -> NDArray[np.float64] | None:
+    """A robot's joint values given in a cell file (``home_deg``, ``start_deg``), rad; None
+    when not given.
+
+    Raises:
+        CellError: ``key`` named when the count is not the robot's joint count or a value is
+            outside its joint's range.
+    """
+    from sim.robots.spec import joint_ranges
+
+    if values_deg is None:
+        return None
+    n = robot.n_joints
+    if len(values_deg) != n:
+        raise CellError(f"{key}: {len(values_deg)} values; robot {robot.name} has {n} joints")
+    q = np.deg2rad(np.asarray(values_deg, dtype=float))
+    for j, (qj, (lo, hi)) in enumerate(zip(q, joint_ranges(robot)[:n], strict=True)):
+        if not lo - 1e-9 <= qj <= hi + 1e-9:
+            raise CellError(f"{key}[{j}]: {values_deg[j]:g} deg is outside joint "
+                            f"{robot.joints[j]}'s range [{np.rad2deg(lo):g}, "
+                            f"{np.rad2deg(hi):g}] deg (robot {robot.name})")
+    return q
+
+
 def read_partners(spec: CellFileSpec, path: Path, taken: set[str],
                   solids: dict[str, Solid] | None = None) -> dict[str, PlacedRobot]:
     """The cell file's other robots (``[[robots]]``): model and home resolved, each base
@@ -239,7 +264,6 @@ def read_partners(spec: CellFileSpec, path: Path, taken: set[str],
             workpiece).
     """
     from sim.robots.registry import resolve_robot
-    from sim.robots.spec import joint_ranges
 
     where = path.name
     out: dict[str, PlacedRobot] = {}
@@ -253,18 +277,7 @@ def read_partners(spec: CellFileSpec, path: Path, taken: set[str],
             robot = resolve_robot(rb.model, path.parent)
         except CellsimError as exc:
             raise CellError(f"{key}.model: {exc}") from None
-        home = None
-        if rb.home_deg is not None:
-            if len(rb.home_deg) != robot.n_joints:
-                raise CellError(f"{key}.home_deg: {len(rb.home_deg)} values; robot "
-                                f"{robot.name} has {robot.n_joints} joints")
-            home = np.deg2rad(np.asarray(rb.home_deg, dtype=float))
-            ranges = joint_ranges(robot)
-            for j, (qj, (lo, hi)) in enumerate(zip(home, ranges, strict=True)):
-                if not lo - 1e-9 <= qj <= hi + 1e-9:
-                    raise CellError(f"{key}.home_deg[{j}]: {rb.home_deg[j]:g} deg is outside "
-                                    f"joint {robot.joints[j]}'s range [{np.rad2deg(lo):g}, "
-                                    f"{np.rad2deg(hi):g}] deg (robot {robot.name})")
+        home = joint_values(rb.home_deg, robot, f"{key}.home_deg")
         base = object_pose(rb.base_pos_mm, rb.base_euler_zyx_deg)
         if rb.mount == "ceiling":
             base[:3, :3] = base[:3, :3] @ np.diag([1.0, -1.0, -1.0])
