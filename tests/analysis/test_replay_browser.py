@@ -58,6 +58,8 @@ class Page:
         for _ in range(READY_POLLS):  # bounded by a count of polls
             if self.page.evaluate("!!(window.cellsimReplay && window.cellsimReplay.ready)"):
                 break
+            if any(e.startswith("pageerror") for e in self.errors):
+                raise AssertionError(f"the replay failed to load: {self.errors}")
             self.page.wait_for_timeout(50)
         else:
             raise AssertionError(f"the replay was not ready after {READY_POLLS} polls: "
@@ -321,5 +323,66 @@ def test_a_tiny_run_replays_offline_with_the_arm_where_its_poses_put_it(browser,
         boxes = [_bbox_error(page, model, t, qpos, bodies, when) for when in (0.4, 1.6)]
         assert all(err <= TOL_PX for err, _ in boxes), boxes
         assert np.abs(boxes[0][1] - boxes[1][1]).max() > 5 * TOL_PX
+    finally:
+        page.close()
+
+
+def _gold(img: np.ndarray) -> np.ndarray:
+    """Pixels of the bead's colour (0xd4a017, lit): red and green well above blue."""
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    return (r > 110) & (r >= g) & (g - b > 40) & (r - b > 70)
+
+
+def test_the_bead_is_a_tube_laid_up_to_the_replays_time(browser, tmp_path):
+    """The bead (arc on) is drawn as a tube of the weld's width, not a hairline, along the
+    recorded tool points up to the time shown and not beyond; before the arc starts there is
+    none. The oracle: the recorded points projected with the page's camera matrices."""
+    from test_replay import ARM
+
+    from sim.cli import main
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "model.xml").write_text(ARM)
+    t = np.linspace(0, 2, 201)
+    qpos = np.c_[0.2 * t, -0.1 * t]
+    tcp = np.c_[0.2 + 0.2 * t, 0.05 * np.sin(2 * t), np.full_like(t, 0.1)]
+    arc = (t >= 0.5) & (t <= 1.5)
+    np.savez(run / "trajectory.npz", t=t, qpos=qpos, q=qpos, qd=qpos, tau=qpos,
+             tcp_pos=tcp, arc_on=arc)
+    assert main(["view", str(run)]) == 0
+    page = Page(browser, run / "report.html")
+    try:
+        page.js("window.cellsimReplay.solo([], true)")  # the overlays alone
+        target = np.array([0.4, 0.0, 0.1])
+        page.js("(a) => window.cellsimReplay.look(a[0], a[1], 45)",
+                [(target + [0.0, -0.2, 0.1]).tolist(), target.tolist()])
+        before = page.page.evaluate("(x) => window.cellsimReplay.setTime(x)", 0.3)
+        assert before < 0.5 and not _gold(page.pixels()).any()
+        now = page.page.evaluate("(x) => window.cellsimReplay.setTime(x)", 1.0)
+        gold = _gold(page.pixels())
+        cam = page.js("window.cellsimReplay.camera()")
+        proj = np.array(cam["projection"]).reshape(4, 4).T
+        view = np.array(cam["view"]).reshape(4, 4).T
+
+        def px(p):
+            clip = (proj @ view @ np.c_[p, np.ones(len(p))].T).T
+            ndc = clip[:, :3] / clip[:, 3:4]
+            return np.c_[(ndc[:, 0] + 1) / 2 * cam["width"], (1 - ndc[:, 1]) / 2 * cam["height"]]
+
+        laid = px(tcp[(t >= 0.55) & (t <= now - 0.05)])
+        ahead = px(tcp[(t >= now + 0.1) & (t <= 1.45)])
+        assert all(gold[int(y), int(x)] for x, y in laid), "the bead laid so far is missing"
+        assert not any(gold[max(0, int(y) - 1):int(y) + 2, max(0, int(x) - 1):int(x) + 2].any()
+                       for x, y in ahead), "bead drawn ahead of the replay's time"
+        # its width on screen: the tube's 6 mm diameter projected at the middle point
+        mid = tcp[np.argmin(np.abs(t - 0.75))]
+        d = float(np.linalg.norm((view @ np.r_[mid, 1.0])[:3]))
+        want = 0.006 * cam["height"] / 2 / np.tan(np.radians(45) / 2) / d
+        x, y = px(mid[None])[0]
+        column = gold[:, int(round(x))]
+        rows = np.nonzero(column[int(y) - 3 * int(want):int(y) + 3 * int(want) + 1])[0]
+        assert want > 10 and rows.size >= 0.6 * want, (rows.size, want)  # a hairline: 1-2 px
+        assert page.errors == []
     finally:
         page.close()

@@ -109,6 +109,38 @@ function applyPoses(t) {
 }
 
 // ---- tool paths and beads ----
+// the bead: a tube of BEAD_R around each arc-on segment (its ends' rings square to the segment),
+// BEAD_SIDES quads round, so it keeps its width on screen as a weld bead does
+const BEAD_R = 0.003, BEAD_SIDES = 6, BEAD_IDX = 6 * BEAD_SIDES;
+function beadTube(pos, seg) {
+  const v = new Float32Array(seg.length * 2 * BEAD_SIDES * 3), n = new Float32Array(v.length);
+  const idx = new Uint32Array(seg.length * BEAD_IDX);
+  const a = new THREE.Vector3(), b = new THREE.Vector3(), d = new THREE.Vector3();
+  const u = new THREE.Vector3(), w = new THREE.Vector3(), r = new THREE.Vector3();
+  seg.forEach((o, k) => {
+    a.fromArray(pos, o); b.fromArray(pos, o + 3); d.subVectors(b, a);
+    if (d.lengthSq() < 1e-18) d.set(1, 0, 0);
+    d.normalize();
+    u.set(Math.abs(d.z) < 0.9 ? 0 : 1, 0, Math.abs(d.z) < 0.9 ? 1 : 0).cross(d).normalize();
+    w.crossVectors(d, u);
+    for (let j = 0; j < BEAD_SIDES; j++) {
+      const ang = (2 * Math.PI * j) / BEAD_SIDES;
+      r.copy(u).multiplyScalar(Math.cos(ang)).addScaledVector(w, Math.sin(ang));
+      for (const [e, p] of [[0, a], [1, b]]) {
+        const vi = 3 * ((2 * k + e) * BEAD_SIDES + j);
+        v[vi] = p.x + BEAD_R * r.x; v[vi + 1] = p.y + BEAD_R * r.y; v[vi + 2] = p.z + BEAD_R * r.z;
+        n[vi] = r.x; n[vi + 1] = r.y; n[vi + 2] = r.z;
+      }
+      const j1 = (j + 1) % BEAD_SIDES, s0 = 2 * k * BEAD_SIDES, s1 = s0 + BEAD_SIDES;
+      idx.set([s0 + j, s0 + j1, s1 + j, s1 + j, s0 + j1, s1 + j1], k * BEAD_IDX + 6 * j);
+    }
+  });
+  const g = new THREE.BufferGeometry();
+  g.setAttribute("position", new THREE.BufferAttribute(v, 3));
+  g.setAttribute("normal", new THREE.BufferAttribute(n, 3));
+  g.setIndex(new THREE.BufferAttribute(idx, 1));
+  return g;
+}
 const overlays = [];
 const paths = D.paths.map((p) => {
   const t = arr(p.t), pos = arr(p.pos), arc = arr(p.arc);
@@ -117,11 +149,9 @@ const paths = D.paths.map((p) => {
   const pathLine = new THREE.Line(line, new THREE.LineBasicMaterial({ color: 0x3a7d44, transparent: true, opacity: 0.55 }));
   const seg = [], segT = [];
   for (let i = 0; i + 1 < t.length; i++) {
-    if (arc[i] && arc[i + 1]) { seg.push(...pos.subarray(3 * i, 3 * i + 6)); segT.push(t[i + 1]); }
+    if (arc[i] && arc[i + 1]) { seg.push(3 * i); segT.push(t[i + 1]); }
   }
-  const bg = new THREE.BufferGeometry();
-  bg.setAttribute("position", new THREE.BufferAttribute(new Float32Array(seg), 3));
-  const bead = new THREE.LineSegments(bg, new THREE.LineBasicMaterial({ color: 0xd4a017 }));
+  const bead = new THREE.Mesh(beadTube(pos, seg), new THREE.MeshStandardMaterial({ color: 0xd4a017, roughness: 0.45, metalness: 0.3 }));
   scene.add(pathLine, bead);
   overlays.push(pathLine, bead);
   return { bead, segT: Float32Array.from(segT) };
@@ -130,7 +160,7 @@ function showBeads(t) {
   for (const p of paths) {
     let n = 0, hi = p.segT.length;
     while (n < hi) { const m = (n + hi) >> 1; if (p.segT[m] <= t) n = m + 1; else hi = m; }
-    p.bead.geometry.setDrawRange(0, 2 * n);
+    p.bead.geometry.setDrawRange(0, BEAD_IDX * n);
   }
 }
 
@@ -275,10 +305,10 @@ const charts = D.charts.map((c) => {
 });
 
 // ---- hooks for tests and scripts ----
-function solo(names) { // show only the given bodies' geoms (null: everything)
+function solo(names, withOverlays = false) { // only the given bodies' geoms (null: everything)
   const keep = names ? new Set(names) : null;
   for (const m of geomObjects.values()) m.visible = !keep || keep.has(D.bodies[m.userData.body]);
-  overlays.forEach((o) => { o.visible = !keep; });
+  overlays.forEach((o) => { o.visible = !keep || withOverlays; });
   if (!keep) showClearance(time);
   draw();
 }
