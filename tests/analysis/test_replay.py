@@ -177,3 +177,53 @@ def test_view_writes_a_report_of_its_own_and_refuses_poses_that_do_not_fit(tmp_p
     assert main(["view", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "trajectory.npz" in err and "qpos" in err and len(err.strip().splitlines()) == 1
+
+
+SHIPPED = sorted(__import__("sim.core.resources", fromlist=["x"]).shipped_scenarios())
+#: The framed overview is checked on the default cycle in the fast share (its run is shared
+#: with other tests), on the other scenarios (the two-robot cell's among them) in the slow share.
+OVERVIEW_FAST = {"bugnar_5r_weld_cycle"}
+
+
+@pytest.mark.parametrize("name", [n if n in OVERVIEW_FAST else pytest.param(
+    n, marks=pytest.mark.slow) for n in SHIPPED])
+def test_the_first_view_frames_every_robot_over_the_whole_cycle(name, scenario_run):
+    """The replay opens on the video's framed overview: every link of every robot at every
+    one of 40 times along the cycle inside the picture (a pinhole projection written here
+    from the preset's position, orientation and field of view), and the robots fill at least
+    40 % of the picture's height or width (a view from far away fails)."""
+    import mujoco
+
+    from sim.analysis.replay.payload import OVERVIEW_ASPECT, framed_overview
+
+    run_dir = Path(scenario_run(name)[0])
+    model = mujoco.MjModel.from_xml_path(str(run_dir / "model.xml"))
+    qpos = np.load(run_dir / "trajectory.npz")["qpos"]
+    views = framed_overview(model, qpos)
+    assert [v["name"] for v in views] == ["framed overview"] and views[0]["body"] == 0
+    v = views[0]
+    w, x, y, z = v["quat"]
+    rot = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                    [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                    [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    assert abs(rot[2, 0]) < 1e-9  # the picture's horizontal stays level (world z up)
+    data = mujoco.MjData(model)
+    names = [model.body(int(b)).name for b in model.geom_bodyid]
+    bodies = [model.body(b).name for b in range(model.nbody)]
+    robots = {b.split("/")[0] for b in bodies if "/link" in b}  # robot, r2, ...
+    arm = [g for g, n in enumerate(names) if n.split("/")[0] in robots
+           and model.geom_group[g] <= 2 and model.geom_rgba[g, 3] > 0]
+    assert arm
+    half_h = np.tan(np.radians(v["fovy"]) / 2)
+    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+    for i in np.linspace(0, len(qpos) - 1, 40).astype(int):
+        data.qpos[:] = qpos[i]
+        mujoco.mj_kinematics(model, data)
+        cam = (data.geom_xpos[arm] - v["pos"]) @ rot  # camera frame: x right, y up, -z ahead
+        depth = -cam[:, 2]
+        assert (depth > 0).all(), (name, i)
+        ndc = cam[:, :2] / depth[:, None] / [half_h * OVERVIEW_ASPECT, half_h]
+        rad = model.geom_rbound[arm] / depth / half_h  # the bounding sphere, roughly
+        assert (np.abs(ndc) + rad[:, None] <= 1.0 + 1e-9).all(), (name, i, np.abs(ndc).max())
+        lo, hi = np.minimum(lo, ndc.min(axis=0)), np.maximum(hi, ndc.max(axis=0))
+    assert ((hi - lo) / 2 >= 0.4).any(), (name, lo, hi)

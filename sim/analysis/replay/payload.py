@@ -7,7 +7,8 @@ rate (``DISPLAY_FPS``, lower for long runs so that frames x moving bodies stays 
 :data:`~sim.analysis.replay.series.PATH_POINTS` points.
 
 May import: :mod:`sim.analysis.replay.scene`, :mod:`sim.analysis.replay.series`,
-:mod:`sim.simulation.runfolder` (the run as read).
+:mod:`sim.simulation.runfolder` (the run as read), :mod:`sim.render.framing` (the video's
+framed overview, the replay's first view).
 """
 
 from __future__ import annotations
@@ -86,6 +87,35 @@ def tool_paths(arrays: Mapping[str, NDArray[Any]]) -> list[dict[str, Any]]:
     return out
 
 
+#: Width over height the framed overview is fitted for (the page's canvas is its width by 480 px).
+OVERVIEW_ASPECT = 2.0
+
+
+def framed_overview(model: Any, qpos: NDArray[np.float64]) -> list[dict[str, Any]]:
+    """The video's framed overview (:func:`sim.render.framing.overview_view`: the cell's
+    ``overview`` direction, the robot's swept volume and the cell's objects in the image) as a
+    world camera preset named ``framed overview``, the replay's first view; none for a model without a
+    robot (``robot/`` bodies)."""
+    import mujoco
+
+    from sim.render.framing import FOVY_DEG, direction, overview_view
+
+    cid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "overview")
+    view = overview_view(model, qpos, cid if cid >= 0 else None, OVERVIEW_ASPECT)
+    if view is None:
+        return []
+    forward = direction(view.azimuth, view.elevation)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    rot = np.column_stack([right, up, -forward])  # a camera looks along its -z, y up
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, rot.reshape(-1))
+    pos = np.asarray(view.lookat, float) - view.distance * forward
+    return [{"name": "framed overview", "body": 0, "pos": [float(v) for v in pos],
+             "quat": [float(v) for v in quat], "fovy": FOVY_DEG}]
+
+
 def build_payload(model: Any, arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any],
                   joints: list[str], *, fps: float = DISPLAY_FPS,
                   budget: int = POSE_BUDGET) -> dict[str, Any]:
@@ -142,7 +172,7 @@ def build_payload(model: Any, arrays: Mapping[str, NDArray[Any]], summary: Mappi
         "frames": {"t": b64(t[idx]), "bodies": [int(b) for b in moving],
                    "pos": b64(pos[:, moving]), "quat": b64(quat[:, moving]),
                    "fps": float((idx.size - 1) / (t[-1] - t[0])) if idx.size > 1 else 0.0},
-        "cameras": cameras(model),
+        "cameras": framed_overview(model, qpos) + cameras(model),
         "paths": tool_paths(arrays),
         "charts": charts,
         "phases": [{"name": str(p.get("name", "")), "t0": float(p.get("t0", 0.0)),
