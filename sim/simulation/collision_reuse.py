@@ -78,7 +78,7 @@ from sim.simulation.compile import BuiltCell
 NEAR_RANGE_M = DETECTION_MARGIN_M
 #: How far a robot geom may be, in the reference, from where it is at the anchor sample its
 #: coarse sample is bounded from, m (:func:`anchor_samples`).
-ANCHOR_GAP_M = 2e-3
+ANCHOR_GAP_M = 8e-3
 #: Numerical slack on every distance compared, m (GJK and the contact distances are exact to
 #: far better).
 SLACK_M = 5e-5
@@ -322,7 +322,12 @@ def lower_bounds(cm: CollisionModel, ref: ReferenceScan, coarse: NDArray[np.int6
     starts = ref.anchors
     stops = np.append(ref.anchors[1:], coarse.size)
     a_of = np.searchsorted(coarse[starts], ref.ranged.s)
-    counts = (stops - starts)[a_of]
+    # a row that cannot be risky anywhere its anchor reaches is left out before it is spread
+    gap_hi = np.maximum.reduceat(ref.gap, starts)
+    loss_hi = np.maximum.reduceat(dev2 + reach, starts)
+    may = np.maximum(NEAR_RANGE_M, ref.ranged.dist - 2.0 * gap_hi[a_of]) - loss_hi[a_of] \
+        < -PENETRATION_TOLERANCE_M
+    counts = np.where(may, (stops - starts)[a_of], 0)
     rows = np.repeat(np.arange(a_of.size), counts)
     first = np.cumsum(counts) - counts
     m = np.repeat(starts[a_of], counts) + (np.arange(rows.size) - np.repeat(first, counts))

@@ -94,20 +94,8 @@ def pool_startup_s(workers: int, mp_context: str = "spawn", scenario: Any = None
 
 
 def run_group(runner: Callable[[Variant], Any], variants: Sequence[Variant]) -> list[Outcome]:
-    """Run variants one after the other in this process (a task of a parallel sweep). Each is
-    told how many variants of its plan follow it in the group
-    (:data:`sim.pipeline.sweep.reuse.PEERS_AHEAD`): a plan's reference is worth scanning for
-    reuse only when another variant of it follows."""
-    from sim.pipeline.sweep import reuse
-
-    out = []
-    try:
-        for i, v in enumerate(variants):
-            reuse.PEERS_AHEAD = sum(w.speed_scale == v.speed_scale for w in variants[i + 1:])
-            out.append(run_variant(runner, v))
-    finally:
-        reuse.PEERS_AHEAD = None
-    return out
+    """Run variants one after the other in this process (a task of a parallel sweep)."""
+    return [run_variant(runner, v) for v in variants]
 
 
 def _run_batch(batch: Callable[[Sequence[Variant]], Sequence[Any]],

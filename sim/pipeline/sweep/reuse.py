@@ -17,13 +17,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-#: Reuse the plan's scan in metrics-only variants of this process.
+#: Reuse the plan's scan in metrics-only variants of this process (a plan's first variant
+#: scans its reference: cheaper than a run's own check, so even a plan with one variant in a
+#: process gains).
 ENABLED = True
-#: How many variants of the running variant's plan follow it in this process's task (set by
-#: :func:`sim.pipeline.sweep.engines.run_group`); 0: none, so a plan whose reference is not
-#: scanned yet is checked in full (a scan pays off from the second variant); None: unknown
-#: (outside a sweep's task), scan.
-PEERS_AHEAD: int | None = None
 
 
 def reuse_collisions(summary: dict[str, Any], built: Any, motion: Any,
@@ -48,8 +45,7 @@ def reuse_collisions(summary: dict[str, Any], built: Any, motion: Any,
     coarse = coarse_samples(samples)
     q_ref = np.asarray(motion.at(samples.t[coarse]).q, dtype=float)
     found, reasons = collisions_from_reference(built, samples, names, phase_seams(motion),
-                                               phase_weaves(motion), q_ref,
-                                               scan=PEERS_AHEAD != 0)
+                                               phase_weaves(motion), q_ref)
     summary["collisions"] = found
     summary["clearance_skipped"] = True
     summary["allowed_contacts"] = reasons
@@ -63,4 +59,4 @@ def collide_hook() -> Any:
     return reuse_collisions if ENABLED else None
 
 
-__all__ = ["ENABLED", "PEERS_AHEAD", "collide_hook", "reuse_collisions"]
+__all__ = ["ENABLED", "collide_hook", "reuse_collisions"]
