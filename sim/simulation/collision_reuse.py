@@ -343,6 +343,33 @@ def lower_bounds(cm: CollisionModel, ref: ReferenceScan, coarse: NDArray[np.int6
     return Contacts.concat([near, far]), unlisted
 
 
+def scanned_intervals(cm: CollisionModel, ref: ReferenceScan, samples: MotionSamples,
+                      coarse: NDArray[np.int64], allowed: Sequence[AllowedContact]
+                      ) -> list[tuple[int, int]] | None:
+    """The coarse intervals ``(first, last sample)`` of the variant ``samples`` to check at
+    every sample: every interval :func:`~sim.simulation.collisions.find_collisions` checks so,
+    and maybe more (module docstring); None when the variant strays so far from the
+    reference that a robot's own pair the near pass does not list may touch."""
+    # against the positions the scan was made at (whatever the cache gave back)
+    scanned_q = ref.qpos[:, np.asarray(cm.built.robot_qpos)]
+    dev2 = 2.0 * deviation(cm, samples.qpos[coarse], scanned_q) + SLACK_M
+    # a robot's own pair is listed by the full check's scan only where it touches; one the
+    # near pass does not list (at least NEAR_RANGE_M apart) cannot unless the variant strays
+    # that far
+    if np.any(dev2 >= NEAR_RANGE_M - PENETRATION_TOLERANCE_M):
+        return None
+    # how much closer a pair gets inside interval k (its two geoms' bounds; one robot)
+    move = 2.0 * _col.motion_bound(cm, samples, coarse)["link"]
+    reach = np.maximum(np.append(move, 0.0), np.append(0.0, move))
+    rows, unlisted = lower_bounds(cm, ref, coarse, dev2, reach)
+    intervals = _col._intervals_to_check(cm, samples, coarse, rows, allowed)
+    # a pair listed nowhere near: at least `unlisted` apart at each end of the interval
+    worst = np.minimum(unlisted[:-1], unlisted[1:]) - move
+    extra = [(int(coarse[k]), int(coarse[k + 1]))
+             for k in np.flatnonzero(worst < -PENETRATION_TOLERANCE_M)]
+    return sorted(set(intervals) | set(extra))
+
+
 def collisions_from_reference(built: BuiltCell, samples: MotionSamples,
                               phase_names: Sequence[str], phase_seams: Sequence[str | None],
                               weaves: Sequence[float], q_ref: NDArray[np.float64],
@@ -362,24 +389,10 @@ def collisions_from_reference(built: BuiltCell, samples: MotionSamples,
     ref = reference_scan(cm, samples, coarse, q_ref, make=scan)
     if ref is None or ref.qpos.shape[0] != coarse.size:
         return _full(cm, samples, phase_names, allowed), reasons
-    # against the positions the scan was made at (whatever the cache gave back)
-    scanned_q = ref.qpos[:, np.asarray(built.robot_qpos)]
-    dev2 = 2.0 * deviation(cm, samples.qpos[coarse], scanned_q) + SLACK_M
-    # a robot's own pair is listed by the full check's scan only where it touches; one the
-    # near pass does not list (at least NEAR_RANGE_M apart) cannot unless the variant strays
-    # that far: then check it all in full
-    if np.any(dev2 >= NEAR_RANGE_M - PENETRATION_TOLERANCE_M):
+    intervals = scanned_intervals(cm, ref, samples, coarse, allowed)
+    if intervals is None:
         return _full(cm, samples, phase_names, allowed), reasons
-    # how much closer a pair gets inside interval k (its two geoms' bounds; one robot)
-    move = 2.0 * _col.motion_bound(cm, samples, coarse)["link"]
-    reach = np.maximum(np.append(move, 0.0), np.append(0.0, move))
-    rows, unlisted = lower_bounds(cm, ref, coarse, dev2, reach)
-    intervals = _col._intervals_to_check(cm, samples, coarse, rows, allowed)
-    # a pair listed nowhere near: at least `unlisted` apart at each end of the interval
-    worst = np.minimum(unlisted[:-1], unlisted[1:]) - move
-    extra = [(int(coarse[k]), int(coarse[k + 1]))
-             for k in np.flatnonzero(worst < -PENETRATION_TOLERANCE_M)]
-    fine = np.unique(np.concatenate([np.arange(a, b + 1) for a, b in [*intervals, *extra]]
+    fine = np.unique(np.concatenate([np.arange(a, b + 1) for a, b in intervals]
                                     or [np.zeros(0, int)])).astype(int)
     c = cm.scan(samples.qpos, fine)
     if c.select(~allowed_mask(c, allowed)).s.size:  # a collision, or one not ruled out
@@ -402,4 +415,4 @@ def _full(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str]
 __all__ = ["ANCHOR_GAP_M", "KEPT", "NEAR_RANGE_M", "SLACK_M", "STATS", "ReferenceScan",
            "anchor_samples", "clear_cache", "collisions_from_reference", "deviation",
            "geometry_key", "joint_gap", "lower_bounds", "reference_key", "reference_scan",
-           "reusable"]
+           "reusable", "scanned_intervals"]
