@@ -6,7 +6,6 @@ reported as that variant's error while the others go on."""
 from __future__ import annotations
 
 import logging
-import math
 import multiprocessing
 import os
 import socket
@@ -38,23 +37,26 @@ def import_ray() -> Any:
 
 
 def task_groups(variants: Sequence[Variant], workers: int) -> list[list[Variant]]:
-    """The variants cut into tasks for ``workers`` parallel workers: the variants of one speed
-    scale run together, in one worker, one after the other (a plan depends on the speed scale,
-    not on the payload, so the worker plans once and reuses it), split into enough tasks that
-    every worker has at least two to take, of sizes that differ by one at most (6 variants of
-    one plan on 2 workers: 2, 2, 1, 1, so that each worker runs 3). The results do not depend
-    on the grouping (they are gathered by variant index)."""
+    """The variants cut into tasks for ``workers`` parallel workers. The variants of one speed
+    scale follow each other (a plan depends on the speed scale, not on the payload, so a worker
+    plans once for the variants of a task and reuses the plan and its reference's collision
+    scan). With at least twice as many speed scales as workers each speed scale is a task;
+    else the speed-major list is cut into ``2 x workers`` tasks of sizes that differ by one at
+    most, so that every worker has at least two to take (6 variants of one plan on 2 workers:
+    2, 2, 1, 1, so that each worker runs 3; 2 payloads x 3 speed scales: a task per speed
+    scale's pair of payloads and one per payload of the third, so that no two workers make
+    the same plan at once). The results do not depend on the grouping (they are gathered by
+    variant index)."""
     by_speed: dict[float, list[Variant]] = {}
     for v in variants:
         by_speed.setdefault(v.speed_scale, []).append(v)
-    per_speed = max(1, math.ceil(2 * max(workers, 1) / len(by_speed)))
-    groups: list[list[Variant]] = []
-    for members in by_speed.values():
-        n = min(per_speed, len(members))
-        size, extra = divmod(len(members), n)
-        cuts = [k * size + min(k, extra) for k in range(n + 1)]
-        groups.extend(members[a:b] for a, b in zip(cuts[:-1], cuts[1:], strict=True))
-    return groups
+    if len(by_speed) >= 2 * max(workers, 1):
+        return list(by_speed.values())
+    ordered = [v for members in by_speed.values() for v in members]
+    n = min(2 * max(workers, 1), len(ordered))
+    size, extra = divmod(len(ordered), n)
+    cuts = [k * size + min(k, extra) for k in range(n + 1)]
+    return [ordered[a:b] for a, b in zip(cuts[:-1], cuts[1:], strict=True)]
 
 
 def warm_worker(scenario: Any = None) -> None:
