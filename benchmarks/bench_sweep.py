@@ -24,8 +24,10 @@ By default (issue 29's acceptance) it prints instead, for the weld plate:
   ``1.5 x (6 x one variant's simulate) / 2 + the pool's start-up`` (the sum of the 6 variants'
   own simulate stages: a slower speed scale simulates a longer cycle): 6 payloads at one speed
   (one plan: each worker scans its reference once and reuses it) and a 2 x 3 grid (three plans
-  over two workers: a reference scan per plan and worker), each with and without the reuse;
-  the tables with and without the reuse must be identical.
+  over two workers: a plan and its reference scan per task that has it, four in all), each
+  with and without the reuse; the tables with and without the reuse must be identical. Below
+  each sweep's line: how much of its wall the pool took (the rest: loading the scenario and
+  writing the report), the variants' own wall times and their stages, summed.
 
 Wall times on a machine shared with other jobs say little: CPU times (this process's, and the
 workers' from ``getrusage``) and the load average are printed beside them.
@@ -220,9 +222,19 @@ def acceptance(scenario: str, workers: int) -> dict:
             cycles = sum(o.rows[0]["duration_s"] for o in res.outcomes) / one_cycle
             bound = 1.5 * sims / workers + start
             cpu_bound = 1.5 * cycles * sim_cpu
+            # where the wall went: the pool (start-up and variants) and the rest (the
+            # scenario's load, the report's files); and the variants' stages summed
+            stages: dict[str, float] = {}
+            for o in res.outcomes:
+                for k, v in o.timings_s.items():
+                    stages[k] = stages.get(k, 0.0) + v
             out[f"sweep {grid_label} {label}"] = {"wall_s": wall, "bound_s": bound,
                                                   "simulate_sum_s": sims, "cpu_s": cpu,
                                                   "cpu_bound_s": cpu_bound,
+                                                  "pool_wall_s": res.wall_s,
+                                                  "variants_wall_sum_s": sum(
+                                                      o.wall_s for o in res.outcomes),
+                                                  "stages_sum_s": stages,
                                                   "failures": len(res.failures)}
             print(f"sweep {grid_label} {label}: {wall:.1f} s wall vs bound {bound:.1f} s "
                   f"(1.5 x {sims:.1f} s of its {n} simulate stages / {workers} + {start:.2f} s "
@@ -232,6 +244,10 @@ def acceptance(scenario: str, workers: int) -> dict:
                   f"included) vs 1.5 x {cycles:.2f} cycles x {sim_cpu:.2f} s = {cpu_bound:.1f} s "
                   f"({cpu / cpu_bound:.2f}x; less the start-up's "
                   f"{(cpu - out['pool_startup_cpu_s']) / cpu_bound:.2f}x); {load()}", flush=True)
+            rec = out[f"sweep {grid_label} {label}"]
+            print(f"  (pool {res.wall_s:.1f} s of it; the variants' own wall summed "
+                  f"{rec['variants_wall_sum_s']:.1f} s, stages summed: "
+                  + ", ".join(f"{a} {b:.1f}" for a, b in stages.items()) + ")", flush=True)
         same = tables[(grid_label, "with reuse")] == tables[(grid_label, "without reuse")]
         out[f"sweep {grid_label} identical tables"] = same
         print(f"  {grid_label}: tables with and without reuse identical: {same}", flush=True)
