@@ -50,7 +50,7 @@ def task_groups(variants: Sequence[Variant], workers: int) -> list[list[Variant]
     by_speed: dict[float, list[Variant]] = {}
     for v in variants:
         by_speed.setdefault(v.speed_scale, []).append(v)
-    if len(by_speed) >= 2 * max(workers, 1):
+    if not by_speed or len(by_speed) >= 2 * max(workers, 1):
         return list(by_speed.values())
     ordered = [v for members in by_speed.values() for v in members]
     n = min(2 * max(workers, 1), len(ordered))
