@@ -18,11 +18,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from support.scenarios import joint_phase, write_scenario
 
 from sim.pipeline import run as run_module
 from sim.pipeline.run import RunOptions, add_collisions, evaluate_scenarios
-from sim.pipeline.sweep import Variant, reuse, run_sweep
+from sim.pipeline.sweep import Variant, reuse, run_sweep, task_groups
 from sim.pipeline.sweep.evaluation import _variant_scenario, evaluate_variant
 from sim.simulation import collision_reuse
 
@@ -147,3 +149,24 @@ def test_a_pool_sweep_reusing_its_plans_gives_each_variant_s_rows_alone(scenario
     assert not res.failures
     assert {(o.variant.payload_kg, o.variant.speed_scale): _text(list(o.rows))
             for o in res.outcomes} == alone
+
+
+@settings(max_examples=60, deadline=None)
+@given(n_payloads=st.integers(1, 7), n_speeds=st.integers(1, 9), workers=st.integers(1, 5))
+def test_tasks_keep_a_plan_s_variants_together_and_balance_the_workers(n_payloads, n_speeds,
+                                                                        workers):
+    """Every variant (the sweep's payload-major order) in exactly one task, the tasks one
+    after the other in speed-major order; a speed scale per task when there are at least two
+    per worker, else 2 x workers tasks of sizes that differ by one at most."""
+    speeds = [0.5 + 0.05 * s for s in range(n_speeds)]
+    variants = [Variant(float(p), speeds[s], "x", index=p * n_speeds + s)
+                for p in range(n_payloads) for s in range(n_speeds)]
+    groups = task_groups(variants, workers)
+    flat = [v.index for g in groups for v in g]
+    assert flat == [p * n_speeds + s for s in range(n_speeds) for p in range(n_payloads)]
+    if n_speeds >= 2 * workers:
+        assert [{v.speed_scale for v in g} for g in groups] == [{x} for x in speeds]
+    else:
+        sizes = [len(g) for g in groups]
+        assert len(groups) == min(2 * workers, len(variants))
+        assert max(sizes) - min(sizes) <= 1
