@@ -291,6 +291,12 @@ def payload_radius(mass_kg: float) -> float:
     return float((3.0 * mass_kg / (4.0 * np.pi * STEEL_DENSITY)) ** (1.0 / 3.0))
 
 
+def payload_inertia(mass_kg: float) -> float:
+    """Each principal moment of the payload's sphere (:func:`payload_radius`), kg m^2."""
+    r = payload_radius(mass_kg)
+    return 0.4 * mass_kg * r**2
+
+
 def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.0,
                   prefix: str = ROBOT_PREFIX) -> RobotRig:
     """Load the robot, attach the tool at its flange, move its tcp, add the payload.
@@ -362,7 +368,7 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
         r = payload_radius(payload_kg)
         body = flange_body.add("body", name="payload", pos=tcp_pos)
         body.add("inertial", pos=[0.0, 0.0, 0.0], mass=payload_kg,
-                 diaginertia=[0.4 * payload_kg * r**2] * 3)
+                 diaginertia=[payload_inertia(payload_kg)] * 3)
         body.add("geom", name="payload", type="sphere", size=[r], contype=0, conaffinity=0,
                  group=1, rgba=(0.9, 0.8, 0.1, 0.35))
     return RobotRig(spec=spec, tool=tool, model=robot, statics=st,

@@ -44,6 +44,7 @@ from sim.errors import InternalError, RenderError, RunFolderError
 from sim.pipeline.stages import Stages
 from sim.scenario import Scenario
 from sim.simulation import runfolder
+from sim.simulation.build_cache import build_reusing
 from sim.simulation.compile import BuiltCell, build
 from sim.simulation.metrics import make_summary
 from sim.simulation.motion import build_motion, check_motion_limits, check_size
@@ -162,8 +163,8 @@ def _prepare(scenario: Scenario, options: RunOptions, stages: Stages, *, reuse_p
     """Build the cell and plan the motion; refuse bad video settings before simulating. With
     ``reuse_plan`` a motion planned for the same scenario in this process (another payload)
     is reused."""
-    with stages.stage("build"):
-        built = build(scenario)
+    with stages.stage("build"):  # another payload's cell is reused with the plan
+        built = (build_reusing if reuse_plan else build)(scenario)
         _check_tcp_consistency(built, scenario)
         video_args = _video_args(scenario, options)
         if options.video:  # refuse bad video settings before simulating, not after

@@ -76,13 +76,33 @@ class BuiltCell:
 # --------------------------------------------------------------------------------------------
 
 
+@dataclass
+class ComposedCell:
+    """A scenario's composed cell with the runner's sensors, before compiling.
+
+    Attributes:
+        cell: The composed cell (its ``mjcf`` holds the sensors).
+        sensors: The recorded quantities and their sizes, in ``sensordata`` order.
+        xml: The cell's MJCF as ``dm_control`` writes it (what is compiled).
+        assets: Its assets (meshes, textures), by file name.
+    """
+
+    cell: Cell
+    sensors: list[tuple[str, int]]
+    xml: str
+    assets: dict[str, Any]
+
+
 def build(scenario: Scenario) -> BuiltCell:
     """Compose and compile the scenario's cell, with the sensors the runner records."""
-    import mujoco
+    composed = compose(scenario)
+    model, saved_xml = compile_composed(composed)
+    return assemble(scenario, composed.cell, model, saved_xml, composed.sensors)
 
+
+def compose(scenario: Scenario) -> ComposedCell:
+    """The scenario's cell composed with the sensors the runner records (not compiled)."""
     from sim.cells import build_cell
-    from sim.cells.compose import FRICTION_PREFIX
-    from sim.robots.kinematics.model import closed_form_model
 
     cell = build_cell(scenario.cell, scenario.robot, tool=scenario.tool,
                       mount=scenario.mount, payload_kg=scenario.payload_kg)
@@ -113,15 +133,32 @@ def build(scenario: Scenario) -> BuiltCell:
         root.sensor.add("framequat", name=f"cellsim_{cr.name}_tcp_quat", objtype="site",
                         objname=tcp_p)
         sensors += [(f"{cr.name}_tcp_pos", 3), (f"{cr.name}_tcp_quat", 4)]
-    xml = root.to_xml_string()
+    return ComposedCell(cell, sensors, root.to_xml_string(), root.get_assets())
+
+
+def compile_composed(composed: ComposedCell) -> tuple[Any, str]:
+    """Compile a composed cell: the ``mujoco.MjModel`` and its MJCF as MuJoCo saves it."""
+    import mujoco
+
     try:
-        model = mujoco.MjModel.from_xml_string(xml, root.get_assets())
+        model = mujoco.MjModel.from_xml_string(composed.xml, composed.assets)
     except ValueError as exc:  # a bug in a cell builder, not a user mistake
-        raise InternalError(f"cell {cell.name!r} does not compile: {exc}") from exc
+        raise InternalError(f"cell {composed.cell.name!r} does not compile: {exc}") from exc
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "model.xml"
         mujoco.mj_saveLastXML(str(path), model)
         saved_xml = path.read_text()
+    return model, saved_xml
+
+
+def assemble(scenario: Scenario, cell: Cell, model: Any, saved_xml: str,
+             sensors: list[tuple[str, int]]) -> BuiltCell:
+    """The :class:`BuiltCell` of a compiled cell: every id, the sensors' slices and the
+    Cartesian context, resolved from ``model``."""
+    import mujoco
+
+    from sim.cells.compose import FRICTION_PREFIX
+    from sim.robots.kinematics.model import closed_form_model
 
     slices, start = {}, 0
     for name, size in sensors:
