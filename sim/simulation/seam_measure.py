@@ -74,24 +74,89 @@ def nearest_on_polyline(p: NDArray[np.float64], pts: NDArray[np.float64], k: int
     """Nearest points of world points ``p`` (N, 3) on the polyline through ``pts`` (M, 3):
     the chord (index of its first vertex, (N,)), the fraction along it (N,) and the distance,
     m (N,). The chords on either side of the ``k`` nearest vertices are tried (a point inside
-    a corner is near both legs)."""
+    a corner is near both legs), in the order of the vertices' nearness, the chord before a
+    vertex first; the first chord at the least distance is the answer (a NaN distance is
+    never the least; a point with none below infinity gets chord 0 at 0 and distance inf).
+
+    Each chord is measured once per point: a point's ``2 k`` tries on a finely sampled path
+    fall in a run of ``k + 1`` chords, measured together (:func:`_nearest_in_runs`); a point
+    whose tries are spread wider, or whose least distance two chords share, tries them one by
+    one in order (:func:`_nearest_tries`). Both give the bits of trying every chord in order
+    (``tests/simulation/test_seam_nearest_runs.py``)."""
     k = min(k, len(pts))
     _, idx = cKDTree(pts).query(p, k=k)
     idx = np.asarray(idx).reshape(len(p), k)
+    tries = np.clip(idx[:, :, None] + np.array([-1, 0]), 0, len(pts) - 2).reshape(len(p), 2 * k)
+    best_i = np.zeros(len(p), dtype=np.intp)
+    best_u = np.zeros(len(p))
+    best_d = np.full(len(p), np.inf)
+    if len(p) == 0:
+        return best_i, best_u, best_d
+    first = tries.min(axis=1)
+    span = tries.max(axis=1) - first
+    in_run = span < min(2 * k, 62)  # the run's chords as the bits of an int64
+    rows: slice | NDArray[np.intp] = slice(None) if in_run.all() else np.flatnonzero(in_run)
+    if in_run.any():
+        i, u, d, exact = _nearest_in_runs(p[rows], pts, tries[rows], first[rows],
+                                          int(span[rows].max()) + 1)
+        best_i[rows], best_u[rows], best_d[rows] = i, u, d
+        in_run[np.flatnonzero(in_run)[~exact]] = False
+    rest = np.flatnonzero(~in_run)
+    if len(rest):
+        best_i[rest], best_u[rest], best_d[rest] = _nearest_tries(p[rest], pts, tries[rest])
+    return best_i, best_u, best_d
+
+
+def _chord_distance(p: NDArray[np.float64], a: NDArray[np.float64], ab: NDArray[np.float64],
+                    den: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The fraction along chords ``a + u ab`` nearest to ``p`` and the distance, row by row
+    (``den``: ``max(ab . ab, 1e-30)``)."""
+    u = np.clip(np.einsum("ij,ij->i", p - a, ab) / den, 0.0, 1.0)
+    return u, np.linalg.norm(p - (a + u[:, None] * ab), axis=1)
+
+
+def _nearest_in_runs(p: NDArray[np.float64], pts: NDArray[np.float64], tries: NDArray[np.intp],
+                     first: NDArray[np.intp], width: int
+                     ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64],
+                                NDArray[np.bool_]]:
+    """:func:`nearest_on_polyline` for points whose tries lie in a run of ``width`` chords from
+    ``first``: each chord of the run that is tried measured once. Returns the chord, fraction
+    and distance, and whether the answer is exact: one chord at the least distance, below
+    infinity (elsewhere the order of the tries decides: :func:`_nearest_tries`)."""
+    n = len(p)
+    tried = np.bitwise_or.reduce(np.left_shift(1, tries - first[:, None]), axis=1)
+    ab_all = pts[1:] - pts[:-1]
+    den_all = np.maximum(np.einsum("ij,ij->i", ab_all, ab_all), 1e-30)
+    last = len(pts) - 2
+    dist = np.empty((n, width))
+    frac = np.empty((n, width))
+    for w in range(width):
+        c = np.minimum(first + w, last)  # beyond the path: not tried
+        frac[:, w], dist[:, w] = _chord_distance(p, np.take(pts, c, axis=0),
+                                                 np.take(ab_all, c, axis=0), np.take(den_all, c))
+    member = ((tried[:, None] >> np.arange(width)) & 1).astype(bool)
+    dist = np.where(member & ~np.isnan(dist), dist, np.inf)
+    least = dist.min(axis=1)
+    hit = dist == least[:, None]
+    pick = hit.argmax(axis=1)
+    exact = (hit.sum(axis=1) == 1) & (least < np.inf)
+    return first + pick, frac[np.arange(n), pick], least, exact
+
+
+def _nearest_tries(p: NDArray[np.float64], pts: NDArray[np.float64], tries: NDArray[np.intp]
+                   ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`nearest_on_polyline` trying each point's chords one by one, in order."""
     best_d = np.full(len(p), np.inf)
     best_i = np.zeros(len(p), dtype=np.intp)
     best_u = np.zeros(len(p))
-    for j in range(k):
-        for off in (-1, 0):
-            i0 = np.clip(idx[:, j] + off, 0, len(pts) - 2)
-            a, ab = pts[i0], pts[i0 + 1] - pts[i0]
-            u = np.clip(np.einsum("ij,ij->i", p - a, ab)
-                        / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-30), 0.0, 1.0)
-            d = np.linalg.norm(p - (a + u[:, None] * ab), axis=1)
-            better = d < best_d
-            best_d = np.where(better, d, best_d)
-            best_i = np.where(better, i0, best_i)
-            best_u = np.where(better, u, best_u)
+    for q in range(tries.shape[1]):
+        i0 = tries[:, q]
+        a, ab = pts[i0], pts[i0 + 1] - pts[i0]
+        u, d = _chord_distance(p, a, ab, np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-30))
+        better = d < best_d
+        best_d = np.where(better, d, best_d)
+        best_i = np.where(better, i0, best_i)
+        best_u = np.where(better, u, best_u)
     return best_i, best_u, best_d
 
 
