@@ -47,7 +47,8 @@ from sim.simulation.seam_measure import (  # measure_seam & co: importable from 
 from sim.simulation.simulate import SimulationRecord
 
 
-def _distance_to_path(p: NDArray[np.float64], cart: Any, T: NDArray[np.float64]) -> NDArray[np.float64]:
+def _distance_to_path(p: NDArray[np.float64], cart: Any, T: NDArray[np.float64]
+                      ) -> NDArray[np.float64]:
     """Distance of world points ``p`` (N,3) from the ideal ADNIA path (frame 0 -> world ``T``)."""
     # sample the path densely (every 10 um, at least 2000 points) by time: the path is
     # traversed monotonically, so nearest samples plus chord projection give the distance
@@ -413,7 +414,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
                                    for x, u in zip(track, units, strict=True)],
         "max_tcp_deviation_mm": float(np.max(dev) * 1e3),
         "torque_rms_diff_pct_of_peak": [float(100 * d / p) if p > 0 else 0.0
-                                        for d, p in zip(rms_diff, peak_id)],
+                                        for d, p in zip(rms_diff, peak_id, strict=True)],
         "actions": [{"t": t, "action": act} for t, act in motion.actions],
         "weld": weld_metrics(a, motion, built, torch_axis, measured),
         "cartesian_speed": cartesian_speeds(a, motion, built.context.world_from_frame0,
@@ -582,14 +583,15 @@ def _singularity(t: NDArray[np.float64], q_ref: NDArray[np.float64], motion: Mot
                  kin: Any, dt: float) -> dict[str, Any]:
     """:func:`singularity_summary` of one robot: its reference joints ``q_ref`` (its arm's
     first), its ``motion`` and kinematics."""
-    from sim.robots.kinematics.jacobian import singularity_measures
+    from sim.simulation.singularity_cache import singularity_measures  # the plan's, kept
 
     step = max(1, int(round(0.01 / dt)))
     t = t[::step]
     m = singularity_measures(kin, q_ref[::step, :kin.n_joints])  # the arm's joints
     i = int(np.argmin(m["sigma_min"]))
     out: dict[str, Any] = {"min_sigma": float(m["sigma_min"][i]), "t": float(t[i]),
-                           "phase": motion.phases[int(np.atleast_1d(motion.phase_index(t[i]))[0])].name,
+                           "phase": motion.phases[
+                               int(np.atleast_1d(motion.phase_index(t[i]))[0])].name,
                            "min_manipulability": float(np.min(m["manipulability"]))}
     for factor in ("wrist", "elbow", "shoulder"):
         if factor in m:
