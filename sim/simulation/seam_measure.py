@@ -86,24 +86,26 @@ def nearest_on_polyline(p: NDArray[np.float64], pts: NDArray[np.float64], k: int
     k = min(k, len(pts))
     _, idx = cKDTree(pts).query(p, k=k)
     idx = np.asarray(idx).reshape(len(p), k)
-    tries = np.clip(idx[:, :, None] + np.array([-1, 0]), 0, len(pts) - 2).reshape(len(p), 2 * k)
+    # tries[q]: the q-th chord each point tries (2 k, N)
+    tries = np.clip(idx.T[:, None, :] + np.array([-1, 0])[None, :, None], 0,
+                    len(pts) - 2).reshape(2 * k, len(p))
     best_i = np.zeros(len(p), dtype=np.intp)
     best_u = np.zeros(len(p))
     best_d = np.full(len(p), np.inf)
     if len(p) == 0:
         return best_i, best_u, best_d
-    first = tries.min(axis=1)
-    span = tries.max(axis=1) - first
+    first = np.minimum.reduce(tries, axis=0)
+    span = np.maximum.reduce(tries, axis=0) - first
     in_run = span < min(2 * k, 62)  # the run's chords as the bits of an int64
     rows: slice | NDArray[np.intp] = slice(None) if in_run.all() else np.flatnonzero(in_run)
     if in_run.any():
-        i, u, d, exact = _nearest_in_runs(p[rows], pts, tries[rows], first[rows],
+        i, u, d, exact = _nearest_in_runs(p[rows], pts, tries[:, rows], first[rows],
                                           int(span[rows].max()) + 1)
         best_i[rows], best_u[rows], best_d[rows] = i, u, d
         in_run[np.flatnonzero(in_run)[~exact]] = False
     rest = np.flatnonzero(~in_run)
     if len(rest):
-        best_i[rest], best_u[rest], best_d[rest] = _nearest_tries(p[rest], pts, tries[rest])
+        best_i[rest], best_u[rest], best_d[rest] = _nearest_tries(p[rest], pts, tries[:, rest])
     return best_i, best_u, best_d
 
 
@@ -119,38 +121,42 @@ def _nearest_in_runs(p: NDArray[np.float64], pts: NDArray[np.float64], tries: ND
                      first: NDArray[np.intp], width: int
                      ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64],
                                 NDArray[np.bool_]]:
-    """:func:`nearest_on_polyline` for points whose tries lie in a run of ``width`` chords from
-    ``first``: each chord of the run that is tried measured once. Returns the chord, fraction
-    and distance, and whether the answer is exact: one chord at the least distance, below
-    infinity (elsewhere the order of the tries decides: :func:`_nearest_tries`)."""
+    """:func:`nearest_on_polyline` for points whose tries (2 k, n) lie in a run of ``width``
+    chords from ``first``: each chord of the run that is tried measured once. Returns the
+    chord, fraction and distance, and whether the answer is exact: one chord at the least
+    distance, below infinity (elsewhere the order of the tries decides:
+    :func:`_nearest_tries`)."""
     n = len(p)
-    tried = np.bitwise_or.reduce(np.left_shift(1, tries - first[:, None]), axis=1)
+    tried = np.bitwise_or.reduce(np.left_shift(1, tries - first), axis=0)
     ab_all = pts[1:] - pts[:-1]
     den_all = np.maximum(np.einsum("ij,ij->i", ab_all, ab_all), 1e-30)
     last = len(pts) - 2
-    dist = np.empty((n, width))
-    frac = np.empty((n, width))
+    dist = np.empty((width, n))
+    frac = np.empty((width, n))
     for w in range(width):
         c = np.minimum(first + w, last)  # beyond the path: not tried
-        frac[:, w], dist[:, w] = _chord_distance(p, np.take(pts, c, axis=0),
-                                                 np.take(ab_all, c, axis=0), np.take(den_all, c))
-    member = ((tried[:, None] >> np.arange(width)) & 1).astype(bool)
-    dist = np.where(member & ~np.isnan(dist), dist, np.inf)
-    least = dist.min(axis=1)
-    hit = dist == least[:, None]
-    pick = hit.argmax(axis=1)
-    exact = (hit.sum(axis=1) == 1) & (least < np.inf)
-    return first + pick, frac[np.arange(n), pick], least, exact
+        frac[w], d = _chord_distance(p, np.take(pts, c, axis=0), np.take(ab_all, c, axis=0),
+                                     np.take(den_all, c))
+        dist[w] = np.where(((tried >> w) & 1).astype(bool) & ~np.isnan(d), d, np.inf)
+    least = np.minimum.reduce(dist, axis=0)
+    pick = np.zeros(n, dtype=np.intp)
+    count = np.zeros(n, dtype=np.intp)
+    for w in range(width - 1, -1, -1):  # the lowest chord at the least distance
+        hit = dist[w] == least
+        count += hit
+        pick[hit] = w
+    exact = (count == 1) & (least < np.inf)
+    return first + pick, frac[pick, np.arange(n)], least, exact
 
 
 def _nearest_tries(p: NDArray[np.float64], pts: NDArray[np.float64], tries: NDArray[np.intp]
                    ) -> tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]:
-    """:func:`nearest_on_polyline` trying each point's chords one by one, in order."""
+    """:func:`nearest_on_polyline` trying each point's chords (``tries``, 2 k, n) one by one,
+    in order."""
     best_d = np.full(len(p), np.inf)
     best_i = np.zeros(len(p), dtype=np.intp)
     best_u = np.zeros(len(p))
-    for q in range(tries.shape[1]):
-        i0 = tries[:, q]
+    for i0 in tries:
         a, ab = pts[i0], pts[i0 + 1] - pts[i0]
         u, d = _chord_distance(p, a, ab, np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-30))
         better = d < best_d
