@@ -293,8 +293,7 @@ def payload_radius(mass_kg: float) -> float:
 
 def payload_inertia(mass_kg: float) -> float:
     """Each principal moment of the payload's sphere (:func:`payload_radius`), kg m^2."""
-    r = payload_radius(mass_kg)
-    return 0.4 * mass_kg * r**2
+    return 0.4 * mass_kg * payload_radius(mass_kg) ** 2
 
 
 def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.0,
@@ -553,26 +552,30 @@ def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np
                       mechanisms: tuple[PlacedMechanism, ...] = (),
                       partners: tuple[Any, ...] = ()) -> mujoco.MjModel:
     """Add keyframe ``home``: robot at ``home_q``, the mechanisms at their home, the other
-    robots at theirs, free bodies where built, suction off."""
+    robots at theirs, free bodies where built, suction off; the model compiled with it."""
     import mujoco
 
-    m = compile_model(world)
-    qpos = m.qpos0.copy()
-    ctrl = np.zeros(m.nu)
+    try:  # the MJCF written and parsed once: the keyframe is added to its spec as well
+        spec = mujoco.MjSpec.from_string(world.to_xml_string(), assets=world.get_assets())
+        m = spec.compile()
+    except ValueError:
+        compile_model(world)  # raises CellsimError, MuJoCo's message on one line
+        raise
+    qpos, ctrl = m.qpos0.copy(), np.zeros(m.nu)
     values = [(f"{ROBOT_PREFIX}/{j}", qj) for j, qj in zip(rig.spec.joints, home_q, strict=True)]
     for pm in mechanisms:
         values += list(zip(pm.joint_names, pm.home, strict=True))
     for cr in partners:
         values += list(zip(cr.placed.joint_names, cr.home_q, strict=True))
     for name, qj in values:
-        jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
-        qpos[m.jnt_qposadr[jid]] = qj
+        qpos[m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)]] = qj
     for a in range(m.nu):
         if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT:
             jid = m.actuator_trnid[a, 0]
             ctrl[a] = qpos[m.jnt_qposadr[jid]]
-    world.keyframe.add("key", name="home", qpos=qpos, ctrl=ctrl)
-    return compile_model(world)
+    key = world.keyframe.add("key", name="home", qpos=qpos, ctrl=ctrl)
+    spec.add_key(name="home", qpos=key.qpos, ctrl=key.ctrl)
+    return spec.compile()
 
 
 def suction_actuator_name(rig: RobotRig) -> str | None:
