@@ -198,11 +198,11 @@ class FrameRenderer:
         self._tiles = [np.empty((self.height, self.width, 3), np.uint8) for _ in self.camera_ids]
 
     def _views(self, model: Any, qpos: np.ndarray, aspect: float) -> list[Any]:
-        """Per tile: a framed free camera (``overview``, ``tool``: :mod:`sim.render.framing`)
+        """Per tile: a framed free camera (``overview``, ``tool``: :mod:`sim.analysis.framing`)
         or None for a model camera rendered as it is."""
         import mujoco
 
-        from sim.render.framing import FOVY_DEG, overview_view, tool_view
+        from sim.analysis.framing import FOVY_DEG, overview_view, tool_view
 
         views: list[Any] = []
         tcp = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "robot/tcp")

@@ -7,7 +7,7 @@ rate (``DISPLAY_FPS``, lower for long runs so that frames x moving bodies stays 
 :data:`~sim.analysis.replay.series.PATH_POINTS` points.
 
 May import: :mod:`sim.analysis.replay.scene`, :mod:`sim.analysis.replay.series`,
-:mod:`sim.simulation.runfolder` (the run as read), :mod:`sim.render.framing` (the video's
+:mod:`sim.simulation.runfolder` (the run as read), :mod:`sim.analysis.framing` (the video's
 framed overview, the replay's first view).
 """
 
@@ -92,13 +92,13 @@ OVERVIEW_ASPECT = 2.0
 
 
 def framed_overview(model: Any, qpos: NDArray[np.float64]) -> list[dict[str, Any]]:
-    """The video's framed overview (:func:`sim.render.framing.overview_view`: the cell's
-    ``overview`` direction, the robot's swept volume and the cell's objects in the image) as a
-    world camera preset named ``framed overview``, the replay's first view; none for a model without a
-    robot (``robot/`` bodies)."""
+    """The video's framed overview (:func:`sim.analysis.framing.overview_view`: the cell's
+    ``overview`` direction, the robot's swept volume and the cell's objects in the image) as
+    a world camera preset named ``framed overview``, the replay's first view; none for a
+    model without a robot (``robot/`` bodies)."""
     import mujoco
 
-    from sim.render.framing import FOVY_DEG, direction, overview_view
+    from sim.analysis.framing import FOVY_DEG, direction, overview_view
 
     cid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "overview")
     view = overview_view(model, qpos, cid if cid >= 0 else None, OVERVIEW_ASPECT)

@@ -11,6 +11,11 @@
 Both are MuJoCo free cameras (:class:`mujoco.MjvCamera`): ``lookat``, ``distance``,
 ``azimuth`` and ``elevation``, with the model's ``visual/global/fovy``. Other camera names
 render the model's camera as it is.
+
+Geometry of the run only (``mj_kinematics`` of the recorded ``qpos``, no OpenGL): the video
+(:mod:`sim.render.frames`) and the 3D replay's first view
+(:func:`sim.analysis.replay.payload.framed_overview`) share it.
+May import: numpy and mujoco.
 """
 
 from __future__ import annotations
