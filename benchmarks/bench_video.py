@@ -4,8 +4,11 @@
 For each size (default 480x360, the default weld cycle's video) it measures, on one camera:
 
 * ``raw``: one process, ``Renderer.update_scene(data, camera)`` + ``Renderer.render()`` per
-  frame, states set beforehand (no overlay, no caption, no encoding, the framebuffer at the
-  frame's size): what MuJoCo alone renders in one process. Measured in a fresh interpreter
+  frame, each state set outside the timed part (no overlay, no caption, no encoding): what
+  MuJoCo alone renders in one process, of the pipeline's own scene (the renderer a
+  :class:`~sim.render.frames.FrameRenderer` opens: the same framed camera and field of view,
+  framebuffer at the tile's size, shadow map sized by :func:`~sim.render.frames.shadow_size`,
+  the model's multisampling; the settings are printed). Measured in a fresh interpreter
   twice: with the environment's ``LP_NUM_THREADS`` (Mesa llvmpipe's default is one rasterizer
   thread per core, so one process already uses more than one core) and with
   ``LP_NUM_THREADS=1`` (``raw1``: one process on one core);
@@ -53,38 +56,41 @@ import json, sys, time
 sys.path.insert(0, sys.argv[1])
 from sim.render.gl import adopt_backend
 adopt_backend(sys.argv[2])
-import mujoco
 import numpy as np
-from sim.render.interp import QposInterpolator
+from sim.render.frames import FrameRenderer
 from sim.simulation.runfolder import load_run
 record = load_run(sys.argv[3])
 camera, fps, n = sys.argv[4], float(sys.argv[7]), int(sys.argv[8])
 width, height = int(sys.argv[5]), int(sys.argv[6])
-model = record.load_model()
-model.vis.global_.offwidth, model.vis.global_.offheight = width, height
-interp = QposInterpolator(model, record.t, record.get("qpos"))
-times = record.t0 + np.arange(n) / fps
-states = []
-for t in times:
-    d = mujoco.MjData(model)
-    d.qpos[:] = interp(float(t))
-    mujoco.mj_forward(model, d)
-    states.append(d)
-with mujoco.Renderer(model, height, width) as renderer:
-    for d in states[:3]:  # warm-up (shader compilation, first allocations)
-        renderer.update_scene(d, camera)
+# the pipeline's own scene: its framebuffer and shadow map sizes, framed camera and field of
+# view, multisampling as the model has it; no overlay, no caption, no encoding
+with FrameRenderer(record, cameras=(camera,), width=width, height=height, overlay=False,
+                   caption=False, gl=sys.argv[2]) as frames:
+    renderer = frames._renderer
+    times = record.t0 + np.arange(n) / fps
+    for t in times[:3]:  # warm-up (shader compilation, first allocations)
+        frames.set_state(float(t))
+        frames._update_scene(0)
         renderer.render()
     try:
         from OpenGL import GL
         name = GL.glGetString(GL.GL_RENDERER).decode()
     except Exception:
         name = "?"
-    w0, c0 = time.perf_counter(), time.process_time()
-    for d in states:
-        renderer.update_scene(d, camera)
+    wall = cpu = 0.0
+    for t in times:
+        frames.set_state(float(t))  # the state is set outside the timed part
+        w0, c0 = time.perf_counter(), time.process_time()
+        frames._update_scene(0)  # Renderer.update_scene(data, the framed camera)
         renderer.render()
-    wall, cpu = time.perf_counter() - w0, time.process_time() - c0
-print(json.dumps({"fps": len(states) / wall, "cpu_ms": 1000 * cpu / len(states), "gl": name}))
+        wall += time.perf_counter() - w0
+        cpu += time.process_time() - c0
+    settings = {"shadowsize": int(frames.model.vis.quality.shadowsize),
+                "offsamples": int(frames.model.vis.quality.offsamples),
+                "offwidth": int(frames.model.vis.global_.offwidth),
+                "offheight": int(frames.model.vis.global_.offheight)}
+print(json.dumps({"fps": len(times) / wall, "cpu_ms": 1000 * cpu / len(times), "gl": name,
+                  "settings": settings}))
 """
 
 
@@ -198,10 +204,10 @@ def main(argv: list[str] | None = None) -> int:
                     if "loop_fps" in value:
                         best[key + "_loop"] = value["loop_fps"]
 
-            gl_name = "?"
+            gl_name, settings = "?", {}
             for _ in range(max(1, args.repeat)):
                 raw = bench_raw(run_dir, backend, args.camera, width, height, fps, frames, None)
-                gl_name = raw["gl"]
+                gl_name, settings = raw["gl"], raw.get("settings", {})
                 keep("raw", raw)
                 keep("raw1", bench_raw(run_dir, backend, args.camera, width, height, fps,
                                        frames, "1"))
@@ -211,6 +217,12 @@ def main(argv: list[str] | None = None) -> int:
                                              fps, n, args.lp_threads))
             if not results:
                 print(f"# OpenGL renderer: {gl_name}")
+                print(f"# raw: one process, the pipeline's scene without overlay/caption/encoding "
+                      f"({', '.join(f'{k}={v}' for k, v in settings.items())}), llvmpipe threads "
+                      f"as the environment has them; raw1: the same with LP_NUM_THREADS=1 "
+                      f"(one process on one core)")
+                print(f"# pipe {n}: write_video with {n} processes, whole call (start-up "
+                      f"included); {n}/raw and {n}/raw1: its frames/s over each baseline's")
                 print(header)
             row = {
                 "width": width, "height": height, "frames": frames, "jobs": n,
