@@ -18,8 +18,14 @@ Each line point is moved towards the camera along its line of sight by a few mil
 (``lift_*``): its projection is unchanged, but it is drawn in front of the bead and the
 reference, instead of flickering with them at equal depth. Paths are
 simplified (Ramer-Douglas-Peucker, ``tolerance``) to at most ``max_segments`` segments each,
-which bounds the geoms added per frame (each is a draw call; straight seams cost one).
-Overlay geoms cast no shadow (no second drawing pass).
+which bounds the geoms added per frame (each is a draw call; straight seams cost one), and
+then again on screen for the frame's camera, to :data:`~sim.render.screenpath.SCREEN_TOL_PX`
+(:mod:`sim.render.screenpath`; for a fixed camera once per video).
+
+MuJoCo's renderer (``render_gl3.c``) never draws a line geom into the shadow map (lines cast
+no shadow), but draws it in every other pass: mirrored in a reflective floor, in the main pass
+and once more, added, in the pass of each shadow-casting light (unlit: its colour is added
+again where that light's shadow does not fall). So every segment costs a few draw calls.
 
 The caption (time, phase, highest |joint torque| with the joint's name, arc/suction state) is
 drawn into the image with Pillow.
@@ -37,6 +43,7 @@ import numpy as np
 
 from sim.core.intervals import true_runs
 from sim.render.interp import interp_rows, sample_index
+from sim.render.screenpath import ScreenPath, camera_key
 from sim.simulation.runfolder import RunRecord
 
 
@@ -171,6 +178,15 @@ class PathOverlay:
                         sub, pts = idx[keep], local[keep]
                     self.bead_runs.append((pts, self.t[sub], float(self.t[a]), t_end))
                     self.bead_body.append(body)
+        # each drawn path simplified again on screen, per camera pose (:mod:`screenpath`)
+        st = self.style
+        self._screen_ref = (None if self.reference is None else ScreenPath(
+            self.reference, np.zeros(len(self.reference)), _lifter(st.lift_reference)))
+        self._screen_act = (None if self.actual is None else ScreenPath(
+            self.actual, self.actual_t, _lifter(st.lift_actual)))
+        self._screen_bead = [None if body is not None else ScreenPath(
+            pts, pts_t, _lifter(st.bead_radius))
+            for (pts, pts_t, _, _), body in zip(self.bead_runs, self.bead_body, strict=True)]
         # a cell's other robots: each its own trails and bead, from its recorded tool point
         # (``<name>_tcp_pos``, ``_tcp_pos_ref``, ``_arc_on``); their seams stand still
         self.others: list[PathOverlay] = [
@@ -219,11 +235,7 @@ class PathOverlay:
         eye3 = np.zeros(3)
         mat = np.eye(3).ravel()
 
-        def lifted(points: np.ndarray, lift: float) -> np.ndarray:
-            v = eye - points
-            d = np.linalg.norm(v, axis=1, keepdims=True)
-            d = np.maximum(d, 1e-9)
-            return points + v / d * np.minimum(lift, 0.25 * d)
+        key = camera_key(cam, height)
 
         def polyline(points: np.ndarray, gtype: int, rgba: tuple, widths: np.ndarray | float,
                      emission: float) -> None:
@@ -242,41 +254,59 @@ class PathOverlay:
                 added += 1
 
         # Weld bead: a wide line along the actual path where the arc was on, up to `time`.
-        for (pts, pts_t, t_start, t_end), body in zip(self.bead_runs, self.bead_body,
-                                                       strict=True):
+        for (pts, pts_t, t_start, t_end), body, screen in zip(
+                self.bead_runs, self.bead_body, self._screen_bead, strict=True):
             if time < t_start:
                 continue
-            k = int(np.searchsorted(pts_t, time, side="right"))
-            path = pts[:k]
-            if body is not None and data is not None:  # on the part, where it is now
-                R, p = data.xmat[body].reshape(3, 3), data.xpos[body]
-                path = path @ R.T + p
-            if time < t_end and self._actual_full is not None:
-                path = np.vstack([path, interp_rows(self.t, self._actual_full, time)])
+            last = (interp_rows(self.t, self._actual_full, time)
+                    if time < t_end and self._actual_full is not None else None)
+            if screen is not None:
+                path = screen.upto(time, key, last)
+            else:  # on a turning part: where the part is now (not simplified on screen)
+                k = int(np.searchsorted(pts_t, time, side="right"))
+                path = pts[:k]
+                if body is not None and data is not None:
+                    R, p = data.xmat[body].reshape(3, 3), data.xpos[body]
+                    path = path @ R.T + p
+                if last is not None:
+                    path = np.vstack([path, last])
+                path = _lifted(path, eye, st.bead_radius)
             if len(path) < 2:
                 continue
+            # `path` is lifted towards the eye by the bead radius: a bead laid in a fillet's
+            # corner would otherwise be buried in both plates; the width is measured at the
+            # segment's middle before the lift
             mid = 0.5 * (path[1:] + path[:-1])
-            dist = np.linalg.norm(mid - eye, axis=1)
+            dist = np.linalg.norm(mid - eye, axis=1) + st.bead_radius
             px = span if ortho else dist * span / near  # metres per pixel at each segment
-            # a wide line (bead width on screen, at least bead_min_px) lifted towards the eye
-            # by the bead radius: a bead laid in a fillet's corner would otherwise be buried
-            # in both plates; lines also cost far less than capsules on software OpenGL
+            # a wide line (bead width on screen, at least bead_min_px); lines also cost far
+            # less than capsules on software OpenGL
             width_px = np.maximum(2.0 * st.bead_radius / px, st.bead_min_px)
-            polyline(lifted(path, st.bead_radius), mujoco.mjtGeom.mjGEOM_LINE, st.bead_rgba,
-                     width_px, 0.35)
+            polyline(path, mujoco.mjtGeom.mjGEOM_LINE, st.bead_rgba, width_px, 0.35)
         # Reference path, whole.
-        if self.reference is not None:
-            polyline(lifted(self.reference, st.lift_reference), mujoco.mjtGeom.mjGEOM_LINE,
+        if self._screen_ref is not None:
+            polyline(self._screen_ref.upto(np.inf, key, None), mujoco.mjtGeom.mjGEOM_LINE,
                      st.reference_rgba, line_px, 1.0)
         # Actual path up to `time`.
-        if self.actual is not None and self._actual_full is not None:
-            k = int(np.searchsorted(self.actual_t, time, side="right"))
-            path = np.vstack([self.actual[:k], interp_rows(self.t, self._actual_full, time)])
-            polyline(lifted(path, st.lift_actual), mujoco.mjtGeom.mjGEOM_LINE, st.actual_rgba,
-                     line_px, 1.0)
+        if self._screen_act is not None and self._actual_full is not None:
+            path = self._screen_act.upto(time, key, interp_rows(self.t, self._actual_full, time))
+            polyline(path, mujoco.mjtGeom.mjGEOM_LINE, st.actual_rgba, line_px, 1.0)
         for other in self.others:
             added += other.add_to_scene(scene, time, height, geoms, data)
         return added
+
+
+def _lifted(points: np.ndarray, eye: np.ndarray, lift: float) -> np.ndarray:
+    """``points`` moved towards ``eye`` by ``lift`` (at most a quarter of their distance):
+    the same pixels, drawn in front of what lies at their depth."""
+    v = eye - points
+    d = np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-9)
+    return points + v / d * np.minimum(lift, 0.25 * d)
+
+
+def _lifter(lift: float) -> Any:
+    """``f(points, eye)``: :func:`_lifted` by ``lift``."""
+    return lambda points, eye: _lifted(points, eye, lift)
 
 
 def _other_robots(record: RunRecord) -> list[str]:
