@@ -239,6 +239,14 @@ def main(argv: list[str] | None = None) -> int:
                   f"{row['ratio_to_raw']:6.2f} {row['ratio_to_raw1']:7.2f}   "
                   f"{cpu['raw']:.0f} {cpu['raw1']:.0f} {cpu['pipe1']:.0f} {cpu['pipeN']:.0f}",
                   flush=True)
+            # a loaded machine slows the wall clock far more than the CPU time per frame
+            ceiling = min(n, usable_cores()) * 1000.0 / cpu["pipeN"]
+            row["cpu_bound_pipelineN_fps"] = ceiling
+            row["cpu_bound_ratio_to_raw1"] = ceiling * cpu["raw1"] / 1000.0
+            print(f"# by CPU time: pipe {n} on {min(n, usable_cores())} idle cores at most "
+                  f"{ceiling:.2f} frames/s = {row['cpu_bound_ratio_to_raw1']:.2f}x raw1 "
+                  f"(1000 / {cpu['raw1']:.0f} ms = {1000.0 / cpu['raw1']:.2f} frames/s)",
+                  flush=True)
     load1 = os.getloadavg()
     print(f"# load average after: {load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f}")
     if args.json:

@@ -182,8 +182,9 @@ class PathOverlay:
         st = self.style
         self._screen_ref = (None if self.reference is None else ScreenPath(
             self.reference, np.zeros(len(self.reference)), _lifter(st.lift_reference)))
-        self._screen_act = (None if self.actual is None else ScreenPath(
-            self.actual, self.actual_t, _lifter(st.lift_actual)))
+        self._screen_act = (None if self.actual is None or self.actual_t is None
+                            else ScreenPath(self.actual, self.actual_t,
+                                            _lifter(st.lift_actual)))
         self._screen_bead = [None if body is not None else ScreenPath(
             pts, pts_t, _lifter(st.bead_radius))
             for (pts, pts_t, _, _), body in zip(self.bead_runs, self.bead_body, strict=True)]

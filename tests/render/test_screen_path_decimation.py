@@ -177,3 +177,69 @@ def test_a_camera_that_moves_every_frame_draws_every_vertex() -> None:
         cam.pos = cam.pos + 1e-3 * k
         counts.append(len(path.upto(1.0, camera_key(cam, 360), None)))
     assert counts[0] == 2 and counts[-1] == 50
+
+
+def _segments(scene: object, first: int, rgba: tuple[float, ...]) -> list[np.ndarray]:
+    """The line geoms of one colour from ``first`` on, as polylines (joined where one
+    segment starts at the previous one's end): (M, 3) each."""
+    out: list[list[np.ndarray]] = []
+    for i in range(first, scene.ngeom):  # type: ignore[attr-defined]
+        g = scene.geoms[i]  # type: ignore[attr-defined]
+        if not np.allclose(g.rgba, rgba, atol=1e-6):
+            continue
+        a = np.array(g.pos, float)
+        b = a + np.array(g.mat, float).reshape(3, 3)[:, 2] * float(g.size[2])
+        if out and np.allclose(out[-1][-1], a, atol=1e-6):
+            out[-1].append(b)
+        else:
+            out.append([a, b])
+    return [np.array(p) for p in out]
+
+
+def test_the_overlay_draws_its_paths_within_the_tolerance(tmp_path, monkeypatch) -> None:
+    """PathOverlay.add_to_scene on a real scene: each colour's polyline, simplified on screen,
+    within the tolerance of the one drawn without the screen step (SCREEN_TOL_PX = 0)."""
+    from sim.render import gl
+
+    gl.configure_gl()
+    import mujoco
+
+    from sim.render.overlay import OverlayStyle, PathOverlay
+    from sim.render.synthetic import write_synthetic_run
+    from sim.simulation.runfolder import load_run
+
+    record = load_run(write_synthetic_run(tmp_path / "run"))
+    model = record.load_model()
+    data = mujoco.MjData(model)
+    style = OverlayStyle()
+    for time in (0.3 * record.duration + record.t0, record.t[-1]):
+        drawn = {}
+        for tol in (0.0, TOL):
+            monkeypatch.setattr(sp, "SCREEN_TOL_PX", tol)
+            overlay = PathOverlay(record, style, model)
+            scene = mujoco.MjvScene(model, maxgeom=model.ngeom + overlay.max_geoms + 10)
+            cam = mujoco.MjvCamera()
+            cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
+            cam.fixedcamid = 0
+            mujoco.mj_forward(model, data)
+            mujoco.mjv_updateScene(model, data, mujoco.MjvOption(), None, cam,
+                                   mujoco.mjtCatBit.mjCAT_ALL, scene)
+            first = scene.ngeom
+            overlay.add_to_scene(scene, time, 360)
+            gcam = scene.camera[0]
+            ns = SimpleNamespace(pos=np.array(gcam.pos), forward=np.array(gcam.forward),
+                                 up=np.array(gcam.up), frustum_near=gcam.frustum_near,
+                                 frustum_bottom=gcam.frustum_bottom,
+                                 frustum_top=gcam.frustum_top,
+                                 orthographic=bool(gcam.orthographic))
+            drawn[tol] = {c: _segments(scene, first, c) for c in
+                          (style.reference_rgba, style.actual_rgba, style.bead_rgba)}
+        for colour, full in drawn[0.0].items():
+            simple = drawn[TOL][colour]
+            assert len(simple) == len(full)
+            assert sum(map(len, simple)) <= sum(map(len, full))
+            for f, s in zip(full, simple, strict=True):
+                worst = _worst(_pixels(f, ns, 480, 360), _pixels(s, ns, 480, 360))
+                assert worst <= TOL + 1e-6, (colour, worst)
+        assert sum(map(len, drawn[TOL][style.reference_rgba])) < sum(
+            map(len, drawn[0.0][style.reference_rgba]))  # the screen step dropped vertices
