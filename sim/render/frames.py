@@ -178,6 +178,11 @@ class FrameRenderer:
         model.vis.quality.shadowsize = shadow_size(width, height,
                                                    int(model.vis.quality.shadowsize))
         self.views = self._views(model, qpos, width / height)
+        # tiles whose camera stays put (the overlay is simplified on screen once for them)
+        self.fixed = [(v.track_site is None) if v is not None else
+                      (int(model.cam_bodyid[c]) == 0
+                       and int(model.cam_mode[c]) == int(mujoco.mjtCamLight.mjCAMLIGHT_FIXED))
+                      for v, c in zip(self.views, self.camera_ids, strict=True)]
         self.model = model
         self.data = mujoco.MjData(model)
         self.width, self.height = int(width), int(height)
@@ -323,7 +328,8 @@ class FrameRenderer:
             self._update_scene(k)
             self.painter.paint(r.scene, time)
             if self.overlay is not None:
-                self.overlay.add_to_scene(r.scene, time, self.height, self._geoms, self.data)
+                self.overlay.add_to_scene(r.scene, time, self.height, self._geoms, self.data,
+                                          self.fixed[k])
             if single:
                 r.render(out=out)
             else:

@@ -206,7 +206,7 @@ class PathOverlay:
         return n + sum(o.max_geoms for o in self.others)
 
     def add_to_scene(self, scene: Any, time: float, height: int, geoms: Any = None,
-                     data: Any = None) -> int:
+                     data: Any = None, fixed_camera: bool = False) -> int:
         """Appends the overlay at ``time`` to ``scene`` (after ``mjv_updateScene``).
 
         Args:
@@ -216,6 +216,8 @@ class PathOverlay:
             geoms: ``scene.geoms`` cached by the caller (building it is costly), or None.
             data: The ``mujoco.MjData`` posed at ``time`` (a bead on a turning part is drawn
                 where the part is); None: every bead where it was laid.
+            fixed_camera: The camera stays put from frame to frame: the paths are simplified
+                on screen once for it (:mod:`sim.render.screenpath`); False: every vertex.
 
         Returns:
             Number of geoms added (stops silently at ``scene.maxgeom``).
@@ -262,7 +264,7 @@ class PathOverlay:
             last = (interp_rows(self.t, self._actual_full, time)
                     if time < t_end and self._actual_full is not None else None)
             if screen is not None:
-                path = screen.upto(time, key, last)
+                path = screen.upto(time, key, last, fixed_camera)
             else:  # on a turning part: where the part is now (not simplified on screen)
                 k = int(np.searchsorted(pts_t, time, side="right"))
                 path = pts[:k]
@@ -286,14 +288,16 @@ class PathOverlay:
             polyline(path, mujoco.mjtGeom.mjGEOM_LINE, st.bead_rgba, width_px, 0.35)
         # Reference path, whole.
         if self._screen_ref is not None:
-            polyline(self._screen_ref.upto(np.inf, key, None), mujoco.mjtGeom.mjGEOM_LINE,
+            polyline(self._screen_ref.upto(np.inf, key, None, fixed_camera),
+                     mujoco.mjtGeom.mjGEOM_LINE,
                      st.reference_rgba, line_px, 1.0)
         # Actual path up to `time`.
         if self._screen_act is not None and self._actual_full is not None:
-            path = self._screen_act.upto(time, key, interp_rows(self.t, self._actual_full, time))
+            path = self._screen_act.upto(time, key, interp_rows(self.t, self._actual_full, time),
+                                         fixed_camera)
             polyline(path, mujoco.mjtGeom.mjGEOM_LINE, st.actual_rgba, line_px, 1.0)
         for other in self.others:
-            added += other.add_to_scene(scene, time, height, geoms, data)
+            added += other.add_to_scene(scene, time, height, geoms, data, fixed_camera)
         return added
 
 

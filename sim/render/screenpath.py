@@ -14,8 +14,9 @@ screen both ways (a segment's band is convex and holds the vertices it replaces)
 :class:`ScreenPath` applies it to a path drawn up to a frame's time: the simplification of the
 whole path is computed once per camera pose (a fixed camera: once per video) and a frame draws
 its kept vertices before the frame's sample, then the last stretch (the vertices since the last
-kept one and the frame's interpolated point) simplified on its own. A camera that moves every
-frame draws every vertex instead (simplifying in every frame would cost what it saves).
+kept one and the frame's interpolated point) simplified on its own. A camera that moves from
+frame to frame (the tool camera) draws every vertex instead (simplifying in every frame would
+cost what it saves); which cameras stay put is the caller's to say.
 
 At 480 x 360 on the default weld cycle, 0.25 px halves the overlay's geoms (240 to 126 a
 frame); 0.23 % of the pixels change by more than 8 levels (anti-aliased line edges moved by a
@@ -123,31 +124,33 @@ class ScreenPath:
         self.lift = lift
         self.tol_px = float(SCREEN_TOL_PX if tol_px is None else tol_px)
         self._cache: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray, bool]] = {}
-        self._hits = self._misses = 0
 
     def _for_camera(self, key: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray, bool]:
         """The path as drawn for the camera ``key``, the vertices kept on screen, and whether
-        it was simplified. A camera that moves every frame (the tool camera) would pay the
-        simplification in every frame: after a few poses seen once, new poses draw every
-        vertex (as without this module)."""
+        it projects (a pure function of ``key``: a frame does not depend on the frames a
+        process rendered before it); a few poses are kept (a few tiles' fixed cameras)."""
         got = self._cache.get(key)
         if got is not None:
-            self._hits += 1
             return got
-        self._misses += 1
         drawn = self.lift(self.points, np.array(key[0:3]))
-        uv = screen_coords(drawn, key) if self._misses <= self._hits + 4 else None
+        uv = screen_coords(drawn, key)
         kept = simplify_screen(uv, self.tol_px) if uv is not None else np.arange(len(drawn))
-        if len(self._cache) >= 4:  # a few tiles' fixed cameras
+        if len(self._cache) >= 4:
             self._cache.pop(next(iter(self._cache)))
         self._cache[key] = got = (drawn, kept, uv is not None)
         return got
 
-    def upto(self, time: float, key: tuple[float, ...], last: np.ndarray | None) -> np.ndarray:
+    def upto(self, time: float, key: tuple[float, ...], last: np.ndarray | None,
+             on_screen: bool = True) -> np.ndarray:
         """The drawn polyline: vertices before ``time`` (those at ``time`` included), then
-        ``last`` (the point at ``time``, not yet lifted) if given; (M, 3)."""
-        drawn, kept, projects = self._for_camera(key)
+        ``last`` (the point at ``time``, not yet lifted) if given; (M, 3). ``on_screen``
+        False (a camera that moves from frame to frame): every vertex, lifted."""
         k = int(np.searchsorted(self.times, time, side="right"))
+        if not on_screen:
+            eye = np.array(key[0:3])
+            path = self.points[:k] if last is None else np.vstack([self.points[:k], last])
+            return self.lift(path, eye)
+        drawn, kept, projects = self._for_camera(key)
         m = int(np.searchsorted(kept, k, side="left"))  # kept vertices before k
         head = drawn[kept[: max(m - 1, 0)]]
         start = int(kept[m - 1]) if m else k
