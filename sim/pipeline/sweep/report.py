@@ -77,8 +77,12 @@ def sweep_chart(result: SweepResult) -> bytes:
     payloads = sorted({r["payload_kg"] for r in rows})
     scales = sorted({r["speed_scale"] for r in rows})
     idx = {(r["payload_kg"], r["speed_scale"], r["joint"]): r for r in rows}
-    fig = Figure(figsize=(10, 2.3 * len(joints) + 0.8), layout="constrained")
-    axes = fig.subplots(len(joints), 2, squeeze=False)
+    height = 2.3 * len(joints) + 0.8
+    fig = Figure(figsize=(10, height))
+    # fixed margins, in inches (a constrained layout costs as much as the drawing itself)
+    fig.subplots_adjust(left=0.085, right=0.985, wspace=0.2, top=1.0 - 0.4 / height,
+                        bottom=0.5 / height, hspace=0.45 / 2.3)
+    axes = fig.subplots(len(joints), 2, squeeze=False, sharex="col")
     cmap = matplotlib.colormaps["viridis"]
 
     def lines(ax, xs, series_keys, label_fmt, make_key):
@@ -95,7 +99,7 @@ def sweep_chart(result: SweepResult) -> bytes:
         ax_p, ax_s = axes[k]
         lines(ax_p, payloads, scales, lambda s: f"speed x{s:g}", lambda x, s: (x, s, j))
         lines(ax_s, scales, payloads, lambda p: f"{p:g} kg", lambda x, p: (p, x, j))
-        ax_p.set_ylabel(f"{j} torque (N m; N on a linear axis)")
+        ax_p.set_ylabel(f"{j} torque (N m)\n(N on a linear axis)", fontsize=9)
         for ax in (ax_p, ax_s):
             ax.grid(alpha=0.3)
         if k == 0:

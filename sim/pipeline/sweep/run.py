@@ -9,6 +9,7 @@ import multiprocessing
 import os
 import shutil
 import tempfile
+import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -23,6 +24,12 @@ from sim.pipeline.sweep.engines import (
 from sim.pipeline.sweep.report import write_sweep
 from sim.pipeline.sweep.variants import SweepResult, Variant, make_variants
 from sim.simulation import runfolder
+
+
+def _import_charts() -> None:
+    """Import what :func:`~sim.pipeline.sweep.report.sweep_chart` draws with."""
+    import matplotlib.backends.backend_agg  # noqa: F401
+    import matplotlib.figure  # noqa: F401
 
 
 def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Sequence[float],
@@ -104,8 +111,14 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
             runfolder.write_marker(tmp, state="writing")
             variants = make_variants(base_scenario, payloads, speed_scales, tmp)
             n_workers = min(workers or os.cpu_count() or 1, len(variants))
+            # the chart's matplotlib is imported while the workers run (the parent waits)
+            charts = threading.Thread(target=_import_charts, daemon=True)
+            if write and n_workers > 1:
+                charts.start()
             result = run_variants(runner, variants, n_workers, mp_context, engine, address,
                                    batch, progress)
+            if charts.is_alive():
+                charts.join()
             result = moved(result, tmp, out_dir)
             failures = result.failures
             every_failed = bool(failures) and len(failures) == len(result.outcomes)
