@@ -43,7 +43,7 @@ import numpy as np
 
 from sim.core.intervals import true_runs
 from sim.render.interp import interp_rows, sample_index
-from sim.render.screenpath import ScreenPath, camera_key
+from sim.render.screenpath import ScreenPath, camera_key, rdp_keep
 from sim.simulation.runfolder import RunRecord
 
 
@@ -98,30 +98,21 @@ def simplify_polyline(points: np.ndarray, tolerance: float, max_points: int) -> 
     max_points = max(int(max_points), 2)
     tol = max(float(tolerance), 1e-9)
     while True:
-        keep = np.zeros(n, dtype=bool)
-        keep[0] = keep[-1] = True
-        stack = [(0, n - 1)]
-        while stack:
-            a, b = stack.pop()
-            if b <= a + 1:
-                continue
-            rel = pts[a + 1 : b] - pts[a]
-            chord = pts[b] - pts[a]
-            length = float(np.linalg.norm(chord))
-            if length < 1e-12:
-                dist = np.linalg.norm(rel, axis=1)
-            else:
-                dist = np.linalg.norm(np.cross(rel, chord / length), axis=1)
-            k = int(np.argmax(dist))
-            if dist[k] > tol:
-                i = a + 1 + k
-                keep[i] = True
-                stack.append((a, i))
-                stack.append((i, b))
-        idx = np.flatnonzero(keep)
+        idx = rdp_keep(pts, tol, _line_distances)
         if len(idx) <= max_points:
             return idx
         tol *= 2.0
+
+
+def _line_distances(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance of each point of ``q`` (N, 3) from the line through ``a`` and ``b`` (from
+    ``a`` where they coincide)."""
+    rel = q - a
+    chord = b - a
+    length = float(np.linalg.norm(chord))
+    if length < 1e-12:
+        return np.linalg.norm(rel, axis=1)
+    return np.linalg.norm(np.cross(rel, chord / length), axis=1)
 
 
 class PathOverlay:

@@ -25,6 +25,7 @@ fraction of a pixel); 0.5 px: 94 geoms, 0.37 %.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -71,11 +72,14 @@ def segment_distances(q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray
     return np.linalg.norm(rel - s[:, None] * ab, axis=1)
 
 
-def simplify_screen(uv: np.ndarray, tol_px: float = SCREEN_TOL_PX) -> np.ndarray:
-    """Indices of the vertices of the image polyline ``uv`` (N, 2) kept so that every dropped
-    vertex lies within ``tol_px`` of the segment between the kept vertices around it
-    (Ramer-Douglas-Peucker, distance to the segment). Sorted, with 0 and N - 1."""
-    n = len(uv)
+def rdp_keep(points: np.ndarray, tol: float,
+             distances: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+             = segment_distances) -> np.ndarray:
+    """Ramer-Douglas-Peucker: indices of the vertices of the polyline ``points`` (N, d) kept
+    so that every dropped vertex is within ``tol`` of the kept vertices around it, as
+    ``distances(q, a, b)`` measures (default: the segment ``a``-``b``). Sorted, with 0 and
+    N - 1."""
+    n = len(points)
     if n <= 2:
         return np.arange(n)
     keep = np.zeros(n, dtype=bool)
@@ -85,14 +89,21 @@ def simplify_screen(uv: np.ndarray, tol_px: float = SCREEN_TOL_PX) -> np.ndarray
         a, b = stack.pop()
         if b <= a + 1:
             continue
-        dist = segment_distances(uv[a + 1 : b], uv[a], uv[b])
+        dist = distances(points[a + 1 : b], points[a], points[b])
         k = int(np.argmax(dist))
-        if dist[k] > tol_px:
+        if dist[k] > tol:
             i = a + 1 + k
             keep[i] = True
             stack.append((a, i))
             stack.append((i, b))
     return np.flatnonzero(keep)
+
+
+def simplify_screen(uv: np.ndarray, tol_px: float = SCREEN_TOL_PX) -> np.ndarray:
+    """Indices of the vertices of the image polyline ``uv`` (N, 2) kept so that every dropped
+    vertex lies within ``tol_px`` of the segment between the kept vertices around it
+    (Ramer-Douglas-Peucker, distance to the segment). Sorted, with 0 and N - 1."""
+    return rdp_keep(uv, tol_px, segment_distances)
 
 
 def simplified(points: np.ndarray, key: tuple[float, ...], tol_px: float | None = None
