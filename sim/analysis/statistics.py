@@ -54,13 +54,20 @@ def time_integral(t: ArrayLike, x: ArrayLike) -> NDArray[np.float64] | float:
     # thread count or the arrays' alignment (a sweep on Ray, one thread per task, gives the
     # pool's table exactly); numpy's sum where a term is not finite (fsum raises on inf - inf
     # and on overflow)
-    out = np.array([exact_sum(col) if np.all(np.isfinite(col)) else float(np.sum(col))
-                    for col in flat.T])
+    out = np.array([_sum(col) for col in flat.T])
     return float(out[0]) if terms.ndim == 1 else out.reshape(terms.shape[1:])
 
 
-#: Mantissa bits in each of the two halves :func:`exact_sum` adds separately.
+#: Veltkamp's splitter for float64, ``2**27 + 1``: ``x`` is ``hi + lo`` exactly, each half
+#: within 26 bits of ``x``'s own exponent.
+_SPLIT = 134217729.0
+
+#: Mantissa bits in each of the two halves :func:`_exact_sum_integers` adds separately.
 _HALF_BITS = 26
+
+#: Exponent field from which :func:`exact_sum` leaves the sum to ``math.fsum`` (``|x| >=
+#: 2**995``: the split, or ``fsum``'s partial sums, could overflow).
+_BIG_EXPONENT = 1023 + 995
 
 
 def exact_sum(x: NDArray[np.float64]) -> float:
@@ -68,20 +75,70 @@ def exact_sum(x: NDArray[np.float64]) -> float:
     bit for bit (both round the exact sum to the nearest double, ties to even), faster on
     long records.
 
-    Each value is ``m 2**(e - 1075)`` with an integer mantissa ``m`` (53 bits, signed) and its
-    exponent field ``e``; the mantissas' high and low halves (27 and 26 bits) are summed per
-    exponent in float64 (integers below 2**53 for fewer than 2**25 values: exact in any
-    order), the sums combined as one Python integer and divided by ``2**1075`` (Python's
-    integer division rounds exactly). ``math.fsum`` itself where the sum is zero (its sign of
-    zero), the record is longer or a value so large that ``fsum`` could overflow (it raises).
+    The values are grouped by their exponent field; each value is split (Veltkamp) into two
+    halves of at most 26 and 27 significant bits, whose sums within a group are exact in
+    float64 in any order (fewer than 2**25 values). ``math.fsum`` of those exact group sums
+    is then the exactly rounded total. ``math.fsum`` itself where the total is zero (its sign
+    of zero), the record is longer or a value is so large that the split could overflow;
+    subnormal values (where the split is not exact) are summed as integers
+    (:func:`_exact_sum_integers`).
     """
     x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
     if x.size == 0 or x.size >= (1 << 25):
         return math.fsum(x.tolist())
+    ex = x.view(np.int64) >> 52
+    ex &= 0x7FF
+    return _grouped_sum(x, ex)
+
+
+def _sum(x: NDArray[np.float64]) -> float:
+    """:func:`exact_sum` of a column whose terms are finite, numpy's sum where one is not
+    (``fsum`` raises on ``inf - inf``); the finiteness read from the exponent fields."""
+    x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1)
+    if x.size == 0 or x.size >= (1 << 25):
+        return exact_sum(x) if np.all(np.isfinite(x)) else float(np.sum(x))
+    ex = x.view(np.int64) >> 52
+    ex &= 0x7FF
+    if int(ex.max()) == 0x7FF:  # an inf or a NaN
+        return float(np.sum(x))
+    return _grouped_sum(x, ex)
+
+
+def _grouped_sum(x: NDArray[np.float64], ex: NDArray[np.int64]) -> float:
+    """:func:`exact_sum` of ``x`` (1-D, contiguous, fewer than 2**25 values) given each
+    value's exponent field ``ex``."""
+    if int(ex.max()) >= _BIG_EXPONENT:
+        return math.fsum(x.tolist())
+    if int(ex.min()) == 0 and np.any(x[ex == 0]):  # a subnormal value
+        return _exact_sum_integers(x)
+    # x = hi + lo exactly (Veltkamp: c = (2**27 + 1) x, hi = c - (c - x), lo = x - hi). For x
+    # of exponent field e: hi is a multiple of 2**(e - 1048), |hi| <= 2**(e - 1022); lo a
+    # multiple of 2**(e - 1075), |lo| <= 2**(e - 1049). Each group's sums are then below
+    # 2**53 of their units: exact, in bincount's order too.
+    c = x * _SPLIT
+    hi = c - x
+    np.subtract(c, hi, out=hi)
+    np.subtract(x, hi, out=c)  # c is now lo
+    sums = np.concatenate([np.bincount(ex, weights=hi, minlength=2047),
+                           np.bincount(ex, weights=c, minlength=2047)])
+    total = math.fsum(sums[sums != 0.0].tolist())
+    if total == 0.0:
+        return math.fsum(x.tolist())
+    return total
+
+
+def _exact_sum_integers(x: NDArray[np.float64]) -> float:
+    """:func:`exact_sum` of finite ``x`` (1-D, contiguous, fewer than 2**25 values, below
+    2**997) as integers, subnormal values too.
+
+    Each value is ``m 2**(e - 1075)`` with an integer mantissa ``m`` (53 bits, signed) and its
+    exponent field ``e``; the mantissas' high and low halves (27 and 26 bits) are summed per
+    exponent in float64 (integers below 2**53 for fewer than 2**25 values: exact in any
+    order), the sums combined as one Python integer and divided by ``2**1075`` (Python's
+    integer division rounds exactly).
+    """
     bits = x.view(np.int64)
     ex = (bits >> 52) & 0x7FF
-    if int(ex.max()) >= 1023 + 997:  # |x| >= 2**997: fsum's partial sums might overflow
-        return math.fsum(x.tolist())
     man = bits & ((1 << 52) - 1)
     man |= (ex > 0).astype(np.int64) << 52  # the implicit bit of a normal value
     ex = np.maximum(ex, 1)  # a subnormal's scale is the smallest normal's
@@ -149,16 +206,24 @@ def sustained(t: ArrayLike, x: ArrayLike, window: float) -> NDArray[np.float64]:
     flat = x.reshape(t.size, -1)
     c = np.concatenate([np.zeros((1, flat.shape[1])),
                         np.cumsum(0.5 * (flat[1:] + flat[:-1]) * np.diff(t)[:, None], axis=0)])
-    (lo, k_lo, half_lo), (hi, k_hi, half_hi), width, inside, everywhere = _windows(t, window)
+    lo, hi, width, inside, everywhere = _windows(t, window)
 
-    def integral_to(s: NDArray[np.float64], k: NDArray[np.intp],
-                    half: NDArray[np.float64]) -> NDArray[np.float64]:
+    slope = np.diff(flat, axis=0) / np.diff(t)[:, None]
+
+    def integral_to(end: Any) -> NDArray[np.float64]:
         # int from t[0] to s: whole trapezoids up to the sample before s (k), then the part
         # trapezoid from that sample to s (x linear in between; half = (s - t[k]) / 2)
-        xs = np.stack([np.interp(s, t, flat[:, m]) for m in range(flat.shape[1])], axis=1)
-        return c[k] + half * (flat[k] + xs)
+        s, k, half, ds, at_k, at_next = end
+        xk = flat[k]
+        # x at s: np.interp's value (the same operations, its sample value where s is one)
+        xs = slope[k] * ds + xk
+        xs[at_k] = xk[at_k]
+        xs[at_next] = flat[k[at_next] + 1]
+        if np.isnan(xs).any():  # a value that is not finite: np.interp's own fallbacks
+            xs = np.stack([np.interp(s, t, flat[:, m]) for m in range(flat.shape[1])], axis=1)
+        return c[k] + half * (xk + xs)
 
-    mean = integral_to(hi, k_hi, half_hi) - integral_to(lo, k_lo, half_lo)
+    mean = integral_to(hi) - integral_to(lo)
     if everywhere:  # every window has a width: the same quotients, without the masks
         return (mean / width[:, None]).reshape(x.shape)
     out = flat.copy()
@@ -179,10 +244,11 @@ def _same_times(a: NDArray[np.float64], b: NDArray[np.float64]) -> bool:
 
 
 def _windows(t: NDArray[np.float64], window: float) -> Any:
-    """The window bounds of each sample for :func:`sustained`: ``(lo, k_lo, half_lo)``,
-    ``(hi, k_hi, half_hi)`` (each end, clipped to the record, the sample at or before it and
-    half the time from that sample to the end, (N, 1)), the width, where it is positive and
-    whether it is everywhere. Kept for the latest times and window (the same times, compared
+    """The window bounds of each sample for :func:`sustained`: for the low and the high end
+    ``(s, k, half, ds, at_k, at_next)`` (the end, clipped to the record; the sample at or
+    before it; the time from that sample to the end, halved and whole, (N, 1); the rows where
+    the end is that sample, and where it is the next one), the width, where it is positive
+    and whether it is everywhere. Kept for the latest times and window (the same times, compared
     value by value, give the same bounds)."""
     for tt, w, got in _WINDOWS:
         if w == window and _same_times(tt, t):
@@ -192,7 +258,10 @@ def _windows(t: NDArray[np.float64], window: float) -> Any:
     ends = []
     for s in (lo, hi):
         k = np.clip(np.searchsorted(t, s, side="right") - 1, 0, t.size - 2)
-        ends.append((s, k, (s - t[k])[:, None] * 0.5))
+        ds = (s - t[k])[:, None]
+        # s on a sample: k's (s == t[k]), or the last (s == t[-1], k = N - 2)
+        ends.append((s, k, ds * 0.5, ds, np.flatnonzero(s == t[k]),
+                     np.flatnonzero(s == t[k + 1])))
     width = hi - lo
     inside = width > 0.0  # else a window below the times' resolution: the sample itself
     got = (*ends, width, inside, bool(np.all(inside)))

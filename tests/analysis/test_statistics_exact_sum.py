@@ -74,3 +74,23 @@ def test_planted_low_halves_dropped_are_caught(monkeypatch: pytest.MonkeyPatch) 
     no_low.calls = 0
     monkeypatch.setattr(statistics.np, "bincount", no_low)
     assert _mismatches(range(1)) != []
+
+
+def test_one_exponent_group_at_its_bound_is_fsum() -> None:
+    """2**17 values of one exponent with their largest mantissas: each half's group sum is at
+    its largest (the split's exactness bound), positive so nothing cancels."""
+    rng = np.random.default_rng(7)
+    mant = rng.integers(2**52 - 2**30, 2**52, 1 << 17)
+    x = (2.0**52 + mant.astype(np.float64)) * 2.0**-52  # in [1, 2)
+    assert _bits(exact_sum(x)) == _bits(math.fsum(x.tolist()))
+    y = np.concatenate([x * 2.0**993, -x[:1000] * 2.0**-1000])  # just below the fsum limit
+    assert _bits(exact_sum(y)) == _bits(math.fsum(y.tolist()))
+
+
+def test_a_column_with_an_inf_or_a_nan_is_numpys_sum() -> None:
+    x = np.array([1.0, np.inf, 2.0])
+    assert statistics._sum(x) == np.inf
+    assert math.isnan(statistics._sum(np.array([1.0, np.nan])))
+    assert math.isnan(statistics._sum(np.array([np.inf, -np.inf])))
+    t = np.array([0.0, 1.0, 2.0])
+    assert statistics.time_integral(t, x) == np.inf
