@@ -1,6 +1,6 @@
 """A sweep's report: ``sweep.csv`` (one row per variant and joint), ``sweep.md`` (pivot tables of
 peak and RMS torque, sizing margins, failures), ``sweep.png`` (torque against payload and
-against speed scale) and ``sweep.json``."""
+against speed scale, each where the sweep varies it) and ``sweep.json``."""
 
 from __future__ import annotations
 
@@ -66,9 +66,21 @@ def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
     return "\n".join(parts)
 
 
-def sweep_chart(result: SweepResult) -> bytes:
-    """PNG: per joint (rows), peak (solid) and RMS (dashed) torque against payload (left, one
-    line per speed scale) and against speed scale (right, one line per payload)."""
+def chart_columns(result: SweepResult) -> tuple[str, ...]:
+    """The columns :func:`sweep_figure` draws: ``"payload"`` (torque against payload) and
+    ``"speed"`` (against speed scale), each only where the sweep has more than one value of
+    it (against a single value every line would be one point); the payload column alone for
+    a sweep of one variant."""
+    rows = result.rows
+    cols = tuple(name for name, key in (("payload", "payload_kg"), ("speed", "speed_scale"))
+                 if len({r[key] for r in rows}) > 1)
+    return cols or ("payload",)
+
+
+def sweep_figure(result: SweepResult) -> Any:
+    """The chart as a matplotlib ``Figure``: per joint (rows), peak (solid) and RMS (dashed)
+    torque against payload (one line per speed scale) and against speed scale (one line per
+    payload), the columns of :func:`chart_columns`."""
     import matplotlib
     from matplotlib.figure import Figure
 
@@ -77,12 +89,14 @@ def sweep_chart(result: SweepResult) -> bytes:
     payloads = sorted({r["payload_kg"] for r in rows})
     scales = sorted({r["speed_scale"] for r in rows})
     idx = {(r["payload_kg"], r["speed_scale"], r["joint"]): r for r in rows}
+    cols = chart_columns(result)
     height = 2.3 * len(joints) + 0.8
-    fig = Figure(figsize=(10, height))
+    width = 5.0 * len(cols)
+    fig = Figure(figsize=(width, height))
     # fixed margins, in inches (a constrained layout costs as much as the drawing itself)
-    fig.subplots_adjust(left=0.085, right=0.985, wspace=0.2, top=1.0 - 0.4 / height,
-                        bottom=0.5 / height, hspace=0.45 / 2.3)
-    axes = fig.subplots(len(joints), 2, squeeze=False, sharex="col")
+    fig.subplots_adjust(left=0.85 / width, right=1.0 - 0.15 / width, wspace=0.2,
+                        top=1.0 - 0.4 / height, bottom=0.5 / height, hspace=0.45 / 2.3)
+    axes = fig.subplots(len(joints), len(cols), squeeze=False, sharex="col")
     cmap = matplotlib.colormaps["viridis"]
 
     def lines(ax, xs, series_keys, label_fmt, make_key):
@@ -91,25 +105,34 @@ def sweep_chart(result: SweepResult) -> bytes:
             for key, style in (("peak_torque_nm", "-o"), ("rms_torque_nm", "--s")):
                 pts = [(x, idx[make_key(x, other)][key]) for x in xs if make_key(x, other) in idx]
                 if pts:
-                    x, y = zip(*pts)
+                    x, y = zip(*pts, strict=True)
                     ax.plot(x, y, style, color=color, ms=3.5, lw=1.2,
                             label=label_fmt(other) if key == "peak_torque_nm" else None)
 
+    against = {
+        "payload": (payloads, scales, lambda s: f"speed x{s:g}",
+                    lambda j: lambda x, s: (x, s, j), "against payload", "payload (kg)"),
+        "speed": (scales, payloads, lambda p: f"{p:g} kg",
+                  lambda j: lambda x, p: (p, x, j), "against speed scale", "speed scale"),
+    }
     for k, j in enumerate(joints):
-        ax_p, ax_s = axes[k]
-        lines(ax_p, payloads, scales, lambda s: f"speed x{s:g}", lambda x, s: (x, s, j))
-        lines(ax_s, scales, payloads, lambda p: f"{p:g} kg", lambda x, p: (p, x, j))
-        ax_p.set_ylabel(f"{j} torque (N m)\n(N on a linear axis)", fontsize=9)
-        for ax in (ax_p, ax_s):
+        for c, col in enumerate(cols):
+            ax = axes[k][c]
+            xs, series, label, key_of, title, xlabel = against[col]
+            lines(ax, xs, series, label, key_of(j))
             ax.grid(alpha=0.3)
-        if k == 0:
-            ax_p.set_title("against payload (solid: peak, dashed: RMS)", fontsize=9)
-            ax_s.set_title("against speed scale (solid: peak, dashed: RMS)", fontsize=9)
-            ax_p.legend(fontsize=7)
-            ax_s.legend(fontsize=7)
-    axes[-1][0].set_xlabel("payload (kg)")
-    axes[-1][1].set_xlabel("speed scale")
-    return figure_png(fig)
+            if k == 0:
+                ax.set_title(f"{title} (solid: peak, dashed: RMS)", fontsize=9)
+                ax.legend(fontsize=7)
+            if k == len(joints) - 1:
+                ax.set_xlabel(xlabel)
+        axes[k][0].set_ylabel(f"{j} torque (N m)\n(N on a linear axis)", fontsize=9)
+    return fig
+
+
+def sweep_chart(result: SweepResult) -> bytes:
+    """PNG bytes of :func:`sweep_figure`."""
+    return figure_png(sweep_figure(result))
 
 
 def write_sweep(out_dir: str | Path, result: SweepResult) -> dict[str, Path]:
@@ -136,4 +159,5 @@ def write_sweep(out_dir: str | Path, result: SweepResult) -> dict[str, Path]:
     return files
 
 
-__all__ = ["SWEEP_COLUMNS", "sweep_chart", "sweep_markdown", "write_sweep"]
+__all__ = ["SWEEP_COLUMNS", "chart_columns", "sweep_chart", "sweep_figure", "sweep_markdown",
+           "write_sweep"]
