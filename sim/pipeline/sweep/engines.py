@@ -62,11 +62,23 @@ def task_groups(variants: Sequence[Variant], workers: int) -> list[list[Variant]
 def warm_worker(scenario: Any = None) -> None:
     """A pool worker's initializer: import what every variant needs (cellsim's pipeline,
     MuJoCo) and load the base scenario once, so that the first variant does not pay for it."""
+    import dm_control.mjcf  # noqa: F401 - composing a cell (with lxml, absl)
     import mujoco  # noqa: F401
+    import mujoco.rollout  # noqa: F401
+    import tqdm  # noqa: F401 - the simulation's progress bar (silent in a worker)
 
+    import planners.adnia  # noqa: F401 - the planners package imports these lazily
+    import planners.cartesian  # noqa: F401
+    import planners.limits  # noqa: F401
     import sim.pipeline.run  # noqa: F401
     import sim.pipeline.sweep.evaluation  # noqa: F401
+    import sim.pipeline.sweep.reuse  # noqa: F401
+    import sim.robots.drives  # noqa: F401
+    import sim.robots.kinematics.jacobian  # noqa: F401
+    import sim.robots.kinematics.mujoco_fk  # noqa: F401
     import sim.simulation.collision_reuse  # noqa: F401
+    import sim.simulation.seam_orientation  # noqa: F401
+    import sim.simulation.singularity_cache  # noqa: F401
 
     if isinstance(scenario, (str, os.PathLike)):
         from pathlib import Path
