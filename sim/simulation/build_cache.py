@@ -1,6 +1,7 @@
-"""Compiled cells kept for the variants of a sweep that differ only in payload.
+"""Compiled cells kept for the variants of a sweep that differ only in payload and speed.
 
-A sweep's metrics-only variants of one plan share their cell but for the payload at the tcp: a
+A sweep's metrics-only variants share their cell but for the payload at the tcp (a speed
+scale changes the motion, not the cell): a
 body ``robot/payload`` with a lumped mass, its inertia and a marker sphere
 (:func:`sim.cells.compose.prepare_robot`). Composing the cell with ``dm_control`` and writing
 its MJCF costs more than compiling it, so :func:`build_reusing` keeps, per scenario without its
@@ -47,12 +48,17 @@ _CELLS: dict[str, _Kept] = {}
 
 
 def cell_key(scenario: Scenario) -> str | None:
-    """What a cell depends on but for the payload: the scenario without it (None when it
-    cannot be fingerprinted or has no payload body; then it is built in full)."""
+    """What a cell depends on but for the payload: the scenario without it and without its
+    (and its partners') phases and actions, which a speed scale changes and the cell does not
+    read (:meth:`~sim.scenario.Scenario.scaled`); None when it cannot be fingerprinted or has
+    no payload body (then it is built in full)."""
     if not scenario.payload_kg > 0.0:
         return None
     try:
-        blob = pickle.dumps(dataclasses.replace(scenario, payload_kg=0.0))
+        blob = pickle.dumps(dataclasses.replace(
+            scenario, payload_kg=0.0, phases=(), actions=(),
+            partners=tuple(dataclasses.replace(w, phases=(), actions=())
+                           for w in scenario.partners)))
     except Exception:  # noqa: BLE001 - an unpicklable scenario is built every time
         return None
     return hashlib.sha256(blob).hexdigest()

@@ -6,7 +6,7 @@ its cell built in full, bit for bit. A planted cell cache that forgets the paylo
 caught by the same comparison.
 
 The scenario: the LR Mate 200iC/5L on the weld table with its torch, a joint move of 1.2 s;
-payloads 1, 3 and 12 kg at one speed (one plan, one composed cell).
+payloads 1, 3 and 12 kg at speed scales 1 and 1.7 (two plans, one composed cell).
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from sim.simulation.compile import build
 
 ROWS = [[0, 20, -60, 0, -30, 0], [0, 8, -60, 0, -30, 0], [0, 20, -60, 0, -30, 0]]
 PAYLOADS = [1.0, 3.0, 12.0]
+SPEEDS = [1.0, 1.7]
 
 
 def _forget_everything() -> None:
@@ -56,12 +57,13 @@ def _text(rows: list[dict]) -> list[str]:
     return [json.dumps({k: repr(v) for k, v in r.items()}, sort_keys=True) for r in rows]
 
 
-def _swept(scenario: Path, tmp_path: Path) -> dict[float, list[str]]:
-    res = run_sweep(scenario, PAYLOADS, [1.0], evaluate_variant, workers=1,
+def _swept(scenario: Path, tmp_path: Path) -> dict[tuple[float, float], list[str]]:
+    res = run_sweep(scenario, PAYLOADS, SPEEDS, evaluate_variant, workers=1,
                     out_dir=tmp_path / "sweep", progress=False, write=False,
                     raise_on_failure=False)
     assert not res.failures, [o.error for o in res.failures]
-    return {o.variant.payload_kg: _text(list(o.rows)) for o in res.outcomes}
+    return {(o.variant.payload_kg, o.variant.speed_scale): _text(list(o.rows))
+            for o in res.outcomes}
 
 
 def test_a_sweep_reusing_its_cell_gives_each_variant_s_rows_alone(
@@ -70,8 +72,9 @@ def test_a_sweep_reusing_its_cell_gives_each_variant_s_rows_alone(
     with monkeypatch.context() as m:
         m.setattr(run_module, "build_reusing", build)  # each cell built in full
         for p in PAYLOADS:
-            _forget_everything()
-            alone[p] = _text(list(evaluate_variant(Variant(p, 1.0, scenario)).rows))
+            for v in SPEEDS:
+                _forget_everything()
+                alone[(p, v)] = _text(list(evaluate_variant(Variant(p, v, scenario)).rows))
     _forget_everything()
     composed = [0]
     real = build_cache.compose
@@ -82,7 +85,7 @@ def test_a_sweep_reusing_its_cell_gives_each_variant_s_rows_alone(
 
     monkeypatch.setattr(build_cache, "compose", counting)
     assert _swept(scenario, tmp_path) == alone
-    assert composed[0] == 1  # one composed cell for the three payloads
+    assert composed[0] == 1  # one composed cell for the three payloads and two speeds
 
     # planted fault: a kept cell whose payload keeps the first variant's inertia
     _forget_everything()
@@ -92,5 +95,6 @@ def test_a_sweep_reusing_its_cell_gives_each_variant_s_rows_alone(
 
     monkeypatch.setattr(build_cache, "_set_payload", forgets_inertia)
     swept = _swept(scenario, tmp_path)
-    assert swept[PAYLOADS[0]] == alone[PAYLOADS[0]]
+    first = (PAYLOADS[0], SPEEDS[0])
+    assert swept[first] == alone[first]
     assert swept != alone, "the comparison missed a kept cell without its payload's inertia"

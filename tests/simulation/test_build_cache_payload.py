@@ -1,11 +1,11 @@
-"""A sweep's variants that differ only in payload reuse one composed cell (issue 29:
-:mod:`sim.simulation.build_cache`). Specification: whatever payloads were built before, the
-cell built for a payload is the one a fresh :func:`sim.simulation.compile.build` of that
-scenario gives, bit for bit: every ``MjModel`` array and scalar (the model's binary MJB image,
-and each array named, for a readable failure), the saved MJCF, every id and the Cartesian
+"""A sweep's variants that differ only in payload and speed scale reuse one composed cell (issue
+29: :mod:`sim.simulation.build_cache`). Specification: whatever payloads and speeds were built
+before, the cell built for a variant is the one a fresh :func:`sim.simulation.compile.build` of
+that scenario gives, bit for bit: every ``MjModel`` array and scalar (the model's binary MJB
+image, and each array named, for a readable failure), the saved MJCF, every id and the Cartesian
 context; the cell says the new payload. A payload of 0 kg (no payload body) and a cell with
-mechanisms (gains tuned on the compiled model) are built in full. The oracle is a fresh build;
-a planted patch that forgets the payload's inertia, or its marker's radius, is caught."""
+mechanisms (gains tuned on the compiled model) are built in full. The oracle is a fresh build; a
+planted patch that forgets the payload's inertia, or its marker's radius, is caught."""
 
 from __future__ import annotations
 
@@ -118,18 +118,22 @@ def composed_count(monkeypatch: pytest.MonkeyPatch) -> list[int]:
 
 @settings(max_examples=4, deadline=None, derandomize=True, database=None)
 @given(payloads=st.lists(st.floats(min_value=1e-3, max_value=40.0, allow_nan=False),
-                         min_size=1, max_size=2))
-def test_reused_cell_equals_a_fresh_build(weld: Any, payloads: list[float]) -> None:
+                         min_size=1, max_size=2),
+       scales=st.lists(st.floats(min_value=0.2, max_value=3.0), min_size=1, max_size=2))
+def test_reused_cell_equals_a_fresh_build(weld: Any, payloads: list[float],
+                                          scales: list[float]) -> None:
     build_cache.clear()
     build_cache.build_reusing(_with(weld, 2.0))
-    for p in payloads:  # one kept cell, its payload set again and again
-        got = build_cache.build_reusing(_with(weld, p))
-        assert built_differences(got, build(_with(weld, p))) == []
+    for p, s in zip(payloads, scales * 2, strict=False):  # one kept cell, payload set again
+        variant = weld.scaled(s, p)
+        got = build_cache.build_reusing(variant)
+        assert built_differences(got, build(variant)) == []
 
 
 def test_the_cell_is_composed_once_per_scenario(weld: Any, composed_count: list[int]) -> None:
     first = build_cache.build_reusing(_with(weld, 1.0))
     second = build_cache.build_reusing(_with(weld, 5.0))
+    build_cache.build_reusing(weld.scaled(0.6, 3.0))  # another speed: the same cell
     assert composed_count[0] == 1
     assert second.model.body(build_cache.PAYLOAD).mass[0] == 5.0
     assert first.model is not second.model
@@ -138,6 +142,9 @@ def test_the_cell_is_composed_once_per_scenario(weld: Any, composed_count: list[
     # another scenario (its own cell key) is composed again
     build_cache.build_reusing(dataclasses.replace(_with(weld, 1.0), name="other"))
     assert composed_count[0] == 2
+    finer = weld.simulation.model_copy(update={"timestep_s": 0.0005})
+    build_cache.build_reusing(dataclasses.replace(weld, simulation=finer, payload_kg=1.0))
+    assert composed_count[0] == 3  # another timestep: another cell
 
 
 def test_no_payload_and_mechanisms_are_built_in_full(weld: Any,
