@@ -296,7 +296,19 @@ class Seam:
     # ------------------------------------------------------------------ torch posture
     def torch_axis(self, s: float) -> NDArray[np.float64]:
         """Unit torch axis at ``s``, pointing from the torch into the joint, world, (3,)."""
+        return self._torch_axis(s, self.tangent(s))
+
+    def path_row(self, s: float) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                           NDArray[np.float64]]:
+        """``(tcp_point(s), tangent(s), torch_axis(s))``, the same values, each computed once
+        (the tool-point path of :mod:`sim.simulation.seam_measure` samples a seam by them)."""
         t = self.tangent(s)
+        a = self._torch_axis(s, t)
+        p = self.point(s)
+        return (p if self.standoff_m == 0.0 else p - self.standoff_m * a), t, a
+
+    def _torch_axis(self, s: float, t: NDArray[np.float64]) -> NDArray[np.float64]:
+        """:meth:`torch_axis` at ``s`` given the tangent ``t`` there."""
         n = self.surface_normal - (self.surface_normal @ t) * t
         if np.linalg.norm(n) < _EPS:
             raise CellsimError(f"seam {self.name!r}: the surface normal runs along the seam at "

@@ -215,7 +215,7 @@ class ToolPointPath:
                 n = max(3, int(np.ceil(L / h)) + 1)
             ss = np.linspace(0.0, L, n)
             s_all.append(s0 + ss)
-            rows += [(seg.tcp_point(x), seg.tangent(x), seg.torch_axis(x)) for x in ss]
+            rows += [seg.path_row(x) for x in ss]
             s0 += L
         point, tangent, axis = (np.array(v) for v in zip(*rows, strict=True))
         s_arr = np.concatenate(s_all)

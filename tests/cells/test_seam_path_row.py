@@ -1,0 +1,92 @@
+""":meth:`sim.cells.seam.Seam.path_row`: the tool point, tangent and torch axis at an arc
+length, each computed once (issue 29: the tool-point path of a seam sampled every millimetre
+computed the torch axis twice and the tangent three times per sample). Specification, on
+generated lines, arcs and polylines with generated torch angles, sides and stand-offs: the
+three values are :meth:`~Seam.tcp_point`, :meth:`~Seam.tangent` and :meth:`~Seam.torch_axis`,
+bit for bit, at generated arc lengths and at the ends; and the tool-point path built from them
+(:class:`~sim.simulation.seam_measure.ToolPointPath`) is the one built from those three
+methods. A planted stand-off of the wrong sign is caught."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from sim.cells import seam as seam_module
+from sim.cells.seam import Seam
+from sim.simulation import seam_measure
+from sim.simulation.seam_measure import ToolPointPath
+
+
+@st.composite
+def seams(draw: st.DrawFn) -> Seam:
+    kind = draw(st.sampled_from(["line", "arc", "polyline"]))
+    rng = np.random.default_rng(draw(st.integers(0, 2**16)))
+    if kind == "arc":
+        r = rng.uniform(0.05, 0.6)
+        ang = np.sort(rng.uniform(0.0, 3.0, 3))
+        ang[1] = 0.5 * (ang[0] + ang[2])
+        ang[2] = ang[0] + max(ang[2] - ang[0], 0.3)
+        ang[1] = 0.5 * (ang[0] + ang[2])
+        pts = np.column_stack([r * np.cos(ang), r * np.sin(ang), np.full(3, rng.uniform(0, 1))])
+    else:
+        n = 2 if kind == "line" else int(rng.integers(3, 6))
+        steps = rng.uniform(0.05, 0.3, (n - 1, 2)) * rng.choice([-1, 1], (n - 1, 2))
+        xy = np.vstack([[0.0, 0.0], np.cumsum(steps, axis=0)])
+        pts = np.column_stack([xy, np.full(n, rng.uniform(0, 1))])
+    return Seam(draw(st.sampled_from(["s1", "seam"])), kind, pts, None,
+                draw(st.floats(-60.0, 60.0)), draw(st.floats(-30.0, 30.0)),
+                surface_normal=[0.0, 0.0, 1.0], torch_side=draw(st.sampled_from([1, -1])),
+                standoff_m=draw(st.sampled_from([0.0, 0.01, 0.0153])))
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def _rows_differ(seam: Seam, fractions: list[float]) -> bool:
+    for seg in seam.segments():
+        L = seg.length()
+        for s in [0.0, L, *(f * L for f in fractions)]:
+            got = seg.path_row(s)
+            want = (seg.tcp_point(s), seg.tangent(s), seg.torch_axis(s))
+            if not all(_same(g, w) for g, w in zip(got, want, strict=True)):
+                return True
+    return False
+
+
+@settings(max_examples=40, deadline=None)
+@given(seam=seams(), fractions=st.lists(st.floats(0.0, 1.0), min_size=1, max_size=8))
+def test_path_row_is_the_three_methods_bit_for_bit(seam: Seam, fractions: list[float]) -> None:
+    assert not _rows_differ(seam, fractions)
+
+
+@settings(max_examples=10, deadline=None)
+@given(seam=seams())
+def test_the_tool_point_path_is_built_from_the_three_methods(seam: Seam) -> None:
+    got = ToolPointPath._make(seam)
+    s0, parts = 0.0, []
+    for seg in seam.segments():  # the path before: each value from its own method
+        n = len(ToolPointPath._make(seg).s)
+        ss = np.linspace(0.0, float(seg.length()), n)
+        parts += [(s0 + x, seg.tcp_point(x), seg.tangent(x), seg.torch_axis(x)) for x in ss]
+        s0 += float(seg.length())
+    s, point, tangent, axis = (np.array(v) for v in zip(*parts, strict=True))
+    for g, w in ((got.s, s), (got.point, point), (got.tangent, tangent), (got.axis, axis)):
+        assert _same(g, w)
+
+
+def test_planted_standoff_sign_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
+    real = Seam.path_row
+
+    def wrong_sign(self: Seam, s: float):  # type: ignore[no-untyped-def]
+        p, t, a = real(self, s)
+        return p + 2.0 * self.standoff_m * a, t, a
+
+    monkeypatch.setattr(seam_module.Seam, "path_row", wrong_sign)
+    seam = Seam("x", "line", [[0, 0, 0], [0.2, 0, 0]], None, 30.0, 5.0,
+                surface_normal=[0, 0, 1], standoff_m=0.01)
+    assert _rows_differ(seam, [0.5])
+    seam_measure.clear_caches()
