@@ -152,18 +152,24 @@ def test_a_pool_sweep_reusing_its_plans_gives_each_variant_s_rows_alone(scenario
 
 
 @settings(max_examples=60, deadline=None)
-@given(n_payloads=st.integers(1, 7), n_speeds=st.integers(1, 9), workers=st.integers(1, 5))
+@given(n_payloads=st.integers(1, 7), n_speeds=st.integers(1, 9), workers=st.integers(1, 5),
+       order=st.sampled_from(["ascending", "descending", "shuffled"]), seed=st.integers(0, 99))
 def test_tasks_keep_a_plan_s_variants_together_and_balance_the_workers(n_payloads, n_speeds,
-                                                                        workers):
+                                                                        workers, order, seed):
     """Every variant (the sweep's payload-major order) in exactly one task, the tasks one
-    after the other in speed-major order; a speed scale per task when there are at least two
-    per worker, else 2 x workers tasks of sizes that differ by one at most."""
+    after the other in speed-major order, the slowest speed scale first whatever the order
+    they were given in (the longest cycles first); a speed scale per task when there are at
+    least two per worker, else 2 x workers tasks of sizes that differ by one at most."""
     speeds = [0.5 + 0.05 * s for s in range(n_speeds)]
-    variants = [Variant(float(p), speeds[s], "x", index=p * n_speeds + s)
+    given_order = {"ascending": speeds, "descending": speeds[::-1],
+                   "shuffled": [speeds[i] for i in np.random.default_rng(seed).permutation(
+                       n_speeds)]}[order]
+    variants = [Variant(float(p), given_order[s], "x", index=p * n_speeds + s)
                 for p in range(n_payloads) for s in range(n_speeds)]
     groups = task_groups(variants, workers)
     flat = [v.index for g in groups for v in g]
-    assert flat == [p * n_speeds + s for s in range(n_speeds) for p in range(n_payloads)]
+    position = {x: s for s, x in enumerate(given_order)}
+    assert flat == [p * n_speeds + position[x] for x in speeds for p in range(n_payloads)]
     if n_speeds >= 2 * workers:
         assert [{v.speed_scale for v in g} for g in groups] == [{x} for x in speeds]
     else:

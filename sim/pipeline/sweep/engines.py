@@ -40,15 +40,17 @@ def task_groups(variants: Sequence[Variant], workers: int) -> list[list[Variant]
     """The variants cut into tasks for ``workers`` parallel workers. The variants of one speed
     scale follow each other (a plan depends on the speed scale, not on the payload, so a worker
     plans once for the variants of a task and reuses the plan and its reference's collision
-    scan). With at least twice as many speed scales as workers each speed scale is a task;
-    else the speed-major list is cut into ``2 x workers`` tasks of sizes that differ by one at
-    most, so that every worker has at least two to take (6 variants of one plan on 2 workers:
-    2, 2, 1, 1, so that each worker runs 3; 2 payloads x 3 speed scales: a task per speed
-    scale's pair of payloads and one per payload of the third, so that no two workers make
-    the same plan at once). The results do not depend on the grouping (they are gathered by
-    variant index)."""
+    scan), the slowest speed scale first (the longest cycles: a pool hands out tasks in order,
+    so the longest go first and the short ones fill the workers' ends, whatever order the
+    speed scales were given in). With at least twice as many speed scales as workers each
+    speed scale is a task; else the speed-major list is cut into ``2 x workers`` tasks of sizes
+    that differ by one at most, so that every worker has at least two to take (6 variants of
+    one plan on 2 workers: 2, 2, 1, 1, so that each worker runs 3; 2 payloads x 3 speed
+    scales: a task per speed scale's pair of payloads and one per payload of the third, so
+    that no two workers make the same plan at once). The results do not depend on the
+    grouping (they are gathered by variant index)."""
     by_speed: dict[float, list[Variant]] = {}
-    for v in variants:
+    for v in sorted(variants, key=lambda v: v.speed_scale):  # stable: payload order kept
         by_speed.setdefault(v.speed_scale, []).append(v)
     if not by_speed or len(by_speed) >= 2 * max(workers, 1):
         return list(by_speed.values())
