@@ -4,7 +4,7 @@ one value every line would be a single point; issue 29: the chart is drawn after
 half of it was such a column). Specification, on generated grids and joints: one row of axes
 per joint, a column per varied quantity (the payload's alone for one variant), and every
 line's points are the table's values (peak solid, RMS dashed), one line per value of the
-other quantity. A planted fault (the two quantities swapped in the right-hand column) is
+other quantity; a joint's columns share their torque axis. A planted fault (the two quantities swapped in the right-hand column) is
 caught."""
 
 from __future__ import annotations
@@ -61,6 +61,8 @@ def _mismatches(result: SweepResult, draw: Any = sweep_figure) -> list[str]:
                for ln in axes[k, c].get_lines()}
         if got != want:
             bad.append(f"joint {j}, column {col}")
+        if axes[k, c].get_ylim() != axes[k, 0].get_ylim():
+            bad.append(f"joint {j}: its columns' torque axes differ")
     return bad
 
 

@@ -80,7 +80,8 @@ def chart_columns(result: SweepResult) -> tuple[str, ...]:
 def sweep_figure(result: SweepResult) -> Any:
     """The chart as a matplotlib ``Figure``: per joint (rows), peak (solid) and RMS (dashed)
     torque against payload (one line per speed scale) and against speed scale (one line per
-    payload), the columns of :func:`chart_columns`."""
+    payload), the columns of :func:`chart_columns`; a joint's columns share their torque axis
+    (the same values, seen two ways)."""
     import matplotlib
     from matplotlib.figure import Figure
 
@@ -96,7 +97,7 @@ def sweep_figure(result: SweepResult) -> Any:
     # fixed margins, in inches (a constrained layout costs as much as the drawing itself)
     fig.subplots_adjust(left=0.85 / width, right=1.0 - 0.15 / width, wspace=0.2,
                         top=1.0 - 0.4 / height, bottom=0.5 / height, hspace=0.45 / 2.3)
-    axes = fig.subplots(len(joints), len(cols), squeeze=False, sharex="col")
+    axes = fig.subplots(len(joints), len(cols), squeeze=False, sharex="col", sharey="row")
     cmap = matplotlib.colormaps["viridis"]
 
     def lines(ax, xs, series_keys, label_fmt, make_key):
