@@ -11,50 +11,33 @@ payloads 1, 3 and 12 kg at speed scales 1 and 1.7 (two plans, one composed cell)
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import pytest
-from support.scenarios import joint_phase, write_scenario
+from support.sweeps import count_composes, forget_everything, rows_text, short_weld_scenario
 
 from sim.pipeline import run as run_module
 from sim.pipeline.sweep import Variant, reuse, run_sweep
 from sim.pipeline.sweep.evaluation import evaluate_variant
-from sim.simulation import build_cache, collision_reuse, seam_measure, singularity_cache
+from sim.simulation import build_cache
 from sim.simulation.compile import build
 
-ROWS = [[0, 20, -60, 0, -30, 0], [0, 8, -60, 0, -30, 0], [0, 20, -60, 0, -30, 0]]
 PAYLOADS = [1.0, 3.0, 12.0]
 SPEEDS = [1.0, 1.7]
 
 
-def _forget_everything() -> None:
-    run_module._PLANS.clear()
-    collision_reuse.clear_cache()
-    build_cache.clear()
-    singularity_cache.clear()
-    seam_measure.clear_caches()
-
-
 @pytest.fixture
 def scenario(tmp_path: Path) -> Path:
-    return write_scenario(tmp_path, "lrmate200ic5l",
-                          [joint_phase(ROWS, time_s=[0.0, 0.6, 1.2], planner="546")],
-                          cell="weld_table", tool="mig_torch", payload_kg=1.0)
+    return short_weld_scenario(tmp_path)
 
 
 @pytest.fixture(autouse=True)
 def fresh(monkeypatch: pytest.MonkeyPatch) -> Any:
-    _forget_everything()
+    forget_everything()
     monkeypatch.setattr(reuse, "ENABLED", True)
     yield
-    _forget_everything()
-
-
-def _text(rows: list[dict]) -> list[str]:
-    """Rows as exact text (repr of a float round-trips its bits; NaN equals NaN)."""
-    return [json.dumps({k: repr(v) for k, v in r.items()}, sort_keys=True) for r in rows]
+    forget_everything()
 
 
 def _swept(scenario: Path, tmp_path: Path) -> dict[tuple[float, float], list[str]]:
@@ -62,7 +45,7 @@ def _swept(scenario: Path, tmp_path: Path) -> dict[tuple[float, float], list[str
                     out_dir=tmp_path / "sweep", progress=False, write=False,
                     raise_on_failure=False)
     assert not res.failures, [o.error for o in res.failures]
-    return {(o.variant.payload_kg, o.variant.speed_scale): _text(list(o.rows))
+    return {(o.variant.payload_kg, o.variant.speed_scale): rows_text(list(o.rows))
             for o in res.outcomes}
 
 
@@ -73,22 +56,15 @@ def test_a_sweep_reusing_its_cell_gives_each_variant_s_rows_alone(
         m.setattr(run_module, "build_reusing", build)  # each cell built in full
         for p in PAYLOADS:
             for v in SPEEDS:
-                _forget_everything()
-                alone[(p, v)] = _text(list(evaluate_variant(Variant(p, v, scenario)).rows))
-    _forget_everything()
-    composed = [0]
-    real = build_cache.compose
-
-    def counting(sc: Any) -> Any:
-        composed[0] += 1
-        return real(sc)
-
-    monkeypatch.setattr(build_cache, "compose", counting)
+                forget_everything()
+                alone[(p, v)] = rows_text(list(evaluate_variant(Variant(p, v, scenario)).rows))
+    forget_everything()
+    composed = count_composes(monkeypatch)
     assert _swept(scenario, tmp_path) == alone
     assert composed[0] == 1  # one composed cell for the three payloads and two speeds
 
     # planted fault: a kept cell whose payload keeps the first variant's inertia
-    _forget_everything()
+    forget_everything()
     def forgets_inertia(kept: Any, mass: float, inertia: float, radius: float) -> None:
         kept.spec.body(build_cache.PAYLOAD).mass = mass
         kept.spec.geom(build_cache.PAYLOAD).size = [radius, 0.0, 0.0]

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support.scenarios import joint_phase, write_scenario
+from support.sweeps import rows_text, short_weld_scenario
 
 from sim.pipeline import run as run_module
 from sim.pipeline.run import RunOptions, add_collisions, evaluate_scenarios
@@ -28,16 +28,13 @@ from sim.pipeline.sweep import Variant, reuse, run_sweep, task_groups
 from sim.pipeline.sweep.evaluation import _variant_scenario, evaluate_variant
 from sim.simulation import collision_reuse
 
-ROWS = [[0, 20, -60, 0, -30, 0], [0, 8, -60, 0, -30, 0], [0, 20, -60, 0, -30, 0]]
 PAYLOADS = [1.0, 40.0]
 SPEEDS = [0.8, 1.0]
 
 
 @pytest.fixture
 def scenario(tmp_path: Path) -> Path:
-    return write_scenario(tmp_path, "lrmate200ic5l",
-                          [joint_phase(ROWS, time_s=[0.0, 0.6, 1.2], planner="546")],
-                          cell="weld_table", tool="mig_torch", payload_kg=1.0)
+    return short_weld_scenario(tmp_path)
 
 
 @pytest.fixture(autouse=True)
@@ -51,11 +48,6 @@ def fresh(monkeypatch: pytest.MonkeyPatch):
     collision_reuse.clear_cache()
 
 
-def _text(rows: list[dict]) -> list[str]:
-    """Rows as exact text (repr of a float round-trips its bits; NaN equals NaN)."""
-    return [json.dumps({k: repr(v) for k, v in r.items()}, sort_keys=True) for r in rows]
-
-
 def _alone(scenario: Path, monkeypatch: pytest.MonkeyPatch) -> dict[tuple[float, float], list]:
     """Each variant evaluated on its own: no plan and no scan kept, checked as a run is."""
     out = {}
@@ -65,7 +57,7 @@ def _alone(scenario: Path, monkeypatch: pytest.MonkeyPatch) -> dict[tuple[float,
             for s in SPEEDS:
                 run_module._PLANS.clear()
                 collision_reuse.clear_cache()
-                out[(p, s)] = _text(list(evaluate_variant(Variant(p, s, scenario)).rows))
+                out[(p, s)] = rows_text(list(evaluate_variant(Variant(p, s, scenario)).rows))
     run_module._PLANS.clear()
     collision_reuse.clear_cache()
     return out
@@ -78,7 +70,7 @@ def _mismatches(scenario: Path, tmp_path: Path, alone: dict) -> list[tuple[float
                     raise_on_failure=False)
     assert not res.failures, [o.error for o in res.failures]
     return [(o.variant.payload_kg, o.variant.speed_scale) for o in res.outcomes
-            if _text(list(o.rows)) != alone[(o.variant.payload_kg, o.variant.speed_scale)]]
+            if rows_text(list(o.rows)) != alone[(o.variant.payload_kg, o.variant.speed_scale)]]
 
 
 def test_a_sweep_reusing_its_plans_gives_each_variant_s_rows_alone(scenario, tmp_path,
@@ -147,7 +139,7 @@ def test_a_pool_sweep_reusing_its_plans_gives_each_variant_s_rows_alone(scenario
                     out_dir=tmp_path / "sweep", progress=False, write=False,
                     raise_on_failure=False)
     assert not res.failures
-    assert {(o.variant.payload_kg, o.variant.speed_scale): _text(list(o.rows))
+    assert {(o.variant.payload_kg, o.variant.speed_scale): rows_text(list(o.rows))
             for o in res.outcomes} == alone
 
 

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.sweeps import count_composes
 
 from sim.core.resources import shipped_scenarios
 from sim.scenario import load_scenario
@@ -104,16 +105,7 @@ def weld() -> Any:
 @pytest.fixture
 def composed_count(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     """How many cells :mod:`build_cache` composed (a reused cell composes none)."""
-    calls = [0]
-    real = build_cache.compose
-
-    def counting(scenario: Any) -> Any:
-        calls[0] += 1
-        return real(scenario)
-
-    monkeypatch.setattr(build_cache, "compose", counting)
-    build_cache.clear()
-    return calls
+    return count_composes(monkeypatch)
 
 
 @settings(max_examples=4, deadline=None, derandomize=True, database=None)
