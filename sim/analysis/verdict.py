@@ -25,6 +25,11 @@ is per joint:
   from the seam's commanded axis (its work and travel angles at the nearest seam point, the
   corner zones left out: :func:`sim.simulation.metrics.measure_seam`), deg, against the
   scenario's ``simulation.torch_angle_tolerance_deg``;
+* ``corner_torch``: per weld phase along a polyline seam with corner zones, how far the
+  simulated torch swings out of its turn from one leg's commanded axis to the next inside
+  them (``corner_torch_excess_deg``: 0 for a torch that turns steadily from the one to the
+  other), deg, against the same tolerance: the corner zones are left out of ``torch_angle``,
+  not out of the verdict;
 * ``selection`` (when actuators were chosen from a catalogue, :mod:`sim.analysis.selection`):
   per joint, the chosen pair's smallest margin, %; fails when no pair serves the joint;
 * ``payload``: the mass at the flange, the tool's and the scenario's payload, kg, against the
@@ -246,7 +251,9 @@ def mechanism_checks(summary: Mapping[str, Any]) -> list[RunCheck]:
 
 def torch_angle_checks(summary: Mapping[str, Any], tolerance_deg: float) -> list[RunCheck]:
     """The ``torch_angle`` checks (errors): one per weld phase along a seam in the summary's
-    ``"weld"``, its worst torch axis error outside the corner zones against ``tolerance_deg``."""
+    ``"weld"``, its worst torch axis error outside the corner zones against ``tolerance_deg``;
+    and a ``corner_torch`` check per such phase with corner zones, the torch's swing out of
+    its turn inside them (``corner_torch_excess_deg``) against the same tolerance."""
     checks = []
     for w in summary.get("weld", ()):
         if w.get("seam") is None:
@@ -258,6 +265,13 @@ def torch_angle_checks(summary: Mapping[str, Any], tolerance_deg: float) -> list
             subject=f"{_who(w)}{w['phase']}: seam {w['seam']}, worst{at}; work angle up to "
             f"{w['work_angle_error_deg']:.3g} deg off, travel angle up to "
             f"{w['travel_angle_error_deg']:.3g} deg off"))
+        excess = w.get("corner_torch_excess_deg")
+        if excess is not None:
+            checks.append(RunCheck(
+                "corner_torch", "", float(excess), float(tolerance_deg), "deg",
+                float(excess) <= tolerance_deg,
+                subject=f"{_who(w)}{w['phase']}: seam {w['seam']}, the torch's swing out of its "
+                "turn from one leg's axis to the next in the corner zones"))
     return checks
 
 

@@ -247,11 +247,18 @@ class WeldResult:
         set_speed_mm_s, travel_speed_mm_s, travel_speed_cv: The set and measured travel
             speed (cruise part), mm/s, and the measured speed's coefficient of variation.
         seam_length_mm: The seam's (or path's) length, mm.
-        max_path_deviation_mm: The tool point's largest distance from the seam, mm.
-        torch_angle_error_deg: The torch axis's largest angle from the commanded axis, deg;
-            ``work_angle_error_deg``/``travel_angle_error_deg`` its parts (None off a seam).
+        max_path_deviation_mm: The tool point's largest distance from the seam, mm, outside
+            a polyline's corner zones.
+        torch_angle_error_deg: The torch axis's largest angle from the commanded axis, deg,
+            outside the corner zones; ``work_angle_error_deg``/``travel_angle_error_deg`` its
+            parts (None off a seam).
         start_error_mm, end_error_mm: The first and last samples' distances from the seam's
             ends, mm.
+        corner_path_deviation_mm: Inside the corner zones, the tool point's largest distance
+            from the seam, mm (the blend's rounding); None without corners.
+        corner_torch_excess_deg: Inside the corner zones, how far the torch swings out of its
+            turn from one leg's commanded axis to the next, deg (the ``corner_torch`` check);
+            None without corners.
     """
 
     robot: str
@@ -267,6 +274,8 @@ class WeldResult:
     travel_angle_error_deg: float | None
     start_error_mm: float
     end_error_mm: float
+    corner_path_deviation_mm: float | None = None
+    corner_torch_excess_deg: float | None = None
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> WeldResult:
@@ -285,7 +294,9 @@ class WeldResult:
                    torch_angle_error_deg=num("torch_angle_error_deg"),
                    work_angle_error_deg=opt("work_angle_error_deg"),
                    travel_angle_error_deg=opt("travel_angle_error_deg"),
-                   start_error_mm=num("start_error_mm"), end_error_mm=num("end_error_mm"))
+                   start_error_mm=num("start_error_mm"), end_error_mm=num("end_error_mm"),
+                   corner_path_deviation_mm=opt("corner_path_deviation_mm"),
+                   corner_torch_excess_deg=opt("corner_torch_excess_deg"))
 
 
 @dataclass(frozen=True)

@@ -140,10 +140,7 @@ def run(args: argparse.Namespace) -> int:
               f"{w['frequency_hz']:.3f} Hz (set {w['set_amplitude_mm']:.3f} mm at "
               f"{w['set_frequency_hz']:.3f} Hz), centre line {w['centre_line_mm']:+.4f} mm")
     for weld in summary.get("weld", []):
-        print(f"  {_who(weld)}weld {weld['phase']}: {weld['seam_length_mm']:.1f} mm at "
-              f"{weld['travel_speed_mm_s']:.2f} mm/s (cv {weld['travel_speed_cv']:.4f}), path "
-              f"deviation {weld['max_path_deviation_mm']:.3f} mm, torch angle error "
-              f"{weld['torch_angle_error_deg']:.3f} deg")
+        print(weld_line(weld))
     sing = summary.get("singularity")
     if sing:
         extra = (f", |sin theta5| >= {sing['min_abs_wrist']:.3f}" if "min_abs_wrist" in sing
@@ -192,6 +189,22 @@ def run(args: argparse.Namespace) -> int:
         print("  " + timings_line(timings, summary.get("total_wall_s", sum(timings.values()))))
     print(f"  results in {out}/")
     return 1 if args.strict and summary.get("verdict") == "fail" else 0
+
+
+def weld_line(weld: dict) -> str:
+    """The console's line for a weld phase (a ``summary["weld"]`` entry): its length, travel
+    speed, path deviation and torch angle error, and with corner zones what happens in them
+    (left out of the first two figures, so said)."""
+    corners = weld.get("corner_path_deviation_mm")
+    swing = weld.get("corner_torch_excess_deg")
+    return (f"  {_who(weld)}weld {weld['phase']}: {weld['seam_length_mm']:.1f} mm at "
+            f"{weld['travel_speed_mm_s']:.2f} mm/s (cv {weld['travel_speed_cv']:.4f}), path "
+            f"deviation {weld['max_path_deviation_mm']:.3f} mm, torch angle error "
+            f"{weld['torch_angle_error_deg']:.3f} deg"
+            + ("" if corners is None else " outside the corner zones; in them the tool point is "
+               f"up to {corners:.3f} mm off the seam"
+               + ("" if swing is None else f" and the torch swings {swing:.3f} deg out of its "
+                  "turn from one leg's posture to the next")))
 
 
 def _who(entry: dict) -> str:

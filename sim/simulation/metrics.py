@@ -259,7 +259,9 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
     the seam (net of the programmed weave; ``corner_path_deviation_mm`` inside the corner
     zones), the torch angle error the torch axis against the seam's commanded axis
     (``work_angle_error_deg``, ``travel_angle_error_deg`` against its work and travel angles,
-    ``t_worst_angle_s`` the time of the worst axis error), the corner zones left out;
+    ``t_worst_angle_s`` the time of the worst axis error), the corner zones left out (there
+    ``corner_torch_excess_deg``: how far the torch swings out of its turn from one leg's axis
+    to the next);
     ``start_error_mm`` / ``end_error_mm`` are the first and last samples' distances from the
     seam's ends. A phase without a seam is measured against its programmed path."""
     return _weld_entries(arrays, motion, built.context, torch_axis, measured)
@@ -300,6 +302,7 @@ def _weld_entries(arrays: Mapping[str, NDArray[Any]], motion: Motion, context: A
                 "corner_path_deviation_mm": (None if m.corner_deviation is None
                                              else m.corner_deviation * 1e3),
                 "torch_angle_error_deg": m.torch_angle_error_deg,
+                "corner_torch_excess_deg": m.corner_torch_excess_deg,
                 "work_angle_error_deg": m.work_angle_error_deg,
                 "travel_angle_error_deg": m.travel_angle_error_deg,
                 "t_worst_angle_s": m.t_worst_angle,
@@ -352,6 +355,7 @@ def _weld_entries(arrays: Mapping[str, NDArray[Any]], motion: Motion, context: A
             "max_path_deviation_mm": float(np.max(dev) * 1e3),
             "corner_path_deviation_mm": None,
             "torch_angle_error_deg": float(np.max(ang)),
+            "corner_torch_excess_deg": None,
             "work_angle_error_deg": None, "travel_angle_error_deg": None,
             "t_worst_angle_s": float(ts[int(np.argmax(ang))]),
             "start_error_mm": float(np.linalg.norm(first - ends[0]) * 1e3),

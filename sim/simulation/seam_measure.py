@@ -285,6 +285,25 @@ def angle_deg(u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.floa
                                  np.einsum("ij,ij->i", u, v)))
 
 
+def corner_torch_excess(a: NDArray[np.float64], s: NDArray[np.float64], seam: Any,
+                        zones: Sequence[tuple[float, float]]) -> float | None:
+    """:attr:`SeamMeasurement.corner_torch_excess_deg` of torch axes ``a`` (N, 3, unit) at seam
+    parameters ``s`` (N,), m: per corner zone ``(s0, s1)``, the legs' commanded axes at its
+    ends; None when no sample lies in a zone."""
+    worst: float | None = None
+    L = float(seam.length())
+    for z0, z1 in zones:
+        inside = (s >= z0) & (s <= z1)
+        if not np.any(inside):
+            continue
+        a1 = seam.torch_axis(min(max(float(z0), 0.0), L))[None, :]
+        a2 = seam.torch_axis(min(max(float(z1), 0.0), L))[None, :]
+        turn = float(angle_deg(a1, a2)[0])
+        swing = np.maximum(angle_deg(a[inside], a1), angle_deg(a[inside], a2)) - turn
+        worst = max(0.0 if worst is None else worst, float(np.max(swing)))
+    return None if worst is None else max(worst, 0.0)
+
+
 def progress_speed(t: NDArray[np.float64], s: NDArray[np.float64], keep: NDArray[np.bool_],
                    period: float | None = None) -> tuple[float, NDArray[np.float64]]:
     """Rate of progress ``ds/dt`` (m/s) over the samples ``keep``: the progress over the time
@@ -334,6 +353,12 @@ class SeamMeasurement:
             zones, deg; ``t_worst_angle`` the time of the largest axis error, s.
         max_deviation: Largest ``deviation`` outside the corner zones, m; ``corner_deviation``
             inside them (None without corner samples).
+        corner_torch_excess_deg: Inside the corner zones, how far the torch swings out of its
+            turn from one leg's commanded axis ``a1`` to the next one's ``a2``: the largest
+            ``max(angle(a, a1), angle(a, a2)) - angle(a1, a2)`` (0 for any turn that moves the
+            axis steadily from ``a1`` to ``a2``, a rotation about one axis included; a torch
+            that swings off through the corner and back shows its swing), deg; None without
+            corner samples.
         start_error, end_error: Distance of the first and last sample's tool point from the
             seam's first and last tool points, m.
         weave: With a weave: ``measure_weave``'s ``amplitude_m``, ``frequency_hz`` and
@@ -355,6 +380,7 @@ class SeamMeasurement:
     t_worst_angle: float | None
     max_deviation: float
     corner_deviation: float | None
+    corner_torch_excess_deg: float | None
     start_error: float
     end_error: float
     weave: dict[str, float] | None
@@ -455,6 +481,7 @@ def measure_seam(t: NDArray[np.float64], pos: NDArray[np.float64], rot: NDArray[
         t_worst_angle=float(t[worst]) if worst is not None else None,
         max_deviation=float(np.max(deviation[~corner_net], initial=0.0)),
         corner_deviation=float(np.max(deviation[corner_net])) if np.any(corner_net) else None,
+        corner_torch_excess_deg=corner_torch_excess(a, s, seam, corner_zones),
         start_error=float(np.linalg.norm(pos[0] - path.point[0])),
         end_error=float(np.linalg.norm(pos[-1] - path.point[-1])),
         weave=weave)

@@ -961,6 +961,7 @@ SYNTHETIC = {
 def test_the_oracle_passes_a_perfect_weld_and_fails_each_planted_fault(kind):
     """Synthetic tool frames (:func:`synthetic_weld`) pass; each fault fails with its figure:
     the torch turned 3 deg, frozen at its start posture past a polyline's first corner zone,
+    swung 3 deg out of its turn inside that zone,
     the time base 2 % slow, a 0.1 mm offset, the weave's amplitude 5 % or frequency 2 % off."""
     seam, speed, weave = SYNTHETIC[kind], 0.008, so.Weave(0.002, 1.5)
     fr = synthetic_weld(seam, speed, weave)
@@ -993,6 +994,17 @@ def test_the_oracle_passes_a_perfect_weld_and_fails_each_planted_fault(kind):
         leg1, leg2 = seam.torch_axis(np.array([0.0, seam.corners[0] + seam.blend + 1e-4]))
         assert v.figures["torch_axis_err_deg"] == pytest.approx(
             math.degrees(math.acos(leg1 @ leg2)), abs=0.01)
+        # inside the first corner zone only, the torch swung 3 deg back, away from the next leg
+        # (out of its turn): each leg's posture is right, the corner check catches it
+        sc = seam.corners[0]
+        a1, a2 = seam.torch_axis(np.array([sc - 0.5 * seam.blend, sc + 0.5 * seam.blend]))
+        m = so.unit(np.cross(a1, a2))
+        back = math.cos(math.radians(3)) * a1 - math.sin(math.radians(3)) * np.cross(m, a1)
+        swung = fr.a.copy()
+        swung[np.abs(s - sc) <= 0.5 * seam.blend] = back
+        v = fails(so.Frames(fr.t, fr.p, swung), "corner swing")
+        assert v.figures["corner_swing_deg"] == pytest.approx(3.0, abs=1e-6)
+        assert not any(f.startswith("torch_axis") for f in v.failures), v.failures
 
 
 def test_a_nozzle_planted_in_the_part_is_a_collision(tmp_path):

@@ -235,6 +235,91 @@ def test_a_torch_frozen_through_the_corner_fails_the_torch_angle_check(tmp_path,
     assert "torch_angle" in {c["name"] for c in failed}, failed
 
 
+def corner_swing(ev) -> float:
+    """Inside the corner zone (by the tool point's arc length, as in :func:`oracle`): how far
+    the recorded torch axis swings out of its turn from the first leg's commanded axis to the
+    second's, deg (on a steady turn neither angle exceeds the angle between the legs)."""
+    t, p, axis = weld_samples(ev)
+    P = seam_points()
+    cum = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))]
+    _, s, _ = project(p)
+    zone = np.abs(s - cum[1]) <= BLEND_MM * 1e-3
+    tangents = np.diff(P, axis=0) / np.diff(cum)[:, None]
+    a1, a2 = commanded_axis(tangents[0]), commanded_axis(tangents[1])
+    turn = np.degrees(np.arccos(a1 @ a2))
+    far = np.degrees(np.arccos(np.clip(np.minimum(axis[zone] @ a1, axis[zone] @ a2), -1, 1)))
+    return float(np.max(far) - turn)
+
+
+def test_the_torch_turns_through_the_corner_without_swinging_out(bracket_runs):
+    """Inside the corner zone, left out of ``torch_angle``, the torch turns from one leg's
+    posture to the next: the recorded axis never points farther from either leg's axis than
+    the legs' axes are from each other. The summary's ``corner_torch_excess_deg`` agrees with
+    the oracle (the same recorded frames, the cell file's numbers), the ``corner_torch`` check
+    passes, and the console and the typed result say it."""
+    from sim.api.results import WeldResult
+
+    weld = {w["phase"]: w for w in bracket_runs.summary["weld"]}["weld"]
+    swing = corner_swing(bracket_runs)
+    assert swing < 0.5
+    assert max(weld["corner_torch_excess_deg"], 0.0) == pytest.approx(max(swing, 0.0), abs=0.05)
+    check = [c for c in bracket_runs.summary["checks"] if c["name"] == "corner_torch"]
+    assert len(check) == 1 and check[0]["pass"], check
+    typed = WeldResult.from_dict(weld)
+    assert typed.corner_torch_excess_deg == weld["corner_torch_excess_deg"]
+    assert typed.corner_path_deviation_mm == weld["corner_path_deviation_mm"] > 0.0
+    from sim.cli.run import weld_line
+
+    line = weld_line(weld)
+    assert "outside the corner zones" in line
+    assert f"up to {weld['corner_path_deviation_mm']:.3f} mm off the seam" in line
+
+
+def test_a_torch_swinging_out_in_the_corner_fails_the_corner_torch_check(tmp_path, monkeypatch):
+    """A planted fault inside the corner zone only: the torch swings back, away from the next
+    leg, by up to 30 deg (sin^2 of the corner's parameter) and returns. Each leg's posture is
+    right, so ``torch_angle`` passes (as it did when a user's torch went 49 deg off through a
+    corner). The oracle sees the swing,
+    the summary's figure agrees with it and the verdict fails on ``corner_torch``; the console
+    line names the swing."""
+    from planners.blend import CornerOrientation
+    from planners.rotations import axis_angle_matrix
+
+    real = CornerOrientation.evaluate
+
+    def swung_frames(self, u):
+        u = np.asarray(u, dtype=float)
+        R = real(self, u)[0]
+        a1, a2 = self.start[:, 2], self.end[:, 2]
+        m = np.cross(a1, a2)
+        m /= np.linalg.norm(m)
+        back = -np.radians(30.0) * np.sin(np.pi * np.clip(u, 0.0, 1.0)) ** 2
+        return np.einsum("...ij,...jk->...ik",
+                         np.array([axis_angle_matrix(m, float(b)) for b in np.ravel(back)]
+                                  ).reshape(np.shape(u) + (3, 3)), R)
+
+    def swung(self, u):
+        e = 1e-6
+        return swung_frames(self, u), (swung_frames(self, np.asarray(u) + e)
+                                       - swung_frames(self, np.asarray(u) - e)) / (2 * e)
+
+    monkeypatch.setattr(CornerOrientation, "evaluate", swung)
+    ev = evaluate_scenario(load_scenario(write(tmp_path)),
+                           RunOptions(video=False, plots=False, progress=False))
+    weld = {w["phase"]: w for w in ev.summary["weld"]}["weld"]
+    swing = corner_swing(ev)
+    assert swing > 5.0
+    assert weld["corner_torch_excess_deg"] == pytest.approx(swing, abs=0.1)
+    by_name = {c["name"]: c for c in ev.summary["checks"] if c["name"] in
+               ("torch_angle", "corner_torch")}
+    assert by_name["torch_angle"]["pass"], by_name
+    assert not by_name["corner_torch"]["pass"] and ev.summary["verdict"] == "fail"
+    from sim.cli.run import weld_line
+
+    assert f"the torch swings {weld['corner_torch_excess_deg']:.3f} deg out of its turn" \
+        in weld_line(weld)
+
+
 def test_approach_and_retract_are_measured_along_the_torch_axis(bracket_runs):
     """``approach_mm = 30`` ends the joint move 30 mm before the seam's start along the
     commanded torch axis; ``retract_mm = 40`` ends 40 mm back from the seam's end along it

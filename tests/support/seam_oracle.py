@@ -445,8 +445,9 @@ def judge_weld(seam: SeamGeom, fr: Frames, t0: float, t1: float, speed: float,
                end_tol: float = END_TOL_M) -> Verdict:
     """Judge one weld phase ``[t0, t1]`` on tool frames (module docstring): tool point on the
     seam outside corner zones (net of the weave), torch axis and work / travel angles outside
-    corner zones, progress speed on the constant-speed part, both ends, weave amplitude and
-    frequency."""
+    corner zones, inside them no swing of the torch out of its turn from one leg's axis to the
+    next (``corner_swing_deg``), progress speed on the constant-speed part, both ends, weave
+    amplitude and frequency."""
     v = Verdict()
     sel = (fr.t >= t0 - 1e-9) & (fr.t <= t1 + 1e-9)
     t, p, a = fr.t[sel], fr.p[sel], unit(fr.a[sel])
@@ -483,6 +484,24 @@ def judge_weld(seam: SeamGeom, fr: Frames, t0: float, t1: float, speed: float,
             if err[i] > angle_tol:
                 v.fail(f"{key} error", float(err[i]), angle_tol, "deg",
                        f" at t={t[i]:.3f} s, s={s[i] * 1e3:.2f} of {L * 1e3:.2f} mm")
+    # inside a polyline's corner zones the torch turns from one leg's axis a1 to the next
+    # one's a2: on any steady turn between them (a rotation about one axis included) neither
+    # angle exceeds angle(a1, a2), so what does is a swing out of the turn
+    for sc in seam.corners:
+        zone = np.abs(s - sc) <= seam.blend + widen
+        if not zone.any():
+            continue
+        a1, a2 = seam.torch_axis(np.array([sc - 0.5 * seam.blend, sc + 0.5 * seam.blend]))
+        turn = math.degrees(math.acos(float(np.clip(a1 @ a2, -1.0, 1.0))))
+        swing = np.degrees(np.arccos(np.clip(np.minimum(a[zone] @ a1, a[zone] @ a2),
+                                             -1.0, 1.0))) - turn
+        i = int(np.argmax(swing))
+        worst = max(v.figures.get("corner_swing_deg", 0.0), float(swing[i]))
+        v.figures["corner_swing_deg"] = worst
+        if swing[i] > angle_tol:
+            v.fail("corner swing", float(swing[i]), angle_tol, "deg",
+                   f" out of the {turn:.2f} deg turn at t={t[zone][i]:.3f} s, corner at "
+                   f"{sc * 1e3:.2f} mm")
     # the weave: lateral offset along a x t, fitted where it is fully faded in
     lateral = unit(np.cross(a_cmd, tt))
     y = np.einsum("ij,ij->i", d, lateral)
