@@ -1,9 +1,8 @@
 """Metrics of a simulated run: tracking, weld seams, placed parts, singularities; the summary.
 
 Weld phases along a cell seam are measured from the recorded tool frames and the seam's own
-geometry, never from the planner's trajectory (:func:`measure_seam`): a torch the plan carried
-off the seam's work and travel angles, a tool point off the seam, a weave that slows the
-progress along it all show in the figures.
+geometry, never from the planner's trajectory (:func:`measure_seam`): a torch off the seam's
+angles, a tool point off the seam, a weave that slows the progress all show in the figures.
 
 A cell with other robots (``[[robots]]``, :attr:`Motion.lanes`): each robot's weld phases,
 Cartesian speeds and weaves are measured exactly as the first robot's, on its own recorded tool
@@ -15,8 +14,8 @@ phases, cycle end, tool point deviation, tracking errors and closest approach to
 A cell with one robot gets neither (its summary as before, key for key).
 
 Owns which phases are measured and the run's summary; the measurement along one seam is
-:mod:`sim.simulation.seam_measure`'s (its names importable from here as before).
-May import: planners, :mod:`sim.core`, :mod:`sim.scenario` and the simulation modules.
+:mod:`sim.simulation.seam_measure`'s (its names importable from here as before). May import:
+planners, :mod:`sim.core`, :mod:`sim.scenario` and the simulation modules.
 """
 
 from __future__ import annotations
@@ -260,8 +259,7 @@ def weld_metrics(arrays: dict[str, NDArray[Any]], motion: Motion, built: BuiltCe
     zones), the torch angle error the torch axis against the seam's commanded axis
     (``work_angle_error_deg``, ``travel_angle_error_deg`` against its work and travel angles,
     ``t_worst_angle_s`` the time of the worst axis error), the corner zones left out (there
-    ``corner_torch_excess_deg``: how far the torch swings out of its turn from one leg's axis
-    to the next);
+    ``corner_torch_excess_deg``, the torch's swing out of its turn from leg to leg);
     ``start_error_mm`` / ``end_error_mm`` are the first and last samples' distances from the
     seam's ends. A phase without a seam is measured against its programmed path."""
     return _weld_entries(arrays, motion, built.context, torch_axis, measured)
@@ -284,9 +282,10 @@ def _weld_entries(arrays: Mapping[str, NDArray[Any]], motion: Motion, context: A
             continue
         cart = pm.cartesian
         set_speed = float(cart.speed)
-        if pm.seam is not None and abs(cart.length / pm.seam.length() - 1.0) > 1e-4:
-            # an arc's tool point off the seam by a stand-off runs faster or slower than the
-            # seam's travel (motion.cartesian): the set speed is the seam's
+        if pm.seam is not None and pm.seam.kind == "arc" and \
+                abs(cart.length / pm.seam.length() - 1.0) > 1e-4:
+            # a stand-off arc's tool point runs a coaxial arc (motion.cartesian): the set speed
+            # is the seam's (not a blended polyline's, whose path is only shorter)
             set_speed *= pm.seam.length() / cart.length
         entry: dict[str, Any] = {
             "phase": pm.name, "seam": None if pm.seam is None else pm.seam.name,
@@ -353,9 +352,8 @@ def _weld_entries(arrays: Mapping[str, NDArray[Any]], motion: Motion, context: A
             "travel_speed_mm_s": float(np.mean(vc) * 1e3),
             "travel_speed_cv": float(np.std(vc) / max(np.mean(vc), 1e-12)),
             "max_path_deviation_mm": float(np.max(dev) * 1e3),
-            "corner_path_deviation_mm": None,
+            "corner_path_deviation_mm": None, "corner_torch_excess_deg": None,
             "torch_angle_error_deg": float(np.max(ang)),
-            "corner_torch_excess_deg": None,
             "work_angle_error_deg": None, "travel_angle_error_deg": None,
             "t_worst_angle_s": float(ts[int(np.argmax(ang))]),
             "start_error_mm": float(np.linalg.norm(first - ends[0]) * 1e3),
@@ -397,8 +395,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
     measured = measure_seam_phases(a, motion, built.context.world_from_frame0, torch_axis,
                                    built.context)
     summary: dict[str, Any] = {
-        "scenario": scenario.name,
-        "robot": scenario.robot.name,
+        "scenario": scenario.name, "robot": scenario.robot.name,
         "cell": None if scenario.cell is None else scenario.cell.name,
         "tool": None if scenario.tool is None else scenario.tool.name,
         "mount": scenario.mount,

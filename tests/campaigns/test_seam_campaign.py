@@ -33,8 +33,9 @@ form since issue 29; its seams are still drawn short, fast and without a weave, 
 IK cost about 0.2 s per pose, so the campaign's cases stay the same). A case
 cellsim may refuse (:func:`refusal`: out of reach or not followable in one arm configuration,
 a corner too sharp for its blend, a reference past a joint's speed or acceleration limit, which
-``cellsim run`` refuses before simulating) must be refused with one line; it is counted (printed at the end of the module's run) and another is
-drawn. Any other refusal or exception fails the case.
+``cellsim run`` refuses before simulating) must be refused with one line; it is counted
+(printed at the end of the module's run) and another is drawn. Any other refusal or exception
+fails the case.
 """
 
 from __future__ import annotations
@@ -816,6 +817,10 @@ def check_simulated(case: Case, root: Path) -> Planned | None:
                       angle_tol=so.ANGLE_TOL_DEG + da,
                       speed_tol=so.SPEED_TOL + dp / (so.SPEED_HALF_WINDOW_S * case.speed * 1e-3))
     pl.evaluation = ev
+    # the summary's set speed is the scenario's own number (a blended polyline's tool path is
+    # shorter than its seam, a stand-off arc's longer or shorter: neither changes it)
+    weld = next(w for w in ev.summary["weld"] if w["phase"] == "weld")
+    assert weld["set_speed_mm_s"] == pytest.approx(case.speed, rel=1e-9), case.short()
     TALLY[(case.arm.key, "simulated: failed" if v.failures else "simulated: passed")] += 1
     figures = ", ".join(f"{key} {x:.4g}" for key, x in v.figures.items())
     assert v.ok, (f"{case.short()} (simulated; servo bound {dp * 1e3:.4f} mm, {da:.4f} deg): "

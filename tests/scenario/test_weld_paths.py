@@ -260,6 +260,8 @@ def test_the_torch_turns_through_the_corner_without_swinging_out(bracket_runs):
     from sim.api.results import WeldResult
 
     weld = {w["phase"]: w for w in bracket_runs.summary["weld"]}["weld"]
+    # the blends shorten the tool path, not the set speed (it was reported 1-8 % high)
+    assert weld["set_speed_mm_s"] == pytest.approx(SPEED, rel=1e-12)
     swing = corner_swing(bracket_runs)
     assert swing < 0.5
     assert max(weld["corner_torch_excess_deg"], 0.0) == pytest.approx(max(swing, 0.0), abs=0.05)
@@ -366,6 +368,23 @@ def test_a_seam_phase_is_never_cut_by_a_blend(tmp_path):
     r = subprocess.run([sys.executable, "-m", "sim", "check", str(tmp_path / "s.toml")],
                        check=False, capture_output=True, text=True)
     assert r.returncode == 2 and "plunge).blend_mm: the next phase 'weld' welds seam" in r.stderr
+
+
+def test_a_polyline_corner_too_sharp_to_weld_through_names_the_seam_and_corner(tmp_path):
+    """A polyline whose second corner nearly reverses (172 deg) cannot be welded in one pass:
+    one line naming the phase, the seam and the corner, and what to do (two seams), exit 2;
+    not a ``blend_mm`` the user never wrote, with advice to leave it out."""
+    sharp = SEAM_MM.tolist() + [[-50.0, 24.5, 5.0]]  # nearly back along the second leg
+    (tmp_path / "cells").mkdir()
+    (tmp_path / "cells" / "bracket.toml").write_text(
+        CELL.replace(f"points_mm = {SEAM_MM.tolist()}", f"points_mm = {sharp}"))
+    (tmp_path / "s.toml").write_text(SCENARIO.format(weave="").replace(
+        f"blend_mm = {BLEND_MM}\n", ""))
+    r = subprocess.run([sys.executable, "-m", "sim", "check", str(tmp_path / "s.toml")],
+                       check=False, capture_output=True, text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "(weld): seam 'ell' turns 172" in r.stderr and "at its corner 2," in r.stderr
+    assert "two seams" in r.stderr and "blend_mm" not in r.stderr
 
 
 def test_a_polyline_ends_exactly_on_its_last_point_with_its_blend(tmp_path):

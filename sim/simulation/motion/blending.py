@@ -253,6 +253,12 @@ def _blend_geometry(moves: list[CartesianPhase], move_labels: list[str], of: lis
             pa, ta = (v[0] for v in cart.path.evaluate(np.array([L - r_out]))[:2])
             pb, tb = (v[0] for v in nxt.path.evaluate(np.array([r_out]))[:2])
             turn = float(np.degrees(np.arccos(np.clip(ta @ tb, -1.0, 1.0))))
+            if turn > MAX_BLEND_TURN and of[k] == of[k + 1]:  # inside one polyline seam
+                raise ScenarioError(
+                    f"{move_labels[k]}: seam {str(moves[k].seam).rsplit('/', 1)[0]!r} turns "
+                    f"{turn:.1f} deg at its corner {k - of.index(of[k]) + 1}, too sharp to weld "
+                    f"through in one pass (at most {MAX_BLEND_TURN:g} deg); weld it as two "
+                    "seams, each its own phase")
             if turn > MAX_BLEND_TURN:
                 raise ScenarioError(
                     f"{move_labels[k]}.blend_mm: the path turns {turn:.1f} deg at the corner into "
