@@ -218,6 +218,9 @@ def _expectation(expect: ExpectSpec, verdict: str | None) -> str | None:
     reason = " ".join((expect.reason or "").split())
     if expect.verdict == "fail" and verdict == "fail":
         return f"expected: the scenario declares this failure ([expect]): {reason}"
+    if expect.verdict != verdict and not expect.model_fields_set:  # no [expect] table
+        return (f"unexpected: verdict {verdict!r}; the scenario expects {expect.verdict!r} (it "
+                "has no [expect] table declaring a failure)")
     if expect.verdict != verdict:
         return (f"unexpected: the scenario declares verdict {expect.verdict!r} ([expect])"
                 + (f": {reason}" if reason else ""))

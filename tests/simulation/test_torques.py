@@ -249,8 +249,8 @@ def test_a_declared_failure_is_one_line_after_the_verdict_and_changes_no_exit_co
                                                                                    capsys):
     """[expect] changes nothing but one line: seed 000's sequence still fails its verdict and
     `--strict` exits 1; `cellsim run` says after the verdict that the scenario declares it, and
-    why. The same file without its [expect] gets a line saying the verdict is not the declared
-    one."""
+    why. The same file without its [expect] gets a line saying the verdict is not the one
+    expected, and that it has no [expect] table (not that it declares one)."""
     import re
 
     args = ["--no-video", "--no-plots", "--quiet", "--strict"]
@@ -265,7 +265,8 @@ def test_a_declared_failure_is_one_line_after_the_verdict_and_changes_no_exit_co
     (tmp_path / "s.toml").write_text(text)
     assert main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "b"), *args]) == 1
     out = capsys.readouterr().out
-    assert "  unexpected: the scenario declares verdict 'pass' ([expect])\n" in out, out
+    assert ("  unexpected: verdict 'fail'; the scenario expects 'pass' (it has no [expect] "
+            "table declaring a failure)\n") in out, out
 
 
 def test_simulated_friction_is_the_coulomb_law_of_tau_id():
