@@ -387,6 +387,21 @@ def test_a_polyline_corner_too_sharp_to_weld_through_names_the_seam_and_corner(t
     assert "two seams" in r.stderr and "blend_mm" not in r.stderr
 
 
+def test_a_ramp_longer_than_its_move_names_ramp_s_with_the_files_numbers(tmp_path):
+    """``ramp_s = 2`` on the 30 mm plunge at 50 mm/s: its ramps need 100 mm of path. One line
+    naming the phase's ``ramp_s`` and that distance (the scenario's own keys and units, not the
+    planner's ``ramp_time`` and ``max_acceleration``), exit 2."""
+    write(tmp_path)
+    (tmp_path / "s.toml").write_text(SCENARIO.format(weave="").replace(
+        'orientation = "seam"\nspeed_mm_s = 50.0', 'orientation = "seam"\nspeed_mm_s = 50.0\n'
+        'ramp_s = 2.0', 1))
+    r = subprocess.run([sys.executable, "-m", "sim", "check", str(tmp_path / "s.toml")],
+                       check=False, capture_output=True, text=True)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "(plunge).ramp_s: start and stop ramps of 2 s at 50 mm/s need 100 mm" in r.stderr
+    assert "max_acceleration" not in r.stderr and "ramp_time" not in r.stderr
+
+
 def test_a_polyline_ends_exactly_on_its_last_point_with_its_blend(tmp_path):
     """``blend_mm`` on a polyline phase rounds its inner corners only: the reference tool point
     ends on the seam's last point (it once stopped 3.5 mm short, where a 5 mm blend into the

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from planners.errors import PlannerError
+from planners.errors import MoveTooShortError, PlannerError
 from sim.errors import ScenarioError
 from sim.scenario import CartesianPhase, JointPhase, plan_phase
 from sim.simulation.motion.context import CartesianContext
@@ -150,6 +150,13 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
             cart = adnia.arc_move(p0, via, to, phase.speed, **kw)
         else:
             cart = adnia.circle_move(center, axis, p0, phase.sweep, phase.speed, **kw)
+    except MoveTooShortError as exc:
+        if phase.ramp is None:  # the default ramp fits any move: the planner's own words
+            raise ScenarioError(f"{label}: {exc}") from None
+        raise ScenarioError(
+            f"{label}.ramp_s: start and stop ramps of {phase.ramp:g} s at "
+            f"{phase.speed * 1e3:g} mm/s need {phase.speed * phase.ramp * 1e3:.6g} mm of path, "
+            "more than the move has; give a shorter ramp_s or a lower speed_mm_s") from None
     except PlannerError as exc:
         raise ScenarioError(f"{label}: {exc}") from None
     if seam is not None and phase.kind == "circular" and \
