@@ -135,6 +135,12 @@ def test_parallel_equals_serial(tmp_path) -> None:
     pids = {json.loads((Path(o.run_dir) / "summary.json").read_text())["pid"]
             for o in parallel.outcomes}
     assert os.getpid() not in pids and len(pids) == 2  # really ran in two worker processes
+    # let go once the last variant was in (they exit while the report is written), the
+    # workers are joined before run_sweep returns: none is left running
+    assert multiprocessing.active_children() == []
+    for pid in pids:
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
 
 
 @pytest.mark.parametrize("workers", [1, 2])

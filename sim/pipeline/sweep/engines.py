@@ -5,10 +5,12 @@ reported as that variant's error while the others go on."""
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import multiprocessing
 import os
 import socket
+import threading
 import time
 import traceback
 from collections.abc import Callable, Sequence
@@ -206,8 +208,11 @@ def _run_on_ray(runner: Callable[[Variant], Any], variants: Sequence[Variant],
 
 def run_variants(runner: Callable[[Variant], Any], variants: list[Variant], workers: int,
                   mp_context: str, engine: str, address: str | None, batch: Any,
-                  progress: bool) -> SweepResult:
-    """Run every variant (a batch, Ray, this process or a process pool)."""
+                  progress: bool, closing: contextlib.ExitStack | None = None) -> SweepResult:
+    """Run every variant (a batch, Ray, this process or a process pool).
+
+    With ``closing``, a process pool's workers are let go as soon as the last variant is in
+    and joined when ``closing`` closes: they exit while the caller writes the report."""
     from tqdm import tqdm
 
     bar = tqdm(total=len(variants), desc="sweep", unit="run", disable=None if progress else True)
@@ -228,9 +233,10 @@ def run_variants(runner: Callable[[Variant], Any], variants: list[Variant], work
             ctx = multiprocessing.get_context(mp_context)
             # started once per sweep, each worker warmed once; the variants of a plan follow
             # each other (task_groups) so a worker reuses the plan and its reference scan
-            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
-                                     initializer=warm_worker,
-                                     initargs=(variants[0].scenario,)) as pool:
+            pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                       initializer=warm_worker,
+                                       initargs=(variants[0].scenario,))
+            try:
                 futures = {pool.submit(run_group, runner, g): g
                            for g in task_groups(variants, workers)}
                 for fut in as_completed(futures):
@@ -242,6 +248,16 @@ def run_variants(runner: Callable[[Variant], Any], variants: list[Variant], work
                         for v in group:
                             results[v.index] = Outcome(v, None, (), f"{type(exc).__name__}: {exc}")
                     bar.update(len(group))
+            except BaseException:
+                pool.shutdown(wait=True)  # as leaving a `with` block would
+                raise
+            if closing is None:
+                pool.shutdown(wait=True)
+            else:  # every result is in: the workers exit while the report is written
+                leaving = threading.Thread(target=pool.shutdown, name="sweep-pool-shutdown",
+                                           daemon=True)
+                leaving.start()
+                closing.callback(leaving.join)
     finally:
         bar.close()
     return SweepResult(outcomes=[r for r in results if r is not None], workers=workers,

@@ -4,6 +4,7 @@ and moves it into place (or, when every variant failed, next to the previous fol
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import multiprocessing
 import os
@@ -21,15 +22,9 @@ from sim.pipeline.sweep.engines import (
     import_ray,
     run_variants,
 )
-from sim.pipeline.sweep.report import write_sweep
+from sim.pipeline.sweep.report import warm_chart, write_sweep
 from sim.pipeline.sweep.variants import SweepResult, Variant, make_variants
 from sim.simulation import runfolder
-
-
-def _import_charts() -> None:
-    """Import what :func:`~sim.pipeline.sweep.report.sweep_chart` draws with."""
-    import matplotlib.backends.backend_agg  # noqa: F401
-    import matplotlib.figure  # noqa: F401
 
 
 def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Sequence[float],
@@ -104,19 +99,20 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
     # when its table is written (a killed sweep leaves the previous folder as it was, and what
     # it left goes at the next sweep); a sweep whose every variant failed leaves the previous
     # table too, its own report in the failed folder next to it
-    with runfolder.RunLock(out_dir):
+    # (the pool's workers, let go once every variant is in, are joined as the lock is left)
+    with runfolder.RunLock(out_dir), contextlib.ExitStack() as closing:
         runfolder.remove_stale(out_dir)
         tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
         try:
             runfolder.write_marker(tmp, state="writing")
             variants = make_variants(base_scenario, payloads, speed_scales, tmp)
             n_workers = min(workers or os.cpu_count() or 1, len(variants))
-            # the chart's matplotlib is imported while the workers run (the parent waits)
-            charts = threading.Thread(target=_import_charts, daemon=True)
+            # the chart's first-time costs are paid while the workers run (the parent waits)
+            charts = threading.Thread(target=warm_chart, daemon=True)
             if write and n_workers > 1:
                 charts.start()
             result = run_variants(runner, variants, n_workers, mp_context, engine, address,
-                                   batch, progress)
+                                   batch, progress, closing)
             if charts.is_alive():
                 charts.join()
             result = moved(result, tmp, out_dir)
