@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from sim.errors import CellsimWarning
 from sim.pipeline.run import RunOptions, evaluate_scenario
 from sim.scenario import load_scenario
 
@@ -385,6 +386,35 @@ def test_a_polyline_corner_too_sharp_to_weld_through_names_the_seam_and_corner(t
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "(weld): seam 'ell' turns 172" in r.stderr and "at its corner 2," in r.stderr
     assert "two seams" in r.stderr and "blend_mm" not in r.stderr
+
+
+def test_a_polyline_blend_over_its_share_of_a_segment_is_cut_back_with_a_warning(tmp_path):
+    """``blend_mm = 80`` on the bracket: more than 45 % of its shorter leg (both 120 mm, from
+    the cell's points: 54 mm). One warning naming the phase's key, the corner and the blend
+    used, the check passes, and the corner zone is the cut-back blend either side of the
+    corner (the test's own arithmetic on the file's points). 40 mm: no warning."""
+    legs = np.linalg.norm(np.diff(SEAM_MM, axis=0), axis=1)
+    share_mm = 0.45 * legs.min()
+    r = check_line(tmp_path, SCENARIO.format(weave="").replace(
+        f"blend_mm = {BLEND_MM}", "blend_mm = 80"))
+    assert r.returncode == 0, r.stderr
+    warned = [ln for ln in r.stderr.splitlines() if ln.startswith("cellsim: warning:")]
+    assert len(warned) == 1, r.stderr
+    assert (f"phases[2] (weld).blend_mm: 80 mm is more than 45% of the shorter segment at "
+            f"corner 1 ({share_mm:.3g} mm) of seam 'ell'") in warned[0]
+    from sim.simulation.compile import build
+    from sim.simulation.motion import build_motion
+
+    sc = load_scenario(tmp_path / "s.toml")
+    with pytest.warns(CellsimWarning, match=r"\(weld\)\.blend_mm: 80 mm .* corner 1 "):
+        motion = build_motion(sc, build(sc).context)
+    weld = next(pm for pm in motion.phases if pm.name == "weld")
+    corner_s = legs[0] * 1e-3
+    assert weld.corner_zones == [pytest.approx((corner_s - share_mm * 1e-3,
+                                                corner_s + share_mm * 1e-3), abs=1e-9)]
+    r = check_line(tmp_path, SCENARIO.format(weave="").replace(
+        f"blend_mm = {BLEND_MM}", "blend_mm = 40"))
+    assert r.returncode == 0 and "warning" not in r.stderr, r.stderr
 
 
 def test_a_ramp_longer_than_its_move_names_ramp_s_with_the_files_numbers(tmp_path):

@@ -13,6 +13,7 @@ the wrist singularity (:func:`_wrist_roll`), and the phases as windows of the on
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from planners.errors import PlannerError
-from sim.errors import CellsimError, ScenarioError
+from sim.errors import CellsimError, CellsimWarning, ScenarioError
 from sim.scenario import CartesianPhase, JointPhase, Phase, plan_phase
 from sim.simulation.motion.cartesian import _phase_cart
 from sim.simulation.motion.context import CartesianContext
@@ -45,6 +46,9 @@ MAX_BLEND_TURN = 150.0
 MIN_BLEND = 1e-4
 #: Corner blend of a polyline seam welded without ``blend_mm``, m.
 POLYLINE_BLEND = 0.002
+#: Largest corner blend of a polyline seam, as a share of the shorter of its two segments (a
+#: larger ``blend_mm`` is cut back to it, with a warning).
+POLYLINE_BLEND_SHARE = 0.45
 
 
 def _blends(phase: CartesianPhase) -> bool:
@@ -83,18 +87,30 @@ def _segments(phase: CartesianPhase, ctx: CartesianContext, label: str
               ) -> list[CartesianPhase]:
     """A linear phase along a polyline seam as one linear move per segment (the seam's
     ``<name>/<i>`` line seams), blended at the inner corners by ``blend_mm`` (default
-    :data:`POLYLINE_BLEND`, at most 45 % of the shorter segment at each corner). The seam's
-    last point is never cut: the last segment stops there (blend 0)."""
+    :data:`POLYLINE_BLEND`, at most :data:`POLYLINE_BLEND_SHARE` of the shorter segment at each
+    corner: a larger ``blend_mm`` is cut back to it there, with a warning naming the corners).
+    The seam's last point is never cut: the last segment stops there (blend 0)."""
     seam = ctx.seams[phase.seam]
     segs = seam.segments()
     corner = phase.blend if phase.blend > 0 else POLYLINE_BLEND
     out = []
+    cut: list[str] = []  # the corners where the user's blend_mm is more than their share
     for i, sg in enumerate(segs):
         r = 0.0
         if i + 1 < len(segs):
-            r = min(corner, 0.45 * min(sg.length(), segs[i + 1].length()))
+            share = POLYLINE_BLEND_SHARE * min(sg.length(), segs[i + 1].length())
+            r = min(corner, share)
+            if phase.blend > share:
+                cut.append(f"{i + 1} ({share * 1e3:.3g} mm)")
         out.append(dataclasses.replace(phase, seam=sg.name, blend=r, blend_fraction=0.0,
                                        weave=None))
+    if cut:
+        many = len(cut) > 1
+        warnings.warn(CellsimWarning(
+            f"{label}.blend_mm: {phase.blend * 1e3:.4g} mm is more than "
+            f"{POLYLINE_BLEND_SHARE:.0%} of the shorter segment at corner{'s' if many else ''} "
+            f"{', '.join(cut)} of seam {phase.seam!r}; blended there with "
+            f"{'those' if many else 'that'} instead"), stacklevel=2)
     return out
 
 
