@@ -144,7 +144,9 @@ class LSProgram:
 _NUM = r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?"
 _TARGET = r"(P|PR)\[\s*(\d+)\s*(?::[^\]]*)?\]"
 _SPEED = rf"({_NUM}|WELD_SPEED|R\[\s*\d+\s*\])\s*(%|mm/sec|cm/min|inch/min|sec|)"
-_TERM = r"(FINE|CNT\s*(\d+))"
+#: The termination, a word of its own (``CNT5O``, ``FINEE`` are malformed, not CNT5 or FINE
+#: with an option).
+_TERM = r"(FINE|CNT\s*(\d+))(?=\s|$)"
 _MOTION = re.compile(rf"^([JL])\s+{_TARGET}\s+{_SPEED}\s+{_TERM}\s*(.*)$", re.I)
 _CIRC1 = re.compile(rf"^C\s+{_TARGET}\s*$", re.I)
 _CIRC2 = re.compile(rf"^:\s*{_TARGET}\s+{_SPEED}\s+{_TERM}\s*(.*)$", re.I)
@@ -218,6 +220,9 @@ def _options(rest: str, path, line: int, warnings: list,
         if m.group(1):
             arc = m.group(1).lower()
             continue
+        if re.fullmatch(r"FINE|CNT\d+", m.group(2), re.I):
+            raise _err(path, line, f"a second termination {m.group(2)!r} (a motion ends FINE "
+                       "or CNTx, once)")
         flag = FLAG_OPTIONS.get(m.group(2).upper())
         if flag is not None and flags is not None and flag not in flags:
             flags.append(flag)
@@ -314,6 +319,10 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
             if mc:
                 pending_circ = ((mc.group(1).upper(), int(mc.group(2))), ln)
                 continue
+            bad = re.match(rf"^[JL]\s+{_TARGET}\s+{_SPEED}\s+(\S+)", body, re.I)
+            if bad:
+                raise _err(path, ln, f"motion termination {bad.group(5)!r} in {body!r}: FINE or "
+                           "CNTx expected (x from 0 to 100)")
             if re.match(r"^[JLC]\s", body):
                 raise _err(path, ln, f"malformed motion instruction {body!r} (expected e.g. "
                            "'L P[2] 100mm/sec FINE' or 'J P[1] 50% CNT50')")

@@ -524,6 +524,17 @@ def test_export_never_replaces_a_file(tmp_path):
 BAD_PROGRAMS = {
     "a malformed motion line": (lambda t: t.replace("L P[2] 100mm/sec FINE", "L P[2] fast FINE"),
                                 "line 10: malformed motion instruction"),
+    # found by a new-user trial: read as CNT5 with an option 'O' (a warning), as FINE with an
+    # option 'E', as FINE with an option 'CNT50'
+    "a termination with a typo (letter O for a zero)": (
+        lambda t: t.replace("L P[2] 100mm/sec FINE", "L P[2] 100mm/sec CNT5O"),
+        "line 10: motion termination 'CNT5O' in 'L P[2] 100mm/sec CNT5O': FINE or CNTx"),
+    "a termination with a letter too many": (
+        lambda t: t.replace("L P[2] 100mm/sec FINE", "L P[2] 100mm/sec FINEE"),
+        "line 10: motion termination 'FINEE'"),
+    "two terminations": (
+        lambda t: t.replace("L P[2] 100mm/sec FINE", "L P[2] 100mm/sec FINE CNT50"),
+        "line 10: a second termination 'CNT50'"),
     "a position not in /POS": (lambda t: t.replace("L P[3] 10mm/sec", "L P[33] 10mm/sec"),
                                "line 12: P[33] is not in the /POS section"),
     "a position register without a value": (
