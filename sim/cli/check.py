@@ -1,8 +1,9 @@
 """``cellsim check SCENARIO``: reach, joint limits, singular passes and collisions of the
 reference motion, without dynamics (:mod:`sim.pipeline.check`), in seconds.
 
-Prints one line per finding. Exit codes: 0 when nothing was found, 1 when something was,
-2 for a mistake in the input.
+Prints what a TP program holds that is not run (``program: ...``, as ``cellsim run`` does; not
+a finding), then one line per finding. Exit codes: 0 when nothing was found, 1 when something
+was, 2 for a mistake in the input.
 """
 
 from __future__ import annotations
@@ -32,6 +33,13 @@ def run(args: argparse.Namespace) -> int:
 
     start = time.perf_counter()
     scenario = load_scenario(args.scenario)
+    # what a TP program holds that is not run (as `cellsim run` lists it): the user edits a
+    # program and checks it, so they see it here first (warnings: no finding, exit unchanged)
+    for line in scenario.program_warnings:
+        print(f"program: {line}")
+    for partner in scenario.partners:
+        for line in partner.program_warnings:
+            print(f"{partner.name}: program: {line}")
     res = check_scenario(scenario)
     for f in res.findings:
         print(f"{f.kind}: {f.line}")

@@ -512,6 +512,23 @@ def test_export_then_import_reproduces_the_tool_path_at_every_programmed_point(t
     assert back.summary["verdict"] == "pass"
 
 
+def test_check_lists_what_a_program_holds_that_is_not_run(tmp_path):
+    """``cellsim check`` (what a user runs after editing a program) lists the program's
+    warnings as ``cellsim run`` does, with their line numbers: weld1.ls's ``DO[1]=ON`` and a
+    J move's CNT50 into an L move, which runs as FINE. Warnings are no finding. (Found by a
+    new-user trial: only ``run`` printed them.)"""
+    text = (DATA / "weld1.ls").read_text().replace("J P[1] 50% FINE", "J P[1] 50% CNT50", 1)
+    (tmp_path / "weld1.ls").write_text(text)
+    (tmp_path / "s.toml").write_text(TP_SCENARIO)
+    r = run_limited([sys.executable, "-m", "sim", "check", str(tmp_path / "s.toml")],
+                    capture_output=True, text=True, cpu_s=300)
+    assert r.returncode == 0, r.stdout + r.stderr  # warnings are no finding
+    out = r.stdout.splitlines()
+    assert "program: weld1.ls: line 17: instruction not simulated: DO[1]=ON" in out, r.stdout
+    assert any(ln.startswith("program: weld1.ls: line 9: CNT50 ") and "runs as FINE" in ln
+               for ln in out), r.stdout
+
+
 def test_export_never_replaces_a_file(tmp_path):
     (tmp_path / "prog.ls").write_text("mine")
     r = run_limited([sys.executable, "-m", "sim", "export", "lrmate200ic_weld_plate",
