@@ -51,7 +51,7 @@ from sim.analysis.sizing_charts import (  # the charts, importable from here as 
     sizing_charts,
 )
 from sim.core.files import write_atomic
-from sim.simulation.collisions import CLEARANCE_RANGE_M
+from sim.simulation.collisions import CLEARANCE_RANGE_M, collision_phase
 from sim.simulation.runfolder import (
     REPORT_HTML,
     SIZING_CHARTS_DIR,
@@ -325,7 +325,7 @@ img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}
 
 def collision_rows(summary: Mapping[str, Any]) -> tuple[list[list[str]], list[list[str]]]:
     """Rows of the collisions table and of the per-phase clearance table of a summary."""
-    coll = [[str(c["phase"]), f"{c['t0']:.3f}-{c['t1']:.3f}", str(c["kind"]),
+    coll = [[collision_phase(c), f"{c['t0']:.3f}-{c['t1']:.3f}", str(c["kind"]),
              f"{c['bodies'][0]} / {c['bodies'][1]}", f"{c['geoms'][0]} / {c['geoms'][1]}",
              f"{c['depth_mm']:.2f}"] for c in summary.get("collisions", ())]
 

@@ -92,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
     from sim.cli.size import selection_overrides
     from sim.pipeline.run import RunOptions, default_out_dir, run_scenario
     from sim.scenario import load_scenario
+    from sim.simulation.collisions import collision_phase
 
     scenario = load_scenario(args.scenario)
     select = selection_overrides(args)
@@ -168,7 +169,8 @@ def run(args: argparse.Namespace) -> int:
               f"demand over the drive's limit by up to {s['worst_excess_nm']:.4g} {force}")
     for c in summary.get("collisions", [])[:10]:
         print(f"  collision {c['bodies'][0]} / {c['bodies'][1]}: {c['t0']:.3f}-{c['t1']:.3f} s "
-              f"({c['phase']}), {c['depth_mm']:.1f} mm deep ({c['geoms'][0]}, {c['geoms'][1]})")
+              f"({collision_phase(c)}), {c['depth_mm']:.1f} mm deep ({c['geoms'][0]}, "
+              f"{c['geoms'][1]})")
     for c in warned:
         print(f"  warning: {c['name']} {c.get('subject') or c['joint']}: {c['value']:.4g} "
               f"{c['unit']} (below {c['limit']:.4g} {c['unit']})")

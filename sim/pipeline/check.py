@@ -31,6 +31,7 @@ from sim.errors import ReachError
 from sim.scenario import Scenario
 from sim.simulation.collisions import (
     check_motion,
+    collision_phase,
     phase_seams,
     phase_weaves,
     samples_from_motion,
@@ -98,7 +99,7 @@ def check_scenario(scenario: Scenario, *, dt: float = CHECK_DT_S) -> CheckResult
     res.collisions = report.collisions
     for c in report.collisions:
         res.findings.append(Finding("collision", (
-            f"{c['phase']}: {c['kind']} collision {c['bodies'][0]} / {c['bodies'][1]} from "
+            f"{collision_phase(c)}: {c['kind']} collision {c['bodies'][0]} / {c['bodies'][1]} from "
             f"{c['t0']:.3f} to {c['t1']:.3f} s, {c['depth_mm']:.1f} mm deep at "
             f"{c['t_worst']:.3f} s ({c['geoms'][0]}, {c['geoms'][1]})")))
     return res

@@ -1,7 +1,8 @@
 """The samples of a motion that collisions are checked on (:class:`MotionSamples`): a run's
 recorded motion (:func:`samples_from_arrays`) or a scenario's reference motion
 (:func:`samples_from_motion`), with each other robot's work on the same samples
-(:func:`lane_samples`), and what each phase welds (:func:`phase_seams`, :func:`phase_weaves`).
+(:func:`lane_samples`), and what each phase welds (:func:`phase_seams`, :func:`phase_weaves`);
+which robots' phases a collision's sample is in (:func:`robots_named`, :func:`collision_phase`).
 
 Owns the sampling; the check model and :class:`MotionSamples` are
 :mod:`sim.simulation.collision_model`'s, the search :mod:`sim.simulation.collisions`'.
@@ -16,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.simulation.allowed_contacts import weave_reach
-from sim.simulation.collision_model import LaneSamples, MotionSamples, mujoco_module
+from sim.simulation.collision_model import LEAD, LaneSamples, MotionSamples, mujoco_module
 from sim.simulation.compile import BuiltCell
 
 
@@ -80,3 +81,29 @@ def phase_seams(motion: Any) -> list[str | None]:
 def phase_weaves(motion: Any) -> list[float]:
     """Each phase's weave reach, m (:func:`weave_reach`; 0 where it does not weave)."""
     return [weave_reach(getattr(pm.phase, "weave", None)) for pm in motion.phases]
+
+
+def robots_named(cm: Any, samples: MotionSamples, phase_names: Any, a: int, b: int,
+                 i: int) -> dict[str, Any]:
+    """``robots``: the robot of each geom of a pair (None for the cell or a part; ``cm``: the
+    check model), and ``robot_phases``: each of them's phase at sample ``i``."""
+    robots = [cm.geoms[a].robot, cm.geoms[b].robot]
+    phases = {}
+    for r in robots:
+        if r == LEAD:
+            phases[r] = phase_names[int(samples.phase[i])]
+        elif r is not None:
+            lane = samples.lane(r)
+            phases[r] = lane.phase_names[int(lane.phase[i])]
+    return {"robots": robots, "robot_phases": phases}
+
+
+def collision_phase(entry: Any) -> str:
+    """The phase a collision happens in, for a line or a table: its ``phase`` (the first
+    robot's); in a cell with several robots, the phase of each robot it involves, another
+    robot's named (``"park, r2: clear"``; ``"r2: clear"`` for another robot against the
+    cell), as the clearance entries name them."""
+    phases = entry.get("robot_phases")
+    if not phases:
+        return str(entry["phase"])
+    return ", ".join(p if r == LEAD else f"{r}: {p}" for r, p in phases.items())

@@ -354,27 +354,12 @@ def find_collisions(cm: CollisionModel, samples: MotionSamples, phase_names: Seq
                 "t_worst": float(samples.t[c.s[w]]),
             }
             if len(cm.robots) > 1:  # several robots: which, in which of its phases, and a line
-                entry.update(_robots_named(cm, samples, phase_names, a, b, int(lo)))
+                entry.update(_samples.robots_named(cm, samples, phase_names, a, b, int(lo)))
                 entry["message"] = (f"{describe_geom(cm, a)} against {describe_geom(cm, b)} at "
                                     f"{entry['t0']:.3f} s ({entry['t0']:.3f}-{entry['t1']:.3f} s, "
                                     f"{entry['depth_mm']:.1f} mm deep)")
             out.append(entry)
     return sorted(out, key=lambda e: (e["t0"], e["bodies"]))
-
-
-def _robots_named(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
-                  a: int, b: int, i: int) -> dict[str, Any]:
-    """``robots``: the robot of each geom of a pair (None for the cell or a part), and
-    ``robot_phases``: each of them's phase at sample ``i``."""
-    robots = [cm.geoms[a].robot, cm.geoms[b].robot]
-    phases = {}
-    for r in robots:
-        if r == LEAD:
-            phases[r] = phase_names[int(samples.phase[i])]
-        elif r is not None:
-            lane = samples.lane(r)
-            phases[r] = lane.phase_names[int(lane.phase[i])]
-    return {"robots": robots, "robot_phases": phases}
 
 
 def clearance(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str],
@@ -587,3 +572,4 @@ samples_from_motion = _samples.samples_from_motion
 lane_samples = _samples.lane_samples
 phase_seams = _samples.phase_seams
 phase_weaves = _samples.phase_weaves
+collision_phase = _samples.collision_phase

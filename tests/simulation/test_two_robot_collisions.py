@@ -197,7 +197,22 @@ def test_a_crossing_fails_the_verdict_and_strict_run_and_check_exit_1(crossing, 
     assert "collision robot/tool/torch / r2/tool/torch" in crossing["out"]
     assert main(["check", str(crossing["path"])]) == 1
     out = capsys.readouterr().out
-    assert "cross: robot_robot collision robot/tool/torch / r2/tool/torch" in out
+    # each robot's phase (r2's named): the first robot's alone once named a phase that had
+    # ended while r2's move caused the hit (found by a new-user trial)
+    assert "collision: cross, r2: cross: robot_robot collision robot/tool/torch / r2/tool/torch" \
+        in out
+
+
+@pytest.mark.parametrize(("entry", "label"), [
+    ({"phase": "weld"}, "weld"),  # one robot
+    ({"phase": "park", "robot_phases": {"robot": "park"}}, "park"),  # the first against the cell
+    ({"phase": "park", "robot_phases": {"r2": "clear"}}, "r2: clear"),  # r2 against the cell
+    ({"phase": "park", "robot_phases": {"robot": "park", "r2": "clear"}}, "park, r2: clear"),
+])
+def test_a_collision_is_labelled_with_each_robots_own_phase(entry, label):
+    from sim.simulation.collisions import collision_phase
+
+    assert collision_phase(entry) == label
 
 
 def test_the_clean_variant_has_no_collision_and_the_oracles_clearance(clean):
