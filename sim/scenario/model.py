@@ -176,6 +176,9 @@ class CartesianPhase:
         axes: External axes' values at the move's end, rad or m, by axis name (a TP program's
             coordinated move, ``COORD``): they move in proportion to the path travelled, and
             the path and the orientation are relative to ``frame`` (carried by its mechanism).
+        time_scale: How many times faster than written the phase runs
+            (:meth:`Scenario.scaled`): the default ramps' least duration is divided by it, as
+            the written times are.
     """
 
     index: int
@@ -206,6 +209,7 @@ class CartesianPhase:
     downhand: bool = False
     follow: str | None = None
     axes: dict[str, float] = field(default_factory=dict)
+    time_scale: float = 1.0
 
     def seam_as_welded(self, seam: Seam) -> Seam:
         """The seam this phase welds: ``seam`` (the cell's seam named ``self.seam``) with the
@@ -354,10 +358,14 @@ class Scenario:
         """This scenario run ``speed_scale`` times faster, optionally with another payload.
 
         Knot times, segment durations, hold durations and action times are divided by
-        ``speed_scale``; Cartesian speeds are multiplied by it (sampling periods and ramps
-        divided), and boundary velocities, accelerations and jerks scale by its 1st, 2nd and 3rd
-        power, so the joint paths are the same, traversed faster. Without gravity, friction and
-        damping, joint torques then scale exactly as ``speed_scale**2``.
+        ``speed_scale``; Cartesian speeds, weave frequencies and a TP program's joint-move
+        speed percentages are multiplied by it (sampling
+        periods, ramps, the default ramps' least duration, weave dwells and a TP program's move
+        times divided), and boundary velocities, accelerations and jerks scale by its 1st, 2nd
+        and 3rd power, so the joint paths are the same, traversed faster: the cycle time is
+        divided by ``speed_scale`` (but where a blended corner is slowed to keep the joints
+        within their limits). Without gravity, friction and damping, joint torques then scale
+        exactly as ``speed_scale**2``.
 
         Raises:
             ScenarioError: ``speed_scale`` not positive, or ``payload_kg`` outside 0 ..
@@ -408,11 +416,16 @@ def _scaled(phases: tuple[Phase, ...], actions: tuple[Action, ...], s: float
             out.append(dataclasses.replace(
                 p, times=None if p.times is None else p.times / s,
                 durations=p.durations / s,
+                speed_pct=None if p.speed_pct is None else p.speed_pct * s,
                 boundary={k: v * s ** order[k[0]] for k, v in p.boundary.items()}))
         elif isinstance(p, CartesianPhase):
+            weave = p.weave if p.weave is None else dataclasses.replace(
+                p.weave, frequency=p.weave.frequency * s, dwell=p.weave.dwell / s)
             out.append(dataclasses.replace(
                 p, speed=p.speed * s, sample_period=p.sample_period / s,
-                ramp=None if p.ramp is None else p.ramp / s))
+                ramp=None if p.ramp is None else p.ramp / s,
+                move_time=None if p.move_time is None else p.move_time / s,
+                weave=weave, time_scale=p.time_scale * s))
         else:
             out.append(dataclasses.replace(p, duration=p.duration / s))
     return tuple(out), tuple(dataclasses.replace(a, time=None if a.time is None else a.time / s)

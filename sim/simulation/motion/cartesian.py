@@ -30,13 +30,18 @@ from sim.simulation.motion.sampling import (
 from sim.simulation.motion.seams import _check_five_axis_torch, _seam, _seam_pose
 from sim.simulation.motion.timeline import PhaseMotion
 
+#: Least duration of a default ramp, s (a phase run faster by :meth:`Scenario.scaled`: this
+#: divided by its ``time_scale``).
+RAMP_FLOOR_S = 0.3
+
 
 def default_ramp(phase: CartesianPhase, p0: NDArray[np.float64], seam: Any,
                  ctx: CartesianContext) -> float:
     """Default duration of the smooth start and stop of a Cartesian move, s.
 
-    Three sampling periods and at least 0.3 s, so the joint polynomial through the ADNIA via
-    points resolves the ramp; at most half the move's duration at full speed.
+    Three sampling periods and at least :data:`RAMP_FLOOR_S` (divided by the phase's
+    ``time_scale``), so the joint polynomial through the ADNIA via points resolves the ramp; at
+    most half the move's duration at full speed.
     """
     if seam is not None:
         length = float(seam.length())
@@ -48,7 +53,8 @@ def default_ramp(phase: CartesianPhase, p0: NDArray[np.float64], seam: Any,
     else:
         radius = float(np.linalg.norm(np.cross(p0 - phase.center, phase.axis)))
         length = abs(phase.sweep) * radius
-    return min(max(3.0 * phase.sample_period, 0.3), 0.5 * length / phase.speed)
+    return min(max(3.0 * phase.sample_period, RAMP_FLOOR_S / phase.time_scale),
+               0.5 * length / phase.speed)
 
 
 def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.float64],
@@ -96,7 +102,8 @@ def _phase_cart(phase: CartesianPhase, p0: NDArray[np.float64], R0: NDArray[np.f
                 length = float(CirclePath.through(p0, via, to).length)
             except PlannerError as exc:
                 raise ScenarioError(f"{label}: {exc}") from None
-        ramp = min(max(3.0 * phase.sample_period, 0.3), phase.move_time / 3.0)
+        ramp = min(max(3.0 * phase.sample_period, RAMP_FLOOR_S / phase.time_scale),
+                   phase.move_time / 3.0)
         phase = dataclasses.replace(phase, ramp=ramp, speed=max(length, 1e-6)
                                     / (phase.move_time - ramp))
 
