@@ -110,7 +110,7 @@ def test_sweep_table_matches_closed_form(tmp_path) -> None:
     md = (tmp_path / "sweep.md").read_text()
     assert "Peak |torque|" in md and "RMS torque" in md and "sweep.png" in md
     # pivot cell: 5 kg at speed x2, joint j1
-    assert f"| 5 | 2 | {expected_peak(5, 2):.4g} |" in md
+    assert f"| 5 | 2 | - | {expected_peak(5, 2):.4g} |" in md  # no verdict: "-"
     assert (tmp_path / "sweep.png").read_bytes().startswith(b"\x89PNG")
     data = json.loads((tmp_path / "sweep.json").read_text())
     assert len(data["variants"]) == 9
@@ -295,3 +295,26 @@ def test_an_interrupted_sweep_leaves_the_previous_folder_and_nothing_marked_comp
     shutil.copytree(out / "payload_0kg_speed_1x", killed / "payload_0kg_speed_1x")
     run_sweep("weld_demo", [0.0], [1.0], fake_runner, workers=1, out_dir=out, progress=False)
     assert not killed.exists() and marker_state(out) == "complete"
+
+
+def test_a_variant_whose_verdict_fails_says_why_in_the_table_and_the_report(tmp_path):
+    """The pick-and-place gripper is rated 2.04 kg: with a 2.5 kg payload (and the 0.25 kg
+    part it carries) the variant is simulated and sized, its verdict fails, and both
+    ``sweep.csv`` (``failed_checks``) and ``sweep.md`` (a verdict column and a section) say
+    why; the 0 kg variant passes. (Found by a new-user trial: only the CSV's ``verdict``
+    column said fail, and no file said why; every margin in sweep.md was positive.)"""
+    from sim.pipeline.sweep.evaluation import evaluate_variant
+
+    res = run_sweep("lrmate200ic_pick_place", [0.0, 2.5], [1.0], evaluate_variant, workers=1,
+                    out_dir=tmp_path / "s", progress=False)
+    rows = read_csv(tmp_path / "s" / "sweep.csv")
+    by_payload = {float(r["payload_kg"]): r for r in rows}
+    assert by_payload[0.0]["verdict"] == "pass" and by_payload[0.0]["failed_checks"] == ""
+    why = by_payload[2.5]["failed_checks"]
+    assert by_payload[2.5]["verdict"] == "fail"
+    assert why.startswith("tool_payload: the vacuum_gripper holds 2.75 kg, rated 2.04 kg"), why
+    md = (tmp_path / "s" / "sweep.md").read_text()
+    assert "2 variants (2 succeeded, 1 of them with a failed verdict)" in md
+    assert "| 2.5 | 1 | fail |" in md and "| 0 | 1 | pass |" in md
+    assert f"- payload 2.5 kg, speed x1: {why}" in md
+    assert res.failures == []  # a failed verdict is a result, not a failed variant

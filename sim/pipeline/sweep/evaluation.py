@@ -57,14 +57,14 @@ def _variant_scenario(variant: Variant) -> Any:
 
 
 def _metrics(variant: Variant, ev: Any, run_dir: str | None = None) -> Any:
-    from sim.pipeline.sweep.variants import VariantMetrics, rows_from
+    from sim.pipeline.sweep.variants import VariantMetrics, failed_checks_text, rows_from
 
     sized = ({j["joint"]: j for j in ev.sizing.to_dict()["joints"]}
              if ev.sizing is not None else {})
     # the sizing's statistics of the same arrays (the same values, not computed again)
     stats = ({j.joint: j.stats for j in ev.sizing.joints} if ev.sizing is not None else None)
     rows = rows_from(variant, ev.record.arrays, ev.summary["joints"], ev.summary["verdict"],
-                     sized, run_dir or "", stats=stats)
+                     sized, run_dir or "", stats=stats, failed=failed_checks_text(ev.summary))
     return VariantMetrics(tuple(rows), ev.selection.to_dict() if ev.selection else None,
                           timings_s=dict(ev.summary.get("timings_s", {})), run_dir=run_dir)
 

@@ -19,17 +19,19 @@ from sim.pipeline.sweep.variants import SweepResult
 SWEEP_COLUMNS = ("payload_kg", "speed_scale", "joint", "peak_torque_nm", "rms_torque_nm",
                  "peak_torque_id_nm", "peak_torque_sim_nm", "rms_torque_id_nm", "rms_torque_sim_nm",
                  "peak_speed_rad_s", "peak_power_w", "duration_s", "margin_pct", "pass",
-                 "limiting", "verdict", "run_dir")
+                 "limiting", "verdict", "failed_checks", "run_dir")
 
 
 def _pivot(rows: Sequence[dict[str, Any]], key: str, joints: Sequence[str]) -> list[list[str]]:
     table: dict[tuple[float, float], dict[str, float]] = {}
+    verdict: dict[tuple[float, float], str] = {}
     for r in rows:
         table.setdefault((r["payload_kg"], r["speed_scale"]), {})[r["joint"]] = r[key]
+        verdict[(r["payload_kg"], r["speed_scale"])] = str(r.get("verdict", ""))
     out = []
     for (p, s), vals in table.items():
         cells = [f"{vals[j]:.4g}" if j in vals and np.isfinite(vals[j]) else "n/a" for j in joints]
-        out.append([f"{p:g}", f"{s:g}", *cells])
+        out.append([f"{p:g}", f"{s:g}", verdict[(p, s)] or "-", *cells])
     return out
 
 
@@ -38,13 +40,16 @@ def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
     rows = result.rows
     joints = list(dict.fromkeys(r["joint"] for r in rows))
     ok = len(result.outcomes) - len(result.failures)
+    failing = len(_verdicts(result))
+    passed = f", {failing} of them with a failed verdict" if failing else ""
     parts = ["# Sweep", "",
-             f"{len(result.outcomes)} variants ({ok} succeeded), {result.workers} worker(s), "
+             f"{len(result.outcomes)} variants ({ok} succeeded{passed}), {result.workers} "
+             "worker(s), "
              f"{result.wall_s:.1f} s wall-clock. Speed scale s divides the knot times "
              "(s = 2: twice as fast). Torques are the larger of inverse dynamics and simulation "
              "(a linear axis's, a track's, are forces in N).",
              ""]
-    head = ["payload kg", "speed scale", *joints]
+    head = ["payload kg", "speed scale", "verdict", *joints]
 
     def table(title: str, key: str) -> None:
         parts.extend([f"## {title}", "",
@@ -57,6 +62,13 @@ def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
         table("RMS torque (N m)", "rms_torque_nm")
         if any(np.isfinite(r["margin_pct"]) for r in rows):
             table("Sizing margin (%)", "margin_pct")
+    verdicts = _verdicts(result)
+    if verdicts:
+        parts += ["## Variants whose verdict failed", "",
+                  "Simulated and sized (their rows are in the tables above), but physically "
+                  "impossible or out of the robot's or tool's rating: why, per variant.", ""]
+        parts += [f"- {label}: {why or 'fail'}" for label, why in verdicts]
+        parts.append("")
     if result.failures:
         parts += ["## Failed variants", ""]
         parts += [f"- {o.variant.label}: {o.error}" for o in result.failures]
@@ -64,6 +76,12 @@ def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
     if chart and rows:
         parts += ["## Chart", "", f"![peak and RMS torque]({chart})", ""]
     return "\n".join(parts)
+
+
+def _verdicts(result: SweepResult) -> list[tuple[str, str]]:
+    """The variants whose verdict failed, in variant order: their label and why."""
+    return [(o.variant.label, str(o.rows[0].get("failed_checks", "")))
+            for o in result.outcomes if o.rows and o.rows[0].get("verdict") == "fail"]
 
 
 def chart_columns(result: SweepResult) -> tuple[str, ...]:

@@ -144,9 +144,26 @@ class VariantMetrics:
     run_dir: str | None = None
 
 
+#: Most failed checks a row names (then how many more there are).
+FAILED_CHECKS_LISTED = 3
+
+
+def failed_checks_text(summary: Mapping[str, Any]) -> str:
+    """Why a variant's verdict failed, for its rows: each failed check of severity error as
+    ``name: subject`` (``tool_payload: the vacuum_gripper holds 2.75 kg, rated 2.04 kg``),
+    the first :data:`FAILED_CHECKS_LISTED`, then how many more; "" when none failed."""
+    failed = [c for c in summary.get("checks", ())
+              if not c.get("pass", True) and c.get("severity", "error") == "error"]
+    text = "; ".join(f"{c.get('name', '?')}: {c.get('subject', '')}".rstrip(": ")
+                     for c in failed[:FAILED_CHECKS_LISTED])
+    more = len(failed) - FAILED_CHECKS_LISTED
+    return text + (f"; and {more} more" if more > 0 else "")
+
+
 def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequence[str],
               verdict: str, sized: Mapping[str, Mapping[str, Any]], run_dir: str = "",
-              stats: Mapping[str, Mapping[str, Any]] | None = None) -> list[dict[str, Any]]:
+              stats: Mapping[str, Mapping[str, Any]] | None = None,
+              failed: str = "") -> list[dict[str, Any]]:
     """Rows of sweep.csv for one variant (one per joint), from its recorded arrays.
 
     Args:
@@ -158,6 +175,7 @@ def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequ
         sized: ``sizing.json``'s joints by name (``margin_pct``, ``pass``, ``limiting``);
             empty when the run was not sized.
         run_dir: The variant's run folder ("" when none was kept).
+        failed: Why the verdict failed (:func:`failed_checks_text`), "" when it passed.
         stats: The sizing's joint-side statistics of these arrays by joint and source
             (:attr:`sim.analysis.sizing.JointSizing.stats`: ``"id"`` with no window, ``"sim"``
             sustained over :data:`~sim.analysis.sizing.PEAK_WINDOW_S`), or None: the peaks,
@@ -193,6 +211,7 @@ def rows_from(variant: Variant, arrays: Mapping[str, NDArray[Any]], joints: Sequ
             "pass": ("PASS" if s["pass"] else "FAIL") if "pass" in s else "",
             "limiting": s.get("limiting") or "",
             "verdict": verdict,
+            "failed_checks": failed,
             "run_dir": str(run_dir),
         })
     return rows
@@ -249,7 +268,8 @@ def variant_rows(variant: Variant, run_dir: str | Path) -> list[dict[str, Any]]:
             sized = {j["joint"]: j for j in json.loads(sizing_path.read_text()).get("joints", [])}
         except (json.JSONDecodeError, KeyError, TypeError):
             sized = {}
-    return rows_from(variant, traj, names, summary.get("verdict", ""), sized, str(run_dir))
+    return rows_from(variant, traj, names, summary.get("verdict", ""), sized, str(run_dir),
+                     failed=failed_checks_text(summary))
 
 
 def outcome_of(variant: Variant, got: Any, wall_s: float) -> Outcome:
