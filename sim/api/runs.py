@@ -85,8 +85,9 @@ def sweep(scenario: ScenarioLike, payloads_kg: Sequence[float] | None = None,
 
     Args:
         scenario: As for :func:`evaluate`.
-        payloads_kg: Payloads, kg (default: the scenario's).
-        speed_scales: Speed factors (> 0; 2 runs the cycle twice as fast).
+        payloads_kg: Payloads, kg (default: the scenario's); one number is a list of one.
+        speed_scales: Speed factors (> 0; 2 runs the cycle twice as fast); one number is a
+            list of one.
         workers: Worker processes (1: in this process).
         keep_runs: Also write each variant's run folder.
         select: Choose a motor and a reducer per joint from the scenario's catalogue.
@@ -107,9 +108,9 @@ def sweep(scenario: ScenarioLike, payloads_kg: Sequence[float] | None = None,
     from sim.pipeline.sweep.evaluation import evaluate_batch, evaluate_variant
 
     loaded = _scenario(scenario)
-    payloads = validate_payloads(list(payloads_kg) if payloads_kg is not None
+    payloads = validate_payloads(payloads_kg if payloads_kg is not None
                                  else [loaded.payload_kg], field="payloads_kg")
-    scales = validate_speed_scales(list(speed_scales), field="speed_scales")
+    scales = validate_speed_scales(speed_scales, field="speed_scales")
     selection = selection_options(loaded) if select or loaded.sizing.select else None
     batch = functools.partial(evaluate_batch, selection=selection) if backend == "warp" else None
     return run_sweep(loaded, payloads, scales,

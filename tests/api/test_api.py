@@ -175,6 +175,31 @@ def test_sweep_tabulates_every_variant(tmp_path):
     assert peak[4.0] > peak[0.0]  # 4 kg more at the flange loads the shoulder more
 
 
+@pytest.mark.parametrize(("kw", "needle"), [
+    ({"payloads_kg": "1,2"}, "payloads_kg: expected numbers like [0, 2.5, 5], got the text '1,2'"),
+    ({"payloads_kg": [True]}, "payloads_kg: True is not a number"),  # True is not 1 kg
+    ({"payloads_kg": [1.0, None]}, "payloads_kg: None is not a number"),
+    ({"speed_scales": "fast"}, "speed_scales: expected numbers like [0.5, 1, 1.5], got the text"),
+    ({"speed_scales": [1.0, "2"]}, "speed_scales: '2' is not a number"),
+    ({"speed_scales": object()}, "speed_scales: expected numbers like [0.5, 1, 1.5], got object"),
+])
+def test_bad_sweep_values_are_one_line_cellsim_errors(tmp_path, kw, needle):
+    """Values a script may pass by mistake (found by a new-user trial: a string raised
+    ValueError, a bare float TypeError, and True ran as 1 kg): one line, a CellsimError (a
+    SweepError), raised before anything is written."""
+    with pytest.raises(sim.CellsimError) as info:
+        sim.sweep(SHORT, out_dir=tmp_path / "sweep", **kw)
+    assert needle in str(info.value) and "\n" not in str(info.value)
+    assert not (tmp_path / "sweep").exists()
+
+
+def test_one_number_is_a_sweep_of_one(tmp_path):
+    """``speed_scales=1.0`` and ``payloads_kg=2.0`` (one number each, not a list) are a sweep
+    of that one variant, as the docs' signature reads."""
+    result = sim.sweep(SHORT, payloads_kg=2.0, speed_scales=1.0, out_dir=tmp_path / "sweep")
+    assert {(r["payload_kg"], r["speed_scale"]) for r in result.rows} == {(2.0, 1.0)}
+
+
 # ---------------------------------------------------------------------------- examples
 EXAMPLES = {
     "payload_study.py": ([SHORT, "0", "5"], 2),

@@ -33,14 +33,38 @@ from sim.simulation.runfolder import SIZING_JSON
 MAX_SWEEP_VARIANTS = 10_000
 
 
+def _as_values(given: Any, field: str, example: str) -> list[float]:
+    """``given`` as a list of floats: a sequence of real numbers, or one number; a string,
+    a bool (``True`` is not 1 kg) or anything else that is not a number is a
+    :class:`SweepError` naming ``field`` (the Python face's counterpart of the command line's
+    parsing, :func:`sim.cli.size.parse_float_list`)."""
+    import numbers
+
+    if isinstance(given, (str, bytes)):
+        raise SweepError(f"{field}: expected numbers like {example}, got the text {given!r} "
+                         "(give a list of numbers)")
+    items = [given] if isinstance(given, numbers.Real) else given
+    try:
+        items = list(items)
+    except TypeError:
+        raise SweepError(f"{field}: expected numbers like {example}, got "
+                         f"{type(given).__name__} {given!r}") from None
+    for v in items:
+        if isinstance(v, bool) or not isinstance(v, numbers.Real):
+            raise SweepError(f"{field}: {v!r} is not a number (expected numbers like "
+                             f"{example})")
+    return [float(v) for v in items]
+
+
 def validate_payloads(payloads: Sequence[float], field: str = "payload") -> list[float]:
     """Payloads in kg: 0 to :data:`~sim.scenario.schema.MAX_PAYLOAD_KG`, at least one;
-    duplicates dropped.
+    duplicates dropped. One number is a list of one.
 
     Raises:
-        SweepError: One line naming ``field`` and the bad value.
+        SweepError: One line naming ``field`` and the bad value (a string, a bool or another
+            non-number too).
     """
-    values = [float(p) for p in payloads]
+    values = _as_values(payloads, field, "[0, 2.5, 5]")
     if not values:
         raise SweepError(f"{field}: no payload given (expected kg values like 0,2.5,5)")
     for p in values:
@@ -51,12 +75,14 @@ def validate_payloads(payloads: Sequence[float], field: str = "payload") -> list
 
 
 def validate_speed_scales(scales: Sequence[float], field: str = "speed scale") -> list[float]:
-    """Speed scales: finite, > 0, at least one; duplicates dropped.
+    """Speed scales: finite, > 0, at least one; duplicates dropped. One number is a list of
+    one.
 
     Raises:
-        SweepError: One line naming ``field`` and the bad value.
+        SweepError: One line naming ``field`` and the bad value (a string, a bool or another
+            non-number too).
     """
-    values = [float(s) for s in scales]
+    values = _as_values(scales, field, "[0.5, 1, 1.5]")
     if not values:
         raise SweepError(f"{field}: no speed scale given (expected factors like 0.5,1,1.5)")
     for s in values:
