@@ -269,6 +269,17 @@ def test_a_sweep_whose_every_variant_failed_leaves_the_previous_table(tmp_path) 
     assert after == before
     failed = tmp_path / "sw.failed"
     assert "torch9" in (failed / "sweep.md").read_text()
+    # a later good sweep into the place: the failed report, cellsim's and now stale, goes (a
+    # new-user trial found it left next to the new table); a folder of the user's by that name
+    # is never touched
+    run_sweep("weld_demo", PAYLOADS, SCALES, fake_runner, workers=1, out_dir=out,
+              progress=False)
+    assert not failed.exists() and (out / "sweep.csv").is_file()
+    failed.mkdir()
+    (failed / "mine.txt").write_text("mine")
+    run_sweep("weld_demo", PAYLOADS, SCALES, fake_runner, workers=1, out_dir=out,
+              progress=False)
+    assert (failed / "mine.txt").read_text() == "mine"
 
 
 def test_an_interrupted_sweep_leaves_the_previous_folder_and_nothing_marked_complete(

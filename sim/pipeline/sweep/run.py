@@ -142,6 +142,9 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
                     os.replace(out_dir, trash / "old")
                     shutil.rmtree(trash, ignore_errors=True)
                 os.replace(tmp, out_dir)
+                failed = runfolder.failed_folder(out_dir)
+                if runfolder.is_run_folder(failed):  # an earlier failed sweep's, now stale
+                    shutil.rmtree(failed, ignore_errors=True)
         except BaseException:
             shutil.rmtree(tmp, ignore_errors=True)
             raise
