@@ -43,7 +43,8 @@ MAX_SWEEP_VALUES = 10_000
 
 def parse_float_list(text: str, field: str = "value") -> list[float]:
     """Numbers from a command-line list: ``"0,2.5,5"`` or an inclusive range ``"0:10:2.5"``
-    (items may mix: ``"0,1:3:1"``). Duplicates are dropped, the order kept.
+    (items may mix: ``"0,1:3:1"``). Duplicates are dropped (with a warning naming them), the
+    order kept.
 
     Args:
         text: The option's text.
@@ -80,7 +81,9 @@ def parse_float_list(text: str, field: str = "value") -> list[float]:
             out.extend(round(a + k * step, 12) for k in range(count))
         else:
             out.append(_number(item, field))
-    return list(dict.fromkeys(out))
+    from sim.pipeline.sweep.variants import unique_values
+
+    return unique_values(out, field)  # a repeated value: a warning, the variant runs once
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -18,7 +18,7 @@ from support.window_oracle import sustained_peak
 
 from sim.analysis.sizing import PEAK_WINDOW_S
 from sim.cli.size import parse_float_list
-from sim.errors import CellsimError, UnknownNameError
+from sim.errors import CellsimError, CellsimWarning, UnknownNameError
 from sim.pipeline.sweep import (
     SWEEP_COLUMNS,
     SweepError,
@@ -188,7 +188,8 @@ def test_bad_workers(tmp_path, workers) -> None:
 
 
 def test_variants_are_every_combination_payload_major(tmp_path) -> None:
-    vs = make_variants("base", [0, 2.5, 2.5], [1, 0.5], tmp_path)
+    with pytest.warns(CellsimWarning, match="payload: 2.5 given more than once"):
+        vs = make_variants("base", [0, 2.5, 2.5], [1, 0.5], tmp_path)
     assert [(v.payload_kg, v.speed_scale) for v in vs] == [(0, 1), (0, 0.5), (2.5, 1), (2.5, 0.5)]
     assert [v.index for v in vs] == [0, 1, 2, 3]
     assert len({v.run_dir for v in vs}) == 4 and all(v.scenario == "base" for v in vs)
@@ -200,7 +201,9 @@ def test_parse_float_list() -> None:
     assert parse_float_list(" 1 , 0.5 ", field="--speed") == [1.0, 0.5]
     assert parse_float_list("0:10:2.5", field="--payload") == [0.0, 2.5, 5.0, 7.5, 10.0]
     assert parse_float_list("0.5:1.1:0.2,2", field="--speed") == pytest.approx([0.5, 0.7, 0.9, 1.1, 2])
-    assert parse_float_list("1,1,2", field="--speed") == [1.0, 2.0]
+    with pytest.warns(CellsimWarning, match=r"--speed: 1 given more than once; each variant "
+                      "runs once"):  # dropped, not silently (a new-user trial)
+        assert parse_float_list("1,1,2", field="--speed") == [1.0, 2.0]
 
 
 @pytest.mark.parametrize("text, fragment", [
@@ -240,6 +243,9 @@ def test_variants_whose_values_print_alike_get_their_own_run_folders(tmp_path) -
                                       "payload_1.0000002kg_speed_1.0x"}
     rows = read_csv(tmp_path / "sw" / "sweep.csv")
     assert {r["run_dir"] for r in rows} == {str(d) for d in dirs}
+    # and sweep.md's tables keep them two rows that read apart (both read "| 1 | 1 |" once)
+    md = (tmp_path / "sw" / "sweep.md").read_text()
+    assert "| 1.0000001 | 1 |" in md and "| 1.0000002 | 1 |" in md
 
 
 def test_a_second_sweep_into_a_busy_folder_refuses(tmp_path) -> None:

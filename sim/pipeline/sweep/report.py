@@ -31,7 +31,9 @@ def _pivot(rows: Sequence[dict[str, Any]], key: str, joints: Sequence[str]) -> l
     out = []
     for (p, s), vals in table.items():
         cells = [f"{vals[j]:.4g}" if j in vals and np.isfinite(vals[j]) else "n/a" for j in joints]
-        out.append([f"{p:g}", f"{s:g}", verdict[(p, s)] or "-", *cells])
+        # 12 digits: values that differ only past the 6th (1.0000001 and 1.0000002 kg) stay
+        # two rows that read apart
+        out.append([f"{p:.12g}", f"{s:.12g}", verdict[(p, s)] or "-", *cells])
     return out
 
 

@@ -9,6 +9,7 @@ import math
 import re
 import time
 import traceback
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,7 +26,7 @@ from sim.analysis.sizing import (
     rms,
     sustained,
 )
-from sim.errors import CellsimError, SweepError
+from sim.errors import CellsimError, CellsimWarning, SweepError
 from sim.scenario.schema import MAX_PAYLOAD_KG
 from sim.simulation.runfolder import SIZING_JSON
 
@@ -56,6 +57,18 @@ def _as_values(given: Any, field: str, example: str) -> list[float]:
     return [float(v) for v in items]
 
 
+def unique_values(values: list[float], field: str) -> list[float]:
+    """``values`` without repeats (first order kept); a warning names the repeated ones (each
+    variant runs once)."""
+    out = list(dict.fromkeys(values))
+    if len(out) < len(values):
+        repeated = sorted({v for v in values if values.count(v) > 1})
+        warnings.warn(CellsimWarning(
+            f"{field}: {', '.join(f'{v:.12g}' for v in repeated)} given more than once; "
+            "each variant runs once"), stacklevel=3)
+    return out
+
+
 def validate_payloads(payloads: Sequence[float], field: str = "payload") -> list[float]:
     """Payloads in kg: 0 to :data:`~sim.scenario.schema.MAX_PAYLOAD_KG`, at least one;
     duplicates dropped. One number is a list of one.
@@ -71,7 +84,7 @@ def validate_payloads(payloads: Sequence[float], field: str = "payload") -> list
         if not math.isfinite(p) or p < 0 or p > MAX_PAYLOAD_KG:
             raise SweepError(f"{field}: payload must be a mass of 0 to {MAX_PAYLOAD_KG:g} kg, "
                              f"got {p:g}")
-    return list(dict.fromkeys(values))
+    return unique_values(values, field)
 
 
 def validate_speed_scales(scales: Sequence[float], field: str = "speed scale") -> list[float]:
@@ -89,7 +102,7 @@ def validate_speed_scales(scales: Sequence[float], field: str = "speed scale") -
         if not math.isfinite(s) or s <= 0:
             raise SweepError(f"{field}: speed scale must be a finite factor > 0 "
                              f"(1 = as planned, 2 = twice as fast), got {s:g}")
-    return list(dict.fromkeys(values))
+    return unique_values(values, field)
 
 
 @dataclass(frozen=True)
@@ -113,7 +126,7 @@ class Variant:
 
     @property
     def label(self) -> str:
-        return f"payload {self.payload_kg:g} kg, speed x{self.speed_scale:g}"
+        return f"payload {self.payload_kg:.12g} kg, speed x{self.speed_scale:.12g}"
 
     @property
     def slug(self) -> str:
@@ -348,6 +361,7 @@ class SweepResult:
         return [o for o in self.outcomes if o.error is not None]
 
 
-__all__ = ["MAX_SWEEP_VARIANTS", "Outcome", "SweepResult", "Variant", "VariantMetrics",
-           "make_variants", "outcome_of", "rows_from", "run_variant", "validate_payloads",
-           "validate_speed_scales", "variant_rows"]
+__all__ = ["FAILED_CHECKS_LISTED", "MAX_SWEEP_VARIANTS", "Outcome", "SweepResult", "Variant",
+           "VariantMetrics", "failed_checks_text", "make_variants", "outcome_of", "rows_from",
+           "run_variant", "unique_values", "validate_payloads", "validate_speed_scales",
+           "variant_rows"]
