@@ -208,6 +208,9 @@ def run(args: argparse.Namespace) -> int:
                        batch=batch)
     print(f"{len(result.outcomes)} variants in {result.wall_s:.1f} s on {result.workers} "
           f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.png)")
+    for o in result.outcomes:  # simulated and sized, but not physically possible: said here too
+        if o.rows and o.rows[0].get("verdict") == "fail":
+            print(f"  verdict fail, {o.variant.label}: {o.rows[0].get('failed_checks') or 'fail'}")
     if selection is not None:
         _print_selections(result)
     return 0

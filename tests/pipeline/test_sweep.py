@@ -314,16 +314,18 @@ def test_an_interrupted_sweep_leaves_the_previous_folder_and_nothing_marked_comp
     assert not killed.exists() and marker_state(out) == "complete"
 
 
-def test_a_variant_whose_verdict_fails_says_why_in_the_table_and_the_report(tmp_path):
+def test_a_variant_whose_verdict_fails_says_why_in_the_table_and_the_report(tmp_path,
+                                                                            capsys):
     """The pick-and-place gripper is rated 2.04 kg: with a 2.5 kg payload (and the 0.25 kg
     part it carries) the variant is simulated and sized, its verdict fails, and both
     ``sweep.csv`` (``failed_checks``) and ``sweep.md`` (a verdict column and a section) say
     why; the 0 kg variant passes. (Found by a new-user trial: only the CSV's ``verdict``
     column said fail, and no file said why; every margin in sweep.md was positive.)"""
-    from sim.pipeline.sweep.evaluation import evaluate_variant
+    from sim.cli import main
 
-    res = run_sweep("lrmate200ic_pick_place", [0.0, 2.5], [1.0], evaluate_variant, workers=1,
-                    out_dir=tmp_path / "s", progress=False)
+    assert main(["size", "lrmate200ic_pick_place", "--payload", "0,2.5", "--workers", "1",
+                 "--quiet", "--out", str(tmp_path / "s")]) == 0  # a result, not an error
+    out = capsys.readouterr().out
     rows = read_csv(tmp_path / "s" / "sweep.csv")
     by_payload = {float(r["payload_kg"]): r for r in rows}
     assert by_payload[0.0]["verdict"] == "pass" and by_payload[0.0]["failed_checks"] == ""
@@ -334,4 +336,5 @@ def test_a_variant_whose_verdict_fails_says_why_in_the_table_and_the_report(tmp_
     assert "2 variants (2 succeeded, 1 of them with a failed verdict)" in md
     assert "| 2.5 | 1 | fail |" in md and "| 0 | 1 | pass |" in md
     assert f"- payload 2.5 kg, speed x1: {why}" in md
-    assert res.failures == []  # a failed verdict is a result, not a failed variant
+    assert f"  verdict fail, payload 2.5 kg, speed x1: {why}" in out.splitlines()  # console
+    assert "payload 0 kg" not in out
