@@ -252,16 +252,17 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
             start = time.perf_counter()
             nacon_dev = wp.zeros(n_max + 1, dtype=int)
             nefc_dev = wp.zeros((n_max + 1, nworld), dtype=int)
+            step = _Stepper(wp, mjw, mw, dw)
             if motor is None:
                 flat = np.stack([b.force_limits[:, 1] for b in builts]).astype(np.float32)
                 limits[:] = flat
                 for k in range(n_max):
                     wp.copy(dw.ctrl, ctrl_dev[k])
-                    mjw.step(mw, dw)
+                    step()
                     _record_step(wp, dw, k, qpos_dev, qvel_dev, sens_dev, nacon_dev, nefc_dev)
             else:
                 first_qdd = np.stack([p["ref"].qdd[0] for p in per])
-                _motor_steps(wp, mjw, mw, dw, motor, ctrl_dev, n_max, ends, first_qdd, labels,
+                _motor_steps(wp, mjw, step, mw, dw, motor, ctrl_dev, n_max, ends, first_qdd, labels,
                              limits, (qpos_dev, qvel_dev, sens_dev, nacon_dev, nefc_dev))
             wp.copy(dw.ctrl, ctrl_dev[n_max])
             if motor is None:
@@ -303,6 +304,39 @@ def simulate_batch(builts: Sequence[BuiltCell], motions: Sequence[Motion], *,
         records.append(SimulationRecord(arrays=arrays, wall_s=wall / nworld, steps=n,
                                         timestep=dt))
     return records
+
+
+#: What the last batch's stepping did (read by benchmarks/bench_warp_gpu.py): the steps run,
+#: passes included, and whether they ran as a CUDA graph.
+STEP_STATS: dict[str, Any] = {"steps": 0, "graph": False}
+
+
+class _Stepper:
+    """One ``mjw.step`` of the batch. On a GPU the step is captured once as a CUDA graph and
+    launched as one graph after that: the same kernels on the same buffers, without Warp's
+    per-kernel launch from Python, which bounds a batch's step time on a GPU (each step of the
+    batch is a few hundred small kernels). The first step runs plainly (it loads the kernels).
+    The graph reads the model and data buffers that the loop writes between steps (the
+    controls, the force ranges, a saved state put back), so those stay where they are."""
+
+    def __init__(self, wp: Any, mjw: Any, mw: Any, dw: Any) -> None:
+        self.wp, self.mjw, self.mw, self.dw = wp, mjw, mw, dw
+        self.capture = wp.get_device().is_cuda and os.environ.get("CELLSIM_WARP_GRAPH") != "0"
+        self.graph: Any = None
+        STEP_STATS.update(steps=0, graph=False)
+
+    def __call__(self) -> None:
+        STEP_STATS["steps"] += 1
+        if self.graph is not None:
+            self.wp.capture_launch(self.graph)
+            return
+        self.mjw.step(self.mw, self.dw)
+        if self.capture:  # recorded, not run: the state stays where the step left it
+            self.capture = False
+            with self.wp.ScopedCapture() as cap:
+                self.mjw.step(self.mw, self.dw)
+            self.graph = cap.graph
+            STEP_STATS["graph"] = True
 
 
 def _record_step(wp: Any, dw: Any, k: int, qpos_dev: Any, qvel_dev: Any, sens_dev: Any,
@@ -419,7 +453,8 @@ class _MotorBounds:
         return side, err, new_hold
 
 
-def _motor_steps(wp: Any, mjw: Any, mw: Any, dw: Any, motor: _MotorBounds, ctrl_dev: Any,
+def _motor_steps(wp: Any, mjw: Any, step: _Stepper, mw: Any, dw: Any, motor: _MotorBounds,
+                 ctrl_dev: Any,
                  n_max: int, ends: NDArray[np.int_], first_qdd: NDArray[np.float64],
                  labels: Sequence[str], limits: NDArray[np.float64],
                  out: tuple[Any, ...]) -> None:
@@ -466,7 +501,7 @@ def _motor_steps(wp: Any, mjw: Any, mw: Any, dw: Any, motor: _MotorBounds, ctrl_
                     wp.copy(getattr(dw, name), arr)
             lo, hi = motor.bounds(qd0, est)
             mw.actuator_forcerange.assign(motor.forcerange(lo, hi, hold))
-            mjw.step(mw, dw)
+            step()
             qd1 = dw.qvel.numpy()[:, motor.dof].astype(np.float64)
             tau_act = dw.sensordata.numpy()[:, motor.tau_cols].astype(np.float64)
             qdd = (qd1 - qd0) / motor.h

@@ -239,3 +239,72 @@ def test_the_motor_oracle_catches_a_planted_clamp_fault(tmp_path, monkeypatch, f
     (ev,) = evaluate_scenarios([_weak_j2(tmp_path)], RunOptions(
         video=False, plots=False, progress=False, backend="warp"))
     assert _motor_excess(ev.record.arrays).max() > 100 * F32_MOTOR_TOL
+
+
+class _FakeDevice:
+    """Warp and MuJoCo Warp as far as the batch's stepper uses them: a step advances the
+    state by one, unless a CUDA graph is being captured (then it is recorded, as Warp records
+    kernel launches), and a launched graph runs what it recorded."""
+
+    def __init__(self, cuda: bool) -> None:
+        self.cuda, self.state, self.recording, self.log = cuda, 0, None, []
+
+    # wp
+    def get_device(self):
+        return type("Device", (), {"is_cuda": self.cuda})()
+
+    def ScopedCapture(self):  # noqa: N802 - Warp's name
+        fake = self
+
+        class Capture:
+            def __enter__(self):
+                fake.recording = []
+                return self
+
+            def __exit__(self, *exc):
+                self.graph, fake.recording = tuple(fake.recording), None
+                fake.log.append("captured")
+
+        return Capture()
+
+    def capture_launch(self, graph):
+        self.log.append("graph")
+        for op in graph:
+            op()
+
+    # mjw
+    def step(self, mw, dw):
+        def advance():
+            self.state += 1
+
+        if self.recording is not None:
+            self.recording.append(advance)
+        else:
+            self.log.append("step")
+            advance()
+
+
+@pytest.mark.parametrize("cuda, graph", [(True, True), (False, False)])
+def test_a_gpu_batch_steps_as_one_cuda_graph_after_its_first_step(monkeypatch, cuda, graph):
+    """On a GPU the first step runs plainly (it loads the kernels), is then captured without
+    being run, and every later step launches the graph: n calls advance the state n steps.
+    Warp's CPU device has no graphs. (The graph's numbers are the plain step's: the H200 run
+    in benchmarks/results/ agrees with MuJoCo in C as closely with graphs as without.)"""
+    from sim.simulation import warp_batch
+
+    monkeypatch.delenv("CELLSIM_WARP_GRAPH", raising=False)
+    fake = _FakeDevice(cuda)
+    step = warp_batch._Stepper(fake, fake, None, None)
+    for _ in range(4):
+        step()
+    assert fake.state == 4
+    assert warp_batch.STEP_STATS == {"steps": 4, "graph": graph}
+    assert fake.log == (["step", "captured", "graph", "graph", "graph"] if graph
+                        else ["step"] * 4)
+    # switched off for a comparison (benchmarks/bench_warp_gpu.py --no-graph)
+    monkeypatch.setenv("CELLSIM_WARP_GRAPH", "0")
+    fake = _FakeDevice(True)
+    step = warp_batch._Stepper(fake, fake, None, None)
+    for _ in range(3):
+        step()
+    assert fake.state == 3 and fake.log == ["step"] * 3
