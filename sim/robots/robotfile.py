@@ -73,6 +73,11 @@ def load_robot_folder(folder: str | Path) -> RobotSpec:
     folder = path.parent
     spec, _ = load_toml(path, RobotFolderSpec, KinematicsError)
     where = str(path)
+    for i, d in enumerate(spec.drives):  # as a scenario's [drives.jN] is held to it
+        if d.peak_torque_nm < d.rated_torque_nm:
+            raise KinematicsError(f"{where}: drives[{i}] (j{i + 1}): peak_torque_nm "
+                                  f"{d.peak_torque_nm:g} N m is below rated_torque_nm "
+                                  f"{d.rated_torque_nm:g} N m")
     k = spec.kinematics
     if (k.family is None) == (k.convention is None):
         raise KinematicsError(f"{where}: kinematics: give family (with dims_mm) or convention "

@@ -993,6 +993,25 @@ def test_a_kept_model_must_match_its_robot_toml(edit, needle, tmp_path):
     assert "robot.toml" in str(e.value) and "\n" not in str(e.value)
 
 
+def test_a_drive_whose_peak_is_below_its_rated_torque_is_refused(tmp_path):
+    """robot.toml's [[drives]] are held to what a scenario's [drives.jN] is: a peak torque
+    under the rated one is a typo (a trial's j6 with 0.1 against 0.32 N m ran and passed)."""
+    import shutil
+
+    from sim.robots.robotfile import load_robot_folder
+
+    dst = tmp_path / "kr6"
+    shutil.copytree(MODELS / "kuka_kr6r900_2", dst)
+    toml = dst / "robot.toml"
+    text = toml.read_text()
+    assert text.count("peak_torque_nm = 4.5\n") >= 1  # J1's comes first
+    toml.write_text(text.replace("peak_torque_nm = 4.5\n", "peak_torque_nm = 0.5\n", 1))
+    with pytest.raises(KinematicsError, match=r"drives\[0\] \(j1\): peak_torque_nm 0.5 N m is "
+                       r"below rated_torque_nm 1.3 N m") as e:
+        load_robot_folder(dst)
+    assert "robot.toml" in str(e.value) and "\n" not in str(e.value)
+
+
 def test_a_urdf_robot_name_that_is_no_file_name_still_runs(tmp_path, monkeypatch):
     """<robot name='my/ur "5"'>: the generated model is named after the file instead."""
     from sim.robots.registry import resolve_robot
