@@ -32,9 +32,10 @@ is per joint:
   not out of the verdict;
 * ``selection`` (when actuators were chosen from a catalogue, :mod:`sim.analysis.selection`):
   per joint, the chosen pair's smallest margin, %; fails when no pair serves the joint;
-* ``payload``: the mass at the flange, the tool's and the scenario's payload, kg, against the
-  robot's rated payload (``[mass] payload_kg``; not checked for a robot that gives none): a
-  robot carrying three times its rating is no result to size from;
+* ``payload``: the mass at the flange, the tool's, the scenario's payload and, for a gripper,
+  the heaviest part of the cell (it carries each part in turn), kg, against the robot's rated
+  payload (``[mass] payload_kg``; not checked for a robot that gives none): a robot carrying
+  three times its rating is no result to size from;
 * ``tool_payload``: for a tool with a rating (``max_payload_kg``: the vacuum gripper's is its
   40 N over twice a part's weight), the mass it holds (the scenario's payload and the
   heaviest part of the cell), kg, against that rating.
@@ -96,11 +97,13 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                flange_load_kg: tuple[float, float] | None = None,
                tool_load: tuple[str, float, float] | None = None,
                tracking_tolerance_mm: float = 0.5,
-               partner_loads: Sequence[tuple[str, RobotSpec, float]] = ()) -> list[RunCheck]:
+               partner_loads: Sequence[tuple[str, RobotSpec, float]] = (),
+               held_part_kg: float = 0.0) -> list[RunCheck]:
     """Every check of a run (module docstring): joint by joint, then collisions, clearance,
     the Cartesian phases' speeds, the weld phases' torch angles, the weaves, the actuator
     selection when one was made, and the payload (``flange_load_kg``: the tool's mass and the
-    scenario's payload, kg) against the robot's rating, and the mass the tool holds against
+    scenario's payload, kg) with the heaviest part a gripper carries (``held_part_kg``)
+    against the robot's rating, and the mass the tool holds against
     the tool's (``tool_load``: the tool's name, the mass it holds and its rating, kg), and each
     of a cell's other robots' tool against its rating (``partner_loads``: name, robot, kg)."""
     checks: list[RunCheck] = []
@@ -111,10 +114,11 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
                                subject=f"the {name} holds {held:g} kg, rated {rating:.3g} kg"))
     if flange_load_kg is not None and spec.payload_kg > 0:
         tool, payload = flange_load_kg
-        load = float(tool) + float(payload)
+        load = float(tool) + float(payload) + float(held_part_kg)
+        part = f" + part {held_part_kg:g} kg" if held_part_kg > 0 else ""
         checks.append(RunCheck("payload", "", load, float(spec.payload_kg), "kg",
                                load <= spec.payload_kg * (1 + 1e-9),
-                               subject=f"tool {tool:g} kg + payload {payload:g} kg on the "
+                               subject=f"tool {tool:g} kg + payload {payload:g} kg{part} on the "
                                f"{spec.name}, rated {spec.payload_kg:g} kg"))
     for name, robot, tool_kg in partner_loads:  # a cell's other robots carry their tools
         if robot.payload_kg > 0:

@@ -173,7 +173,7 @@ def run(args: argparse.Namespace) -> int:
               f"{c['geoms'][1]})")
     for c in warned:
         print(f"  warning: {c['name']} {c.get('subject') or c['joint']}: {c['value']:.4g} "
-              f"{c['unit']} (below {c['limit']:.4g} {c['unit']})")
+              f"{c['unit']} against the limit {c['limit']:.4g} {c['unit']}")
     if failed:
         print(f"  verdict: FAIL ({len(failed)} check(s) failed, {len(warned)} warning(s))")
         for c in failed:

@@ -149,7 +149,9 @@ def add_selection_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--rank", choices=("mass", "inertia", "margin"),
                    help="rank passing pairs by mass (default), rotor inertia or margin")
     g.add_argument("--inertia-ratio-max", type=float, metavar="X",
-                   help="load/rotor inertia ratio above which a pair gets a warning (default 10)")
+                   help="largest load/rotor inertia ratio a pair may have (default 10): over it "
+                        "a pair fails, or only warns where the scenario's [sizing] "
+                        "inertia_ratio = \"warning\"")
 
 
 def selection_overrides(args: argparse.Namespace) -> dict | None:

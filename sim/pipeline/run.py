@@ -276,6 +276,7 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
                             flange_load_kg=(built.cell.tool.mass_kg if built.cell.tool else 0.0,
                                             scenario.payload_kg),
                             tool_load=_tool_load(built, scenario.payload_kg),
+                            held_part_kg=_heaviest_part_kg(built),
                             partner_loads=[(cr.name, cr.robot,
                                             cr.tool.mass_kg if cr.tool is not None else 0.0)
                                            for cr in built.cell.partners])
@@ -291,10 +292,21 @@ def _tool_load(built: Any, payload_kg: float) -> tuple[str, float, float] | None
     tool = built.cell.tool
     if tool is None or tool.max_payload_kg is None:
         return None
+    return tool.name, float(payload_kg) + _parts_kg(built), float(tool.max_payload_kg)
+
+
+def _parts_kg(built: Any) -> float:
+    """The heaviest part of the cell (the compiled model's mass), kg; 0 without parts."""
     model = built.model
-    parts = [float(model.body(name).mass[0]) for name in built.cell.parts
-             if _has_body(model, name)]
-    return tool.name, float(payload_kg) + max(parts, default=0.0), float(tool.max_payload_kg)
+    return max((float(model.body(name).mass[0]) for name in built.cell.parts
+                if _has_body(model, name)), default=0.0)
+
+
+def _heaviest_part_kg(built: Any) -> float:
+    """What a gripper adds at the flange while it carries a part: the heaviest part, kg (0 for
+    a torch or no tool)."""
+    tool = built.cell.tool
+    return _parts_kg(built) if tool is not None and tool.kind == "gripper" else 0.0
 
 
 def _has_body(model: Any, name: str) -> bool:
@@ -512,7 +524,7 @@ def selection_options(scenario: Scenario, *, catalog: str | Path | None = None,
     """
     from sim.analysis.catalog import load_catalog, starter_catalog
     from sim.analysis.selection import RANKS, SelectionOptions
-    from sim.errors import ScenarioError
+    from sim.errors import CatalogError, ScenarioError
 
     spec = scenario.sizing
     if catalog is not None:
@@ -535,8 +547,12 @@ def selection_options(scenario: Scenario, *, catalog: str | Path | None = None,
     rank = spec.rank if rank is None else rank
     if rank not in RANKS:
         raise ScenarioError(f"--rank: must be one of {', '.join(RANKS)}, got {rank!r}")
-    return SelectionOptions(load_catalog(path), rank=rank, inertia_ratio=spec.inertia_ratio,
-                            **values)
+    cat = load_catalog(path)
+    for kind, entries in (("motors", cat.motors), ("reducers", cat.reducers)):
+        if not entries:  # every joint's pair is a motor and a reducer
+            raise CatalogError(f"{cat.sources[0]}: the catalogue has no [[{kind}]]; the "
+                               "selection pairs a motor with a reducer for every joint")
+    return SelectionOptions(cat, rank=rank, inertia_ratio=spec.inertia_ratio, **values)
 
 
 def _video_args(scenario: Scenario, options: RunOptions) -> dict[str, Any]:

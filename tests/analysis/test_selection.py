@@ -293,6 +293,29 @@ def test_cli_bad_catalogue_exits_2_before_any_run(tmp_path, capsys):
     assert not out.exists()
 
 
+@pytest.mark.parametrize("kind", ["motors", "reducers"])
+def test_a_catalogue_without_motors_or_reducers_is_refused_before_any_run(tmp_path, capsys,
+                                                                         kind):
+    """A file of motors alone is a catalogue (files combine), but no selection: a trial's
+    catalogue without ``[[reducers]]`` simulated the whole run, then failed every joint."""
+    from sim.analysis.catalog import starter_catalog
+
+    text = starter_catalog().read_text()
+    head, _, rest = text.partition(f"[[{kind}]]")
+    other = "reducers" if kind == "motors" else "motors"
+    # the starter file lists one kind, then the other: drop every table of this kind
+    kept = head + rest[rest.index(f"[[{other}]]"):] if f"[[{other}]]" in rest else head
+    assert f"[[{kind}]]" not in kept and f"[[{other}]]" in kept
+    cat = tmp_path / "half.toml"
+    cat.write_text(kept)
+    out = tmp_path / "run"
+    rc = main(["run", "lrmate200ic_pick_place", "--select", "--catalog", str(cat),
+               "--out", str(out), "--quiet", "--no-video"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1, err
+    assert f"half.toml: the catalogue has no [[{kind}]]" in err and not out.exists()
+
+
 @pytest.mark.slow  # the fast share's ten minutes (issue 29): a sweep with run folders
 def test_size_select_writes_the_selection_in_each_variant(tmp_path, small_catalog, capsys):
     out = tmp_path / "sweep"
@@ -512,6 +535,10 @@ def test_the_warnings_counted_are_the_warnings_listed_in_every_report(tmp_path, 
     assert any(c["name"] == "selection_inertia_ratio" for c in warned)
     lines = [ln for ln in printed.splitlines() if ln.strip().startswith("warning:")]
     assert len(lines) == len(warned)
+    # each line states its value and its limit, not a direction (an inertia ratio or an
+    # e-stop torque is over its limit, a clearance under it: "below" was printed for all)
+    for ln, c in zip(lines, warned, strict=True):
+        assert ln.rstrip().endswith(f"against the limit {c['limit']:.4g} {c['unit']}"), ln
     assert f"{len(warned)} warning(s)" in printed
     verdict = summary["verdict"].upper()
     assert rc == 0  # without --strict

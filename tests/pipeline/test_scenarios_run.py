@@ -170,6 +170,42 @@ def test_the_gripper_holds_no_more_than_its_rating(scenario_run):
     assert check["pass"] and check["severity"] == "error"
 
 
+def test_the_robot_carries_the_gripper_and_its_heaviest_part(scenario_run):
+    """``payload``: at the flange hang the tool and, while it carries one, the part: the
+    heaviest part of the cell file and the gripper's mass (the tool file's numbers) against
+    the robot's rating. (A trial's 7 kg part on the 5 kg LR Mate passed: only the tool was
+    counted.)"""
+    from sim.cells.tools import TOOLS
+
+    _, summary = scenario_run("lrmate200ic_pick_place")
+    (check,) = [c for c in summary["checks"] if c["name"] == "payload"]
+    part = max(_part_masses_from_cell_file())
+    assert check["value"] == pytest.approx(TOOLS.get("vacuum_gripper").mass_kg + part,
+                                           rel=1e-9)
+    assert f"part {part:g} kg" in check["subject"] and check["pass"]
+
+
+def test_a_part_that_takes_the_flange_over_the_rating_fails_it():
+    """The same check with a part heavy enough: tool and payload alone pass, the part fails
+    it; a torch (no part) is not charged one."""
+    from sim.analysis.verdict import run_checks
+    from sim.robots.registry import ROBOTS
+
+    spec = ROBOTS["lrmate200ic5l"]
+    n = spec.n_joints
+    arrays = {k: np.zeros((3, n)) for k in ("q", "q_ref", "qd", "qdd_ref")}
+
+    def payload(part: float) -> dict:
+        checks = run_checks(arrays, {}, spec, 1.0, torch_angle_tolerance_deg=1.0,
+                            flange_load_kg=(0.25, 0.0), held_part_kg=part)
+        return next(c.to_dict() for c in checks if c.name == "payload")
+
+    assert payload(0.0)["pass"] and payload(4.75)["pass"]
+    heavy = payload(7.0)
+    assert not heavy["pass"] and heavy["value"] == pytest.approx(7.25)
+    assert heavy["limit"] == spec.payload_kg
+
+
 @pytest.mark.slow
 def test_a_payload_over_the_gripper_s_rating_fails_the_verdict(tmp_path, capsys):
     """Issue 31: the robot's rating (5 kg) is not the gripper's: 2.5 kg at the cup and a
