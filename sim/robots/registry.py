@@ -65,13 +65,27 @@ def resolve_robot(ref: str, base: Path | None = None) -> RobotSpec:
     """
     if ref.lower().endswith(".urdf"):
         path = Path(ref) if base is None else base / ref
-        return load_urdf_robot(path)
+        return _own_name(load_urdf_robot(path), path)
     if "/" in ref or "\\" in ref or ref.endswith(".toml"):
         path = Path(ref) if base is None else base / ref
         if not (path.is_dir() and (path / "robot.toml").is_file()) and not path.is_file():
             raise KinematicsError(f"{path}: no robot folder (a folder with a robot.toml)")
-        return load_robot_folder(path)
+        return _own_name(load_robot_folder(path), path / "robot.toml" if path.is_dir() else path)
     return ROBOTS.get(ref)
+
+
+def _own_name(spec: RobotSpec, where: Path) -> RobotSpec:
+    """A robot of one's own must not take a shipped robot's name: cells are laid out for a
+    robot by name (``[robot] model``), and would take this arm for that one.
+
+    Raises:
+        KinematicsError: The name is a shipped robot's (one line naming the file).
+    """
+    if spec.name in ROBOTS.names() and spec.folder != ROBOTS.get(spec.name).folder:
+        raise KinematicsError(f"{where}: name {spec.name!r} is a shipped robot's name (cells laid "
+                              "out for that robot would take this arm for it); give your robot "
+                              "a name of its own")
+    return spec
 
 
 #: The shipped robots by name, read from ``models/*/robot.toml`` the first time it is looked

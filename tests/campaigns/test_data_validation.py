@@ -114,8 +114,10 @@ def _dh(root: Path) -> None:
 
 
 def _family(root: Path) -> None:
-    """The shipped LR Mate 200iC/5L folder (``[kinematics] family``, its own MJCF)."""
+    """The shipped LR Mate 200iC/5L folder (``[kinematics] family``, its own MJCF), under a
+    name of its own (a shipped robot's name is refused for a user's folder)."""
     shutil.copytree(MODELS / "fanuc_lrmate200ic", root / "arm")
+    _rename(root / "arm" / "robot.toml", "lrmate200ic5l")
 
 
 def _kuka(root: Path) -> None:
@@ -124,6 +126,13 @@ def _kuka(root: Path) -> None:
     shutil.copytree(MODELS / "kuka_kr6r900_2", root / "arm")
     toml = root / "arm" / "robot.toml"
     toml.write_text(toml.read_text().replace('mjcf = "kr6r900_2.xml"\n', ""))
+    _rename(toml, "kr6r900_2")
+
+
+def _rename(toml: Path, shipped: str) -> None:
+    text = toml.read_text()
+    assert text.count(f'name = "{shipped}"\n') == 1
+    toml.write_text(text.replace(f'name = "{shipped}"\n', f'name = "my_{shipped}"\n'))
 
 
 def _bare(root: Path) -> None:

@@ -1012,6 +1012,25 @@ def test_a_drive_whose_peak_is_below_its_rated_torque_is_refused(tmp_path):
     assert "robot.toml" in str(e.value) and "\n" not in str(e.value)
 
 
+@pytest.mark.parametrize("name", ["lrmate200ic5l", "kr6r900_2"])
+def test_a_robot_of_ones_own_may_not_take_a_shipped_robots_name(tmp_path, name):
+    """Cells are laid out for a robot by name ([robot] model): a DH arm of one's own named
+    after a shipped robot went into the LR Mate's pick cell, which took it for the LR Mate (a
+    trial: 42 findings). Refused in one line naming the file; the shipped folder itself,
+    given by its path, is still the shipped robot."""
+    from sim.robots.registry import ROBOTS, resolve_robot
+
+    (tmp_path / "arm").mkdir()
+    (tmp_path / "arm" / "robot.toml").write_text(DH_ROBOT.replace('"dh_arm"', f'"{name}"', 1))
+    with pytest.raises(KinematicsError, match=f"name '{name}' is a shipped robot's name") as e:
+        resolve_robot("./arm", tmp_path)
+    assert str(e.value).startswith(str(tmp_path / "arm" / "robot.toml"))
+    (tmp_path / "arm" / "robot.toml").write_text(DH_ROBOT.replace('"dh_arm"', f'"my_{name}"', 1))
+    assert resolve_robot("./arm", tmp_path).name == f"my_{name}"
+    shipped = ROBOTS.get(name)
+    assert resolve_robot(str(MODELS / shipped.folder)).name == name
+
+
 def test_a_urdf_robot_name_that_is_no_file_name_still_runs(tmp_path, monkeypatch):
     """<robot name='my/ur "5"'>: the generated model is named after the file instead."""
     from sim.robots.registry import resolve_robot
