@@ -17,7 +17,13 @@ def pct_text(m: float) -> str:
 
 
 def num_text(x: float, digits: int = 4) -> str:
-    return f"{x:.{digits}g}" if x is not None and np.isfinite(x) else "n/a"
+    """``x`` to ``digits`` significant digits, without an exponent from 10**digits up to
+    1e12 (a motor's 6000 rpm reads "6000", not "6e+03"); "n/a" for none or not finite."""
+    if x is None or not np.isfinite(x):
+        return "n/a"
+    text = f"{x:.{digits}g}"
+    rounded = float(text)
+    return f"{rounded:.0f}" if "e+" in text and abs(rounded) < 1e12 else text
 
 
 def pair_text(j: JointSizing, attr: str, motor: bool = False, digits: int = 4,

@@ -10,6 +10,8 @@ from html.parser import HTMLParser
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from support.window_oracle import sustained_peak
 
 from sim.analysis.report import REQUIRED_COLUMNS, write_atomic, write_sizing
@@ -182,3 +184,22 @@ def test_no_temporary_files_left_after_write(written) -> None:
     run_dir, *_ = written
     leftovers = [p for p in run_dir.rglob("*") if p.name.startswith(".") or p.suffix == ".tmp"]
     assert leftovers == []
+
+
+@settings(max_examples=300, deadline=None)
+@given(x=st.floats(min_value=-1e15, max_value=1e15, allow_nan=False),
+       digits=st.integers(min_value=1, max_value=6))
+def test_report_numbers_keep_their_digits_and_no_exponent_below_a_trillion(x, digits):
+    """A report's number (num_text): the value to ``digits`` significant digits, read back
+    within half a unit of its last digit, and no exponent for |x| from 1 up to 1e12 (a
+    trial's report.html read "6e+03 rpm" for a motor's 6000 rpm)."""
+    from sim.analysis.report_text import num_text
+
+    text = num_text(x, digits)
+    back = float(text)
+    if x != 0:
+        assert abs(back - x) <= 0.5 * 10 ** (math.floor(math.log10(abs(x))) + 1 - digits) \
+            * (1 + 1e-9) + 1e-300
+    if 1 <= abs(back) < 1e12:
+        assert "e" not in text, text
+    assert num_text(float("nan"), digits) == "n/a" and num_text(float("inf"), digits) == "n/a"
