@@ -105,8 +105,16 @@ def _run_arm(args: argparse.Namespace) -> int:
            "five_r": "closed form (seed 000's 5R)"}.get(
         arm.solver, f"numeric ({arm.why_numeric})")
     if not sols:
-        _no_solution(arm.name, args, "numeric solver: none found in the joint ranges"
-                     if arm.solver == "numeric" else f"{arm.solver} solver")
+        why = "numeric solver: none found in the joint ranges" if arm.solver == "numeric" \
+            else f"{arm.solver} solver"
+        if arm.opw is not None:
+            from sim.robots.kinematics.opw import reach_gap
+
+            gap, inner, outer = reach_gap(arm.opw, make_transform(R, p))
+            if gap > 1e-9:
+                why += (f"; the wrist centre is {1e3 * gap:.1f} mm outside the arm's reach, J2 "
+                        f"to wrist centre between {1e3 * inner:.1f} and {1e3 * outer:.1f} mm")
+        _no_solution(arm.name, args, why)
     shown = sols if args.all else sols[:1]
     if args.json:
         print(json.dumps({"robot": arm.name, "solver": arm.solver, "tool": None,

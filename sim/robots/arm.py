@@ -212,7 +212,13 @@ def _dedupe(sols: list[Solution]) -> list[Solution]:
 
 def arm_from_chain(chain: Chain, source: Path | None = None) -> Arm:
     """An :class:`Arm`: OPW when its axes at q = 0 make one, else offset-wrist (UR-type) when
-    they make that, else numeric."""
+    they make that, else numeric.
+
+    Raises:
+        KinematicsError: Two neighbouring joints turn about one axis line (a zero-length link
+            between them: the two are one joint, and no solver can split a turn between them).
+    """
+    _check_distinct_axes(chain, source)
     if chain.n == 6:
         axes, points, F = chain.frames(np.zeros(6))
         try:
@@ -232,6 +238,20 @@ def arm_from_chain(chain: Chain, source: Path | None = None) -> Arm:
             return Arm(chain.name, chain, None, why_numeric=str(exc), source=source)
     return Arm(chain.name, chain, None, why_numeric=f"{chain.n} joints (the closed forms are "
                "for 5 and 6)", source=source)
+
+
+def _check_distinct_axes(chain: Chain, source: Path | None) -> None:
+    """Refuse neighbouring joints on one axis line (parallel axes through a common point)."""
+    axes, points, _ = chain.frames(np.zeros(chain.n))
+    for i in range(chain.n - 1):
+        a, b = axes[i] / np.linalg.norm(axes[i]), axes[i + 1] / np.linalg.norm(axes[i + 1])
+        offset = np.linalg.norm(np.cross(points[i + 1] - points[i], a))
+        if np.linalg.norm(np.cross(a, b)) < opw.STRUCTURE_TOL and offset < opw.STRUCTURE_TOL:
+            where = f"{source}: " if source is not None else ""
+            raise KinematicsError(
+                f"{where}J{i + 1} and J{i + 2} turn about one axis line (a zero-length link "
+                "between them: nothing moves one axis off the other), so they act as one "
+                "joint; give the link between them its length")
 
 
 def chain_from_robot_file(spec: RobotFolderSpec, path: Path) -> Chain:

@@ -238,6 +238,8 @@ def robot_root(tmp_path_factory):
     (root / "dh.toml").write_text(DH_SCENARIO)
     src = ROOT / "models" / "kuka_kr6r900_2"
     shutil.copytree(src, root / "robots" / "kr6", ignore=shutil.ignore_patterns("*.py"))
+    toml = root / "robots" / "kr6" / "robot.toml"  # a user's robot takes a name of its own
+    toml.write_text(toml.read_text().replace('name = "kr6r900_2"\n', 'name = "my_kr6"\n', 1))
     (root / "urdf.toml").write_text(DH_SCENARIO.replace("robots/dh_arm", "robots/kr6").replace(
         "[[0, 0, 0, 0, 30, 0], [20, 10, -20, 10, 40, 20], [30, 20, -30, 0, 60, 0]]",
         "[[0, -90, 90, 0, 30, 0], [10, -80, 80, 10, 40, 20], [20, -70, 70, 0, 60, 0]]").replace(

@@ -228,7 +228,9 @@ def test_ik_path_branch_continuity_and_error_index():
     assert np.abs(np.diff(out, axis=0)).max() < np.deg2rad(3.0)
     bad = poses.copy()
     bad[7, :3, 3] = [3.0, 0.0, 0.0]
-    with pytest.raises(UnreachableError, match="path point 7"):
+    with pytest.raises(UnreachableError, match=r"path point 7 \(X Y Z = 3000\.0 0\.0 0\.0 mm "
+                       r"in frame 0\): .*the wrist centre is [0-9.]+ mm outside the arm's "
+                       "reach"):
         ik_path(m, bad, q_start=q0)
 
 

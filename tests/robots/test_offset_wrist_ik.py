@@ -22,7 +22,7 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from sim.errors import UnreachableError
+from sim.errors import KinematicsError, UnreachableError
 from sim.robots.arm import arm_from_chain
 from sim.robots.families.chain_family import ChainFamily
 from sim.robots.kinematics import offset_wrist
@@ -215,10 +215,8 @@ def test_whole_turn_variants_inside_ur_ranges():
 @pytest.mark.parametrize("row, col, value, why", [
     (2, 1, math.radians(10.0), "J4 is not parallel"),        # J4 tilted off J2-J3
     (1, 1, math.radians(-20.0), "J3 is not parallel"),       # J3 tilted off J2
-    (3, 1, 0.0, "J5 is parallel"),                            # J5 along J2-J4
     (4, 0, 0.05, "J5 and J6 do not meet"),                    # a5 != 0
     (4, 1, math.radians(60.0), "not perpendicular"),          # J6 oblique to J5
-    (1, 0, 0.0, "coincide"),                                  # a2 = 0: J2, J3 one axis
 ])
 def test_an_arm_that_is_not_ur_type_is_not_detected(row, col, value, why):
     rows = UR5.copy()
@@ -226,6 +224,19 @@ def test_an_arm_that_is_not_ur_type_is_not_detected(row, col, value, why):
     arm = arm_from_chain(chain_from_dh(rows))
     assert arm.solver == "numeric"
     assert why in arm.why_numeric
+
+
+@pytest.mark.parametrize("row, col, value, joints", [
+    (3, 1, 0.0, "J4 and J5"),                                 # J5 along J4: one line
+    (1, 0, 0.0, "J2 and J3"),                                 # a2 = 0: J2, J3 one axis
+])
+def test_an_arm_with_two_joints_on_one_axis_line_is_refused(row, col, value, joints):
+    """Two neighbouring joints on one axis line are one joint twice: refused (they fell back
+    to the numeric solver before, which picks one split of a turn among infinitely many)."""
+    rows = UR5.copy()
+    rows[row, col] = value
+    with pytest.raises(KinematicsError, match=f"{joints} turn about one axis line"):
+        arm_from_chain(chain_from_dh(rows))
 
 
 def test_an_opw_arm_stays_opw():

@@ -81,16 +81,28 @@ class ChainFamily(KinematicFamily):
     def _flange(self, T) -> NDArray[np.float64]:
         return np.asarray(T, dtype=float) @ np.linalg.inv(self._tool_T())
 
-    def _none(self) -> UnreachableError:
-        return UnreachableError(f"{self.arm.name}: no inverse-kinematics solution "
-                                f"({self.arm.solver} solver)", 0.0)
+    def _none(self, flange: NDArray[np.float64]) -> UnreachableError:
+        """No solution: for an OPW arm, how far the wrist centre is out of reach (as the
+        shipped FANUC family says it)."""
+        head = f"{self.arm.name}: no inverse-kinematics solution ({self.arm.solver} solver)"
+        if self.arm.opw is not None:
+            from sim.robots.kinematics.opw import reach_gap
+
+            gap, inner, outer = reach_gap(self.arm.opw, flange)
+            if gap > 1e-9:
+                return UnreachableError(
+                    f"{head}: the wrist centre is {1e3 * gap:.1f} mm outside the arm's reach "
+                    f"(J2 to wrist centre between {1e3 * inner:.1f} and {1e3 * outer:.1f} mm)",
+                    gap)
+        return UnreachableError(head, 0.0)
 
     def ik(self, T, current):
         # an offset-wrist arm gives its branches only: solve_ik lists each joint's turns (its
         # UR-style +-360 deg ranges give each branch 32 of them)
-        sols = self.arm.labelled_branches(self._flange(T), current)
+        flange = self._flange(T)
+        sols = self.arm.labelled_branches(flange, current)
         if not sols:
-            raise self._none()
+            raise self._none(flange)
         return sols
 
     def ik_continue(self, T, current):
@@ -110,9 +122,10 @@ class ChainFamily(KinematicFamily):
         return None
 
     def ik_branches(self, T, current):
-        sols = self.arm.branches(self._flange(T), current)
+        flange = self._flange(T)
+        sols = self.arm.branches(flange, current)
         if not sols:
-            raise self._none()
+            raise self._none(flange)
         return sols
 
     # ------------------------------------------------------------------ Jacobian

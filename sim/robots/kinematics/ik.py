@@ -165,14 +165,21 @@ def ik_path(model: KinematicModel, poses: Sequence[ArrayLike] | NDArray[np.float
             try:
                 raw = model.family.ik_branches(T_seed, prev)
             except UnreachableError as exc:
-                raise UnreachableError(f"path point {k}: {exc}", exc.distance) from None
+                raise UnreachableError(f"path point {k} {_at(P[k])}: {exc}",
+                                       exc.distance) from None
             q = _nearest_representation(model, raw, prev, respect_limits)
         if q is None:
-            raise UnreachableError(f"path point {k}: no IK solution inside the joint ranges",
-                                   0.0)
+            raise UnreachableError(f"path point {k} {_at(P[k])}: no IK solution inside the "
+                                   "joint ranges", 0.0)
         out[k] = q
         prev = q
     return out
+
+
+def _at(T: NDArray[np.float64]) -> str:
+    """Where a path point's tool point is: ``(X Y Z = x y z mm in frame 0)``."""
+    x, y, z = 1e3 * T[:3, 3]
+    return f"(X Y Z = {x:.1f} {y:.1f} {z:.1f} mm in frame 0)"
 
 
 #: Whole turns tried for a joint with a finite range (as :func:`_representations`).

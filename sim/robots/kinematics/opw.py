@@ -116,7 +116,7 @@ def inverse(p: OPWParameters, T: ArrayLike) -> NDArray[np.float64]:
     T = np.asarray(T, dtype=float) @ np.linalg.inv(p.flange)
     R = T[:3, :3]
     c = T[:3, 3] - p.c4 * R[:, 2]
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore"):  # NaN rows: out of reach
         nx1 = np.sqrt(c[0] ** 2 + c[1] ** 2 - p.b**2) - p.a1
         tmp1 = np.arctan2(c[1], c[0])
         tmp2 = np.arctan2(p.b, nx1 + p.a1)
@@ -166,6 +166,27 @@ def inverse(p: OPWParameters, T: ArrayLike) -> NDArray[np.float64]:
     signs = np.asarray(p.signs, dtype=float)
     q = (sols + offsets) * signs
     return np.where(np.isnan(q), np.nan, np.mod(q + np.pi, 2 * np.pi) - np.pi)
+
+
+def reach_gap(p: OPWParameters, T: ArrayLike) -> tuple[float, float, float]:
+    """How far a flange pose's wrist centre lies outside the arm's reach, m (0 inside it), and
+    the reach from J2's axis to the wrist centre, ``(gap, inner, outer)``, m: the wrist centre
+    must be ``inner`` to ``outer`` from J2's axis (J3 folds the forearm, ``sqrt(a2^2 + c3^2)``
+    long, against the upper arm, ``c2``), with the shoulder in front of J1 or behind it, and
+    at least ``b`` from J1's axis."""
+    T = np.asarray(T, dtype=float) @ np.linalg.inv(p.flange)
+    c = T[:3, 3] - p.c4 * T[:3, 2]
+    k = float(np.hypot(p.a2, p.c3))
+    inner, outer = abs(p.c2 - k), p.c2 + k
+    radial = float(np.hypot(c[0], c[1]))
+    if radial < abs(p.b):
+        return abs(p.b) - radial, inner, outer
+    nx1 = float(np.sqrt(radial**2 - p.b**2)) - p.a1
+    gaps = []
+    for x in (nx1, nx1 + 2.0 * p.a1):  # the shoulder in front of J1, behind it
+        d = float(np.hypot(x, c[2] - p.c1))
+        gaps.append(max(d - outer, inner - d, 0.0))
+    return min(gaps), inner, outer
 
 
 def configuration(p: OPWParameters, q: ArrayLike) -> str:
