@@ -214,7 +214,7 @@ class JointSelection:
         h = self.closest.hardest
         return (f"no pair passes; the closest, {self.closest.motor.id} + "
                 f"{self.closest.reducer.id}, fails {h.name} ({_fmt(h.value)} against "
-                f"{_fmt(h.limit)} {h.unit})")
+                f"{_fmt(h.limit)}{'' if h.unit == '-' else ' ' + h.unit})")
 
 
 @dataclass

@@ -243,7 +243,8 @@ class SizingResult:
         if not self.estimated_joints:
             return ""
         return (f"The torques of {', '.join(self.estimated_joints)} rest on estimated link "
-                "inertials (the robot's README says which): check them against the maker's "
+                "inertials (the robot's folder says which: its README, or its robot.toml's [mass] "
+                "and [[links]]): check them against the maker's "
                 "data before ordering.")
 
     @property

@@ -486,6 +486,14 @@ def test_a_pair_over_the_inertia_ratio_limit_does_not_pass_unless_declared_a_war
             c = next(c for c in p.checks if c.name == "inertia_ratio")
             assert c.severity == "warning"
     assert excluded > 0  # the limit bites somewhere (the test compares, not only passes)
+    # a limit no pair meets: each joint's reason names the ratio, a number without a unit
+    # (a trial read "(1.796 against 1 -)")
+    none = select_actuators(record, ids, arm, SelectionOptions(
+        cat, life_h=LIFE_H, dwell_s=DWELL_S, inertia_ratio_max=1e-3))
+    for j in none.joints:
+        assert j.chosen is None and j.reason.endswith("fails inertia_ratio (" +
+                                                      j.reason.split("(")[-1]), j.reason
+        assert j.reason.endswith(" against 0.001)"), j.reason
 
 
 _J_LOAD: dict[tuple[str, int], float] = {}

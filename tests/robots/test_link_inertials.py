@@ -221,4 +221,7 @@ def test_the_reports_name_the_joints_whose_torques_rest_on_estimates(scenario_ru
     assert doc["inertia_estimated_joints"] == joints
     sentence = f"The torques of {', '.join(joints)} rest on estimated link inertials"
     assert sentence in (out / "sizing.md").read_text()
+    # where to look, for a shipped robot and one's own folder (which has no README)
+    assert "its README, or its robot.toml's [mass] and [[links]]" in (
+        out / "sizing.md").read_text()
     assert sentence in (out / "report.html").read_text()
