@@ -19,11 +19,56 @@ This module holds every planner exception; :class:`UnknownNameError` (raised by 
 from __future__ import annotations
 
 import difflib
+import re
 from collections.abc import Iterable
+
+#: A file as messages name it: a path ending in one of cellsim's input or output suffixes.
+_FILE = re.compile(r"^\S.*\.(toml|ls|tp|urdf|xml|stl|obj|json|csv|npz|md|html|mp4)$", re.I)
+#: A key as messages name it: ``phases[2].speed_mm_s``, ``drives[5] (j6)``, ``--rank``.
+_KEY = re.compile(r"^(--[a-z][\w-]*|[A-Za-z_][\w-]*(\[-?\d+\])*( \([^()]*\))?"
+                  r"(\.[A-Za-z_][\w-]*(\[-?\d+\])*( \([^()]*\))?)*)$")
+_LINE = re.compile(r"^line (\d+)$")
+
+
+def _where(message: str) -> tuple[str | None, str | None, int | None]:
+    """``(file, key, line)`` from a one-line message's leading ``file: key: detail`` parts:
+    the last part that names a file (an error inside a file another file names is the inner
+    file's), the key right after it, a ``line N`` part; None where the message gives none."""
+    parts = message.split(": ")[:-1]  # the last part is the detail itself
+    file = key = None
+    line = None
+    for i, part in enumerate(parts):
+        if _FILE.match(part):
+            file, key, line = part, None, None
+            continue
+        found = _LINE.match(part)
+        if found:
+            line = int(found.group(1))
+        elif key is None and (file is not None or i == 0) and _KEY.match(part):
+            key = part
+    return file, key, line
 
 
 class CellsimError(Exception):
-    """Root of every cellsim exception (user mistakes and internal faults)."""
+    """Root of every cellsim exception (user mistakes and internal faults).
+
+    Attributes:
+        file: The file the mistake is in, where the message names one (an error inside a file
+            that another names: the inner one), else None.
+        key: The key, entry or option the message names right after the file (or first, when
+            it names no file): ``phases[2].speed_mm_s``, ``drives[5] (j6)``; else None.
+        line: The line number the message gives (``line 10: ...``: a TP program's), else None.
+
+    Each is read from the one-line message where the raising code does not give it.
+    """
+
+    def __init__(self, *args: object, file: str | None = None, key: str | None = None,
+                 line: int | None = None) -> None:
+        super().__init__(*args)
+        parsed = _where(args[0]) if args and isinstance(args[0], str) else (None, None, None)
+        self.file = file if file is not None else parsed[0]
+        self.key = key if key is not None else parsed[1]
+        self.line = line if line is not None else parsed[2]
 
 
 class InternalError(CellsimError, RuntimeError):
