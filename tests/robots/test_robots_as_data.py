@@ -1042,6 +1042,27 @@ def test_a_urdf_robot_name_that_is_no_file_name_still_runs(tmp_path, monkeypatch
     assert spec.name == "arm" and spec.robot_path.is_file()
 
 
+def test_every_collision_geom_of_a_generated_arm_is_named_after_its_link(dh_robot):
+    """A collision finding names the geoms that touched: a generated arm's were
+    "unnamed_geom_9" (a trial); each is now ``base_collision`` or ``link<k>_collision`` on
+    body ``link<k>``, as the compiled model shows."""
+    import mujoco
+
+    from sim.robots.robotfile import load_robot_folder
+
+    spec = load_robot_folder(dh_robot / "robots" / "dh_arm")
+    model = mujoco.MjModel.from_xml_path(str(spec.robot_path))
+    names = []
+    for g in range(model.ngeom):
+        if model.geom_group[g] != 3:  # the collision class
+            continue
+        body = model.body(model.geom_bodyid[g]).name
+        name = model.geom(g).name
+        assert name == ("base_collision" if body == "base" else f"{body}_collision"), name
+        names.append(name)
+    assert names[:2] == ["base_collision", "link1_collision"] and len(names) == 1 + 6
+
+
 def test_a_second_load_of_a_dh_robot_reuses_its_cache_without_mujoco(dh_robot):
     """The first load of a DH robot folder writes its model and derived acceleration limits
     into cellsim's cache; a second load (a new process) reads both back, identical, and does
