@@ -89,8 +89,7 @@ def _cruise_window(cart: Any) -> tuple[float, float]:
 def _phase_samples(arrays: Mapping[str, NDArray[Any]], pm: PhaseMotion) -> NDArray[np.intp]:
     """Indices of the samples in ``[t0, t1]`` of a phase, both ends included (the sample at
     ``t1`` is where the phase ends, though it counts for the next phase)."""
-    t = arrays["t"]
-    return np.flatnonzero((t >= pm.t0 - 1e-12) & (t <= pm.t1 + 1e-12))
+    return np.flatnonzero((arrays["t"] >= pm.t0 - 1e-12) & (arrays["t"] <= pm.t1 + 1e-12))
 
 
 def measure_seam_phases(arrays: Mapping[str, NDArray[Any]], motion: Motion,
@@ -517,7 +516,8 @@ def cartesian_speeds(arrays: Mapping[str, NDArray[Any]], motion: Motion,
                 v = np.linalg.norm(np.diff(ps, axis=0), axis=1) / np.diff(t[sel])
                 cruise = v[v >= 0.95 * v.max()] if v.max() > 0 else v
                 speed = float(np.median(cruise))
-        want = float(pm.phase.speed)
+        want = float(pm.cartesian.speed if getattr(pm.phase, "move_time", None) is not None
+                     else pm.phase.speed)  # a TP move in 'sec': the speed its time sets
         out.append({"phase": pm.name, "set_mm_s": want * 1e3, "cruise_mm_s": speed * 1e3,
                     "deviation_pct": (speed - want) / want * 100.0 if want > 0 else 0.0})
     return out

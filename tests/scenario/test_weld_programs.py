@@ -401,6 +401,26 @@ def tp_run(tmp_path_factory):
     return scenario, evaluate_scenario(scenario)
 
 
+def test_an_l_move_given_by_its_time_is_judged_at_the_speed_that_time_sets(tmp_path):
+    """``L P[2] 2.5sec FINE``: the move takes 2.5 s (the program's number), and the verdict's
+    cartesian_speed check compares the cruise with the speed that time sets, not with a
+    placeholder (a trial's 16.25sec weld failed at 99 % "off" a set speed of 1000 mm/s)."""
+    (tmp_path / "weld1.ls").write_text((DATA / "weld1.ls").read_text().replace(
+        "L P[2] 100mm/sec FINE", "L P[2] 2.5sec FINE"))
+    (tmp_path / "s.toml").write_text(TP_SCENARIO)
+    ev = evaluate_scenario(load_scenario(tmp_path / "s.toml"))
+    ph = phase_end(ev, "line010_L")
+    assert ph["t1"] - ph["t0"] == pytest.approx(2.5, abs=1e-6)
+    (speed,) = [c for c in ev.summary["cartesian_speed"] if c["phase"] == "line010_L"]
+    assert abs(speed["deviation_pct"]) < 1.0 and speed["set_mm_s"] < 100.0, speed
+    a = ev.record.arrays  # over the move's length and time: above the mean, ramps cost
+    sel = (a["t"] >= ph["t0"]) & (a["t"] <= ph["t1"])
+    mean = np.linalg.norm(a["tcp_pos_ref"][sel][-1] - a["tcp_pos_ref"][sel][0]) / 2.5 * 1e3
+    assert mean < speed["set_mm_s"] < 1.5 * mean, (mean, speed)
+    assert not [c for c in ev.summary["checks"] if c["name"] == "cartesian_speed"
+                and not c["pass"]]
+
+
 def phase_end(ev, name):
     names = [p["name"] for p in ev.summary["phases"]]
     return ev.summary["phases"][names.index(name)]
