@@ -15,7 +15,7 @@ import argparse
 from pathlib import Path
 
 from sim.errors import RenderError
-from sim.simulation.runfolder import VIDEO_MP4
+from sim.simulation.runfolder import VIDEO_MP4, note_written, written_by_cellsim
 
 
 def _positive_int(text: str) -> int:
@@ -97,6 +97,11 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path(args.run_dir) / VIDEO_MP4
     if out.suffix.lower() != ".mp4":
         raise RenderError(f"--out {str(out)!r} must end in .mp4")
+    if not out.parent.is_dir():
+        raise RenderError(f"--out {str(out)!r}: no such folder {str(out.parent)!r}")
+    if (out.exists() or out.is_symlink()) and not written_by_cellsim(out, args.run_dir):
+        raise RenderError(f"{out}: exists; cellsim does not overwrite files it did not write "
+                          "(remove it or choose another --out)")
     if args.plots:  # refused before the video is rendered, not after
         from sim.analysis.plots import check_plots_dir
         from sim.simulation.runfolder import PLOTS_DIR
@@ -113,10 +118,13 @@ def run(args: argparse.Namespace) -> int:
             f"frames/s, {result.jobs} process{'es' if result.jobs > 1 else ''}, OpenGL "
             f"{result.backend})"
         )
+    written = [out]
     if args.plots:
         from sim.analysis.plots import write_plots
 
         paths = write_plots(record)
+        written += list(paths)
         if not args.quiet:
             print(f"wrote {len(paths)} plots into {paths[0].parent}")
+    note_written(args.run_dir, written)  # a later run into the folder may replace them
     return 0

@@ -392,7 +392,7 @@ def run_and_write(scenario: Scenario, options: RunOptions | None = None) -> Eval
     # one writer per place: a second run into it refuses; what a killed run left goes
     with runfolder.RunLock(out_dir):
         runfolder.remove_stale(out_dir)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+        tmp = runfolder.make_folder(f".{out_dir.name}.", out_dir.parent)
         try:
             runfolder.write_marker(tmp, state="writing")
             runfolder.write_text(tmp, runfolder.MODEL_XML, built.xml)
@@ -408,7 +408,7 @@ def run_and_write(scenario: Scenario, options: RunOptions | None = None) -> Eval
                 if runfolder.is_run_folder(failed):
                     shutil.rmtree(failed)
                 elif failed.exists() or failed.is_symlink():  # not ours: never replaced
-                    failed = Path(tempfile.mkdtemp(prefix=failed.name + "-", dir=out_dir.parent))
+                    failed = runfolder.make_folder(failed.name + "-", out_dir.parent)
                     failed.rmdir()
                 os.replace(tmp, failed)
 

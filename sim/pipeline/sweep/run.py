@@ -102,7 +102,7 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
     # (the pool's workers, let go once every variant is in, are joined as the lock is left)
     with runfolder.RunLock(out_dir), contextlib.ExitStack() as closing:
         runfolder.remove_stale(out_dir)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+        tmp = runfolder.make_folder(f".{out_dir.name}.", out_dir.parent)
         try:
             runfolder.write_marker(tmp, state="writing")
             variants = make_variants(base_scenario, payloads, speed_scales, tmp)
@@ -127,8 +127,7 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
                 if runfolder.is_run_folder(failed):
                     shutil.rmtree(failed)
                 elif failed.exists() or failed.is_symlink():  # not ours: never replaced
-                    failed = Path(tempfile.mkdtemp(prefix=failed.name + "-",
-                                                   dir=out_dir.parent))
+                    failed = runfolder.make_folder(failed.name + "-", out_dir.parent)
                     failed.rmdir()
                 os.replace(tmp, failed)
                 result = moved(result, out_dir, failed)

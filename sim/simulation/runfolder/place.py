@@ -46,9 +46,90 @@ def write_marker(folder: str | Path, state: str = "complete") -> Path:
 
     from sim import __version__
 
+    if state == "complete":  # what the folder holds now is all cellsim's
+        write_text(folder, INVENTORY, "".join(f"{e}\n" for e in _entries(Path(folder))))
     return write_text(folder, MARKER, json.dumps({"written_by": "cellsim",
                                                   "cellsim": __version__, "state": state,
                                                   "pid": os.getpid()}) + "\n")
+
+
+#: The files and folders a complete run or sweep folder held when cellsim finished writing it,
+#: one relative path a line (a folder's with a trailing ``/``): what a later run may delete.
+INVENTORY = ".cellsim-files"
+
+
+def _entries(folder: Path) -> list[str]:
+    """Every file and folder under ``folder`` as relative paths (folders end in ``/``),
+    sorted; the marker and the inventory left out. Symbolic links are entries, not followed."""
+    out = []
+    for root, dirs, files in os.walk(folder):
+        rel = Path(root).relative_to(folder)
+        out += [f"{(rel / d).as_posix()}/" for d in dirs]
+        out += [(rel / f).as_posix() for f in files]
+    return sorted(e for e in out if e not in (MARKER, INVENTORY))
+
+
+def foreign_entries(folder: str | Path) -> list[str]:
+    """What a run folder cellsim wrote holds now that cellsim did not write (a colleague's
+    notes, an annotated plot): the entries missing from its :data:`INVENTORY`, a new
+    folder's contents named by the folder; [] for a folder without an inventory (written
+    before it was kept)."""
+    folder = Path(folder)
+    try:
+        known = set((folder / INVENTORY).read_text(encoding="utf-8").splitlines())
+    except (OSError, UnicodeDecodeError):
+        return []
+    extra = [e for e in _entries(folder) if e not in known]
+    dirs = [e for e in extra if e.endswith("/")]
+    return [e for e in extra if not any(e != d and e.startswith(d) for d in dirs)]
+
+
+def written_by_cellsim(path: str | Path, run_dir: str | Path) -> bool:
+    """Whether ``path`` (inside the run folder ``run_dir``) is a file cellsim wrote there: in
+    the folder's :data:`INVENTORY` (a folder without one: its own ``video.mp4`` and plots)."""
+    run, p = Path(run_dir).resolve(), Path(path).resolve()
+    if not is_run_folder(run) or run not in p.parents:
+        return False
+    rel = p.relative_to(run).as_posix()
+    try:
+        known = set((run / INVENTORY).read_text(encoding="utf-8").splitlines())
+    except (OSError, UnicodeDecodeError):
+        return rel == "video.mp4" or rel.startswith("plots/")
+    return rel in known
+
+
+def note_written(run_dir: str | Path, paths: list[Path]) -> None:
+    """Add files cellsim wrote into a finished run folder later (``cellsim render``'s video
+    and plots) to its :data:`INVENTORY`, so that they count as cellsim's."""
+    run = Path(run_dir).resolve()
+    inventory = run / INVENTORY
+    if not inventory.is_file():
+        return
+    known = inventory.read_text(encoding="utf-8").splitlines()
+    new = []
+    for path in paths:
+        p = Path(path).resolve()
+        if run not in p.parents:
+            continue
+        rel = p.relative_to(run)
+        new += [f"{a.as_posix()}/" for a in reversed(rel.parents) if a != Path(".")]
+        new.append(rel.as_posix())
+    merged = sorted(set(known) | set(new))
+    if merged != sorted(known):
+        write_text(run, INVENTORY, "".join(f"{e}\n" for e in merged))
+
+
+def make_folder(prefix: str, parent: Path) -> Path:
+    """A new hidden folder next to a run folder's place (:func:`tempfile.mkdtemp`), with the
+    permissions a folder made with ``mkdir`` gets (mkdtemp's are 0700: colleagues could not
+    open the run moved into place)."""
+    import tempfile
+
+    path = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
+    mask = os.umask(0)
+    os.umask(mask)
+    path.chmod(0o777 & ~mask)
+    return path
 
 
 def marker_state(folder: str | Path) -> str | None:
@@ -193,6 +274,13 @@ def _check_out_dir(raw: Path) -> Path:
         raise RunFolderError(f"run folder {str(target)!r} exists and was not written by cellsim "
                              f"(no {MARKER} in it); cellsim does not replace it: choose another "
                              "--out, or remove the folder yourself")
+    foreign = foreign_entries(target) if target.is_dir() else []
+    if foreign:
+        shown = ", ".join(foreign[:3]) + (f" and {len(foreign) - 3} more" if len(foreign) > 3
+                                          else "")
+        raise RunFolderError(f"run folder {str(target)!r} holds what cellsim did not write "
+                             f"({shown}); replacing the folder would delete it: move it out, or "
+                             "choose another --out")
     return target
 
 
