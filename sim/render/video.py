@@ -228,20 +228,35 @@ def check_video_args(model: Any, video_args: Mapping[str, Any]) -> None:
     resolve_jobs(video_args.get("jobs"), 1)  # a bad process count
 
 
+def max_jobs() -> int:
+    """The most processes a video may be rendered by: 4 per usable core, at least 8 (more than
+    the cores gain nothing; the bound keeps a mistyped count from exhausting the memory)."""
+    from sim.render.workers import usable_cores
+
+    return max(8, 4 * usable_cores())
+
+
 def resolve_jobs(jobs: int | None, frames: int) -> int:
     """Processes that render ``frames`` frames: ``jobs`` (at most one per frame), or by default
     one per usable core and at most one per :data:`MIN_FRAMES_PER_JOB` frames.
 
     Raises:
-        RenderError: ``jobs`` not a positive integer.
+        RenderError: ``jobs`` not a positive integer, or more than the usable cores (each
+            process holds its own OpenGL context and scene, about 60 MB: a trial's 1000 ran
+            the machine out of memory): more than :func:`max_jobs`.
     """
     from sim.render.workers import usable_cores
 
+    cores = usable_cores()
     if jobs is None:
-        return max(1, min(usable_cores(), frames // MIN_FRAMES_PER_JOB))
+        return max(1, min(cores, frames // MIN_FRAMES_PER_JOB))
     if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
         raise RenderError(f"video jobs must be a positive whole number of processes, got "
                           f"{jobs!r}")
+    if jobs > max_jobs():
+        raise RenderError(f"video jobs: at most {max_jobs()} processes (4 per core this process "
+                          f"may use, {cores}; each renders with its own OpenGL context, about "
+                          f"60 MB), got {jobs}")
     return max(1, min(int(jobs), frames))
 
 

@@ -173,6 +173,11 @@ def test_process_counts() -> None:
     for bad in (0, -1, 1.5, True, "2"):
         with pytest.raises(RenderError, match="video jobs must be a positive whole number"):
             resolve_jobs(bad, 100)  # type: ignore[arg-type]
+    # bounded: a trial's --video-jobs 1000 started 300 renderers and ran out of memory
+    top = max(8, 4 * cores)
+    assert resolve_jobs(top, 10**5) == top
+    with pytest.raises(RenderError, match=f"at most {top} processes"):
+        resolve_jobs(top + 1, 10**5)
 
 
 def test_cli_refuses_a_bad_process_count(capsys: pytest.CaptureFixture) -> None:
@@ -182,3 +187,7 @@ def test_cli_refuses_a_bad_process_count(capsys: pytest.CaptureFixture) -> None:
             main(argv)
         assert info.value.code == 2
     assert "expected at least 1 process, got 0" in capsys.readouterr().err
+    # too many: refused before anything is simulated (one line, exit 2)
+    assert main(["run", "bugnar_5r_phase1", "--video-jobs", "1000", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "video jobs: at most" in err and "got 1000" in err
