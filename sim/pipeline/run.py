@@ -41,6 +41,7 @@ from sim import __version__
 from sim.analysis.sizing import SizingResult
 from sim.analysis.verdict import run_checks, verdict, warnings_count
 from sim.errors import InternalError, RenderError, RunFolderError
+from sim.pipeline.loads import heaviest_part_kg, tool_load
 from sim.pipeline.stages import Stages
 from sim.scenario import Scenario
 from sim.simulation import runfolder
@@ -275,8 +276,8 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
                                 scenario.simulation.torch_angle_tolerance_deg),
                             flange_load_kg=(built.cell.tool.mass_kg if built.cell.tool else 0.0,
                                             scenario.payload_kg),
-                            tool_load=_tool_load(built, scenario.payload_kg),
-                            held_part_kg=_heaviest_part_kg(built),
+                            tool_load=tool_load(built, scenario.payload_kg),
+                            held_part_kg=heaviest_part_kg(built),
                             partner_loads=[(cr.name, cr.robot,
                                             cr.tool.mass_kg if cr.tool is not None else 0.0)
                                            for cr in built.cell.partners])
@@ -284,37 +285,6 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
         summary["verdict"] = verdict(checks)
         summary["warnings"] = warnings_count(checks)
     return Evaluation(summary, record, sizing, selected, built)
-
-
-def _tool_load(built: Any, payload_kg: float) -> tuple[str, float, float] | None:
-    """The tool's name, the mass it holds (the payload and the heaviest part of the cell,
-    from the compiled model) and its rating, kg; None for a tool without a rating."""
-    tool = built.cell.tool
-    if tool is None or tool.max_payload_kg is None:
-        return None
-    return tool.name, float(payload_kg) + _parts_kg(built), float(tool.max_payload_kg)
-
-
-def _parts_kg(built: Any) -> float:
-    """The heaviest part of the cell (the compiled model's mass), kg; 0 without parts."""
-    model = built.model
-    return max((float(model.body(name).mass[0]) for name in built.cell.parts
-                if _has_body(model, name)), default=0.0)
-
-
-def _heaviest_part_kg(built: Any) -> float:
-    """What a gripper adds at the flange while it carries a part: the heaviest part, kg (0 for
-    a torch or no tool)."""
-    tool = built.cell.tool
-    return _parts_kg(built) if tool is not None and tool.kind == "gripper" else 0.0
-
-
-def _has_body(model: Any, name: str) -> bool:
-    try:
-        model.body(name)
-    except KeyError:
-        return False
-    return True
 
 
 def evaluate_scenario(scenario: Scenario, options: RunOptions | None = None) -> Evaluation:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag
+from pydantic import AfterValidator, BaseModel, ConfigDict, Discriminator, Field, Tag
 
 from planners.registry import PLANNERS
 from sim.core.text import PlainText
@@ -206,12 +206,24 @@ class SimulationSpec(_Strict):
     clearance_mm: float = Field(5.0, ge=0, le=1000)
 
 
+def _even_pixels(value: int | None) -> int | None:
+    if value is not None and value % 2:
+        raise ValueError(f"must be even for H.264 yuv420p, got {value} (try {value - 1} or "
+                         f"{value + 1})")
+    return value
+
+
+#: A video tile's side, pixels: 16 to sim.render.frames.MAX_SIDE (a test keeps them equal),
+#: even (yuv420p); refused when the scenario is read, as the command line's are before a run.
+VideoSide = Annotated[int, Field(ge=16, le=8192), AfterValidator(_even_pixels)]
+
+
 class VideoSpec(_Strict):
     """Default video settings (command-line flags override them)."""
 
-    cameras: list[str] | None = None
-    width: int | None = Field(None, gt=0)
-    height: int | None = Field(None, gt=0)
+    cameras: list[str] | None = Field(None, min_length=1)
+    width: VideoSide | None = None
+    height: VideoSide | None = None
     fps: float | None = Field(None, gt=0)
     speed: float | None = Field(None, gt=0)
 

@@ -441,3 +441,29 @@ def test_knot_times_at_any_scale_plan_or_are_one_line_without_numpy_warnings(tim
             assert "phases[0].time_s[" in _err(text)
         else:
             build_motion(parse_scenario(text, source="x.toml"), None)
+
+
+@pytest.mark.parametrize("line, key, needle", [
+    ("width = 100000", "video.width", "less than or equal to 8192"),
+    ("height = 8", "video.height", "greater than or equal to 16"),
+    ("width = 641", "video.width", "must be even for H.264 yuv420p, got 641"),
+    ("cameras = []", "video.cameras", "at least 1 item"),
+])
+def test_a_bad_video_table_is_refused_when_the_scenario_is_read(tmp_path, line, key, needle):
+    """The scenario's [video] is held to the command line's rules when it is read, so the
+    error names the file and key and `cellsim check` sees it (a trial's width = 100000 said
+    only "video width must be ..." at run time, and check passed it; cameras = [] filmed the
+    overview camera)."""
+    from sim.errors import ScenarioError
+    from sim.render.frames import MAX_SIDE
+    from sim.scenario import load_scenario
+
+    assert MAX_SIDE == 8192  # the schema's bound (sim/scenario/schema.py VideoSide)
+    from sim.core.resources import scenarios_dir
+
+    text = (scenarios_dir() / "bugnar_5r_phase1.toml").read_text()
+    assert "[video]" not in text
+    path = tmp_path / "v.toml"
+    path.write_text(text + f"\n[video]\n{line}\n")
+    with pytest.raises(ScenarioError, match=rf"v\.toml: {key}: .*{needle}"):
+        load_scenario(path)
