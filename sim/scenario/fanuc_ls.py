@@ -240,7 +240,7 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
     if text.count("\n") >= MAX_PROGRAM_LINES:
         raise _err(path, MAX_PROGRAM_LINES + 1, f"more than {MAX_PROGRAM_LINES:,} lines (split "
                    "the program)")
-    lines = text.splitlines()
+    lines = text.removeprefix("\ufeff").splitlines()  # a Windows editor's byte-order mark
     prog = LSProgram(name="", path=Path(path))
     section = None
     i = 0
@@ -255,12 +255,12 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
         i += 1
         if not s:
             continue
-        if s.startswith("/PROG"):
+        if s.upper().startswith("/PROG"):  # headers in any case, as the instructions
             prog.name = s.split(None, 1)[1].split()[0] if len(s.split()) > 1 else ""
             section = "prog"
             continue
         if s.startswith("/"):
-            key = s.split()[0]
+            key = s.split()[0].upper()
             if key not in ("/ATTR", "/MN", "/POS", "/END", "/APPL", "/APPL_END"):
                 _warn(prog.warnings, ln, f"section {key} not read")
             section = key
@@ -353,7 +353,7 @@ def parse_ls(text: str, path: str | Path = "<program>") -> LSProgram:
             _warn(prog.warnings, ln, f"instruction not simulated: {body}")
             continue
         if section == "/POS":
-            m = re.match(r"^P\[\s*(\d+)\s*(?::[^\]]*)?\]\s*\{\s*$", s)
+            m = re.match(r"^P\[\s*(\d+)\s*(?::[^\]]*)?\]\s*\{\s*$", s, re.I)
             if not m:
                 raise _err(path, ln, f"a position ('P[n]{{') expected, got {s!r}")
             block = []

@@ -925,3 +925,28 @@ def test_a_linear_or_circular_move_honours_its_config(tmp_path, which, config):
                        rf"CONFIG 'N U T, {turns}' but its position says "
                        rf"'{config[0]} {config[1]} {config[2]}, {turns}'"):
         _plan_program(tmp_path, text)
+
+
+@pytest.mark.parametrize("edit", ["byte-order mark", "lower-case headers and positions"])
+def test_a_program_as_an_editor_saves_it_reads_as_the_original(edit):
+    """A byte-order mark (Windows editors write one) and lower-case section headers and
+    position blocks (as lower-case instructions already were) read as the original file:
+    the same moves and the same positions (a trial: "text outside a section" and "no /PROG
+    line" on the line after the header)."""
+    import dataclasses
+    import re
+
+    from sim.scenario.fanuc_ls import parse_ls
+
+    text = (DATA / "weld1.ls").read_text()
+    if edit == "byte-order mark":
+        changed = "\ufeff" + text
+    else:
+        changed = re.sub(r"^/(PROG|ATTR|MN|POS|END)", lambda m: "/" + m.group(1).lower(), text,
+                         flags=re.M)
+        changed = re.sub(r"^P\[", "p[", changed, flags=re.M)
+        assert changed.count("/pos") == 1 and changed.count("p[") >= 2
+    a, b = parse_ls(text, "weld1.ls"), parse_ls(changed, "weld1.ls")
+    assert b.name == a.name and b.instructions == a.instructions
+    assert {k: dataclasses.asdict(v) for k, v in b.positions.items()} == {
+        k: dataclasses.asdict(v) for k, v in a.positions.items()}
