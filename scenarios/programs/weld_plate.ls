@@ -1,6 +1,6 @@
-/PROG  WELD_PLATE
+/PROG  LRMATE200IC_WELD_PLATE
 /ATTR
-COMMENT		= "plate weld";
+COMMENT		= "lrmate200ic_weld";
 PROG_SIZE	= 0;
 FILE_NAME	= ;
 VERSION		= 0;
@@ -48,7 +48,7 @@ P[4]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
 	X =    432.500  mm,	Y =   -270.260  mm,	Z =      0.000  mm,
-	W =   -180.000 deg,	P =    -10.000 deg,	R =    -32.000 deg
+	W =    180.000 deg,	P =    -10.000 deg,	R =    -32.000 deg
 };
 P[5]{
    GP1:
@@ -72,7 +72,7 @@ P[8]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'N U T, 0, 0, 0',
 	X =    469.846  mm,	Y =    171.010  mm,	Z =   -150.000  mm,
-	W =    135.000 deg,	P =      0.000 deg,	R =    135.000 deg
+	W =    135.000 deg,	P =      0.000 deg,	R =    110.000 deg
 };
 P[9]{
    GP1:

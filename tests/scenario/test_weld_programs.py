@@ -950,3 +950,16 @@ def test_a_program_as_an_editor_saves_it_reads_as_the_original(edit):
     assert b.name == a.name and b.instructions == a.instructions
     assert {k: dataclasses.asdict(v) for k, v in b.positions.items()} == {
         k: dataclasses.asdict(v) for k, v in a.positions.items()}
+
+
+def test_the_shipped_tp_program_is_what_export_writes(tmp_path):
+    """scenarios/programs/weld_plate.ls is documented as `cellsim export
+    lrmate200ic_weld_plate`'s output: a trial found it had drifted (the C move's via point
+    R 135 against 110 deg); byte for byte, it is that export."""
+    from sim.cli import main
+    from sim.core.resources import scenarios_dir
+
+    out = tmp_path / "weld_plate.ls"
+    assert main(["export", "lrmate200ic_weld_plate", "--format", "fanuc-ls", "--out",
+                 str(out)]) == 0
+    assert out.read_text() == (scenarios_dir() / "programs" / "weld_plate.ls").read_text()
