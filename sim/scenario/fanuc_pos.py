@@ -412,7 +412,9 @@ def format_default_group(groups: tuple[int, ...] | list[int]) -> str:
 
 
 def _fmt(v: float) -> str:
-    return f"{v:10.3f}"
+    """A position value to 3 decimals; a value that rounds to zero is written 0.000, not
+    -0.000 (a re-exported imported program showed those)."""
+    return f"{round(float(v), 3) + 0.0:10.3f}"
 
 
 def _axis(name: str, value_si: float, unit: str) -> str:

@@ -963,3 +963,12 @@ def test_the_shipped_tp_program_is_what_export_writes(tmp_path):
     assert main(["export", "lrmate200ic_weld_plate", "--format", "fanuc-ls", "--out",
                  str(out)]) == 0
     assert out.read_text() == (scenarios_dir() / "programs" / "weld_plate.ls").read_text()
+
+
+@given(st.floats(-1e4, 1e4, allow_nan=False))
+def test_a_position_value_is_written_without_a_negative_zero(v):
+    """A TP position's numbers: 3 decimals, read back within 0.0005, and never "-0.000"."""
+    from sim.scenario.fanuc_pos import _fmt
+
+    text = _fmt(v)
+    assert abs(float(text) - v) <= 0.0005 + 1e-12 and text.strip() != "-0.000"
