@@ -62,6 +62,7 @@ from sim.scenario.fanuc_pos import (
     parse_default_group,
     parse_position,
 )
+from sim.scenario.schema import MAX_TCP_SPEED_MM_S
 
 
 @dataclass(frozen=True)
@@ -445,6 +446,11 @@ def _check_motion(mo: LSMotion, path, ln: int) -> None:
         raise _err(path, ln, f"speed {mo.speed:g} {mo.unit}: must be > 0")
     if mo.unit == "%" and mo.speed > 100:
         raise _err(path, ln, f"speed {mo.speed:g} %: at most 100")
+    mm_s = mo.speed * {"mm/sec": 1.0, "cm/min": 10.0 / 60.0, "inch/min": 25.4 / 60.0}.get(
+        mo.unit, 0.0)
+    if mm_s > MAX_TCP_SPEED_MM_S:
+        raise _err(path, ln, f"speed {mo.speed:g} {mo.unit}: at most "
+                   f"{MAX_TCP_SPEED_MM_S:g} mm/sec (a tool point's speed)")
     if mo.cnt is not None and not 0 <= mo.cnt <= 100:
         raise _err(path, ln, f"CNT{mo.cnt}: 0..100")
 

@@ -104,12 +104,17 @@ class WeaveSpec(_Strict):
     dwell_s: float = Field(0.0, ge=0)
 
 
+#: The fastest a tool point may be asked to travel, mm/s: industrial arms reach a few m/s; a
+#: larger value is a typo, and 1e308 overflowed the planner's arithmetic.
+MAX_TCP_SPEED_MM_S = 10_000.0
+
+
 class _CartesianSpec(_Strict):
     name: str = Field(pattern=_NAME_PATTERN)
     planner: PlannerName = "434"
     seam: str | None = None
     to_mm: Vec3 | None = None
-    speed_mm_s: float = Field(gt=0)
+    speed_mm_s: float = Field(gt=0, le=MAX_TCP_SPEED_MM_S)
     sample_period_s: float = Field(0.1, gt=0)
     ramp_s: float | None = Field(None, gt=0)
     euler_zyx_deg: Vec3 | None = None
@@ -285,7 +290,8 @@ class _WorkSpec(_Strict):
     program_frames: dict[str, str] = Field({}, description="user frame number -> cell object")
     program_registers: dict[str, list[float]] = Field(
         {}, description="position register number -> [X, Y, Z, W, P, R] (mm, deg)")
-    program_weld_speed_mm_s: float | None = Field(None, gt=0, description="the speed of the "
+    program_weld_speed_mm_s: float | None = Field(None, gt=0, le=MAX_TCP_SPEED_MM_S,
+                                                  description="the speed of the "
                                                   "program's WELD_SPEED moves, mm/s")
 
 

@@ -467,3 +467,21 @@ def test_a_bad_video_table_is_refused_when_the_scenario_is_read(tmp_path, line, 
     path.write_text(text + f"\n[video]\n{line}\n")
     with pytest.raises(ScenarioError, match=rf"v\.toml: {key}: .*{needle}"):
         load_scenario(path)
+
+
+@pytest.mark.parametrize("value", ["1e308", "10000.5"])
+def test_a_tool_point_speed_past_10_m_s_is_refused_in_one_line(tmp_path, value):
+    """speed_mm_s = 1e308 overflowed the planner (a stray numpy warning, then "knot times must
+    be strictly increasing"): at most MAX_TCP_SPEED_MM_S, named with its key."""
+    from sim.core.resources import scenarios_dir
+    from sim.errors import ScenarioError
+    from sim.scenario import load_scenario
+
+    text = (scenarios_dir() / "lrmate200ic_weld_plate.toml").read_text()
+    head, _, rest = text.partition("speed_mm_s = 8.0")
+    path = tmp_path / "fast.toml"
+    path.write_text(head + f"speed_mm_s = {value}" + rest)
+    phase = head.count("[[phases]]") - 1
+    with pytest.raises(ScenarioError, match=rf"fast\.toml: phases\[{phase}\]\.speed_mm_s: must "
+                       "be less than or equal to 10000"):
+        load_scenario(path)
