@@ -59,6 +59,15 @@ from sim.errors import CellsimError
 _EPS = 1e-9
 
 
+def _cross3(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``np.cross(a, b)`` of two float 3-vectors, bit for bit (the same products and
+    differences, in Python floats: no fused multiply-add either way), without ``np.cross``'s
+    per-call set-up (a seam's tool-point path takes thousands)."""
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 def _unit(v: ArrayLike, what: str) -> NDArray[np.float64]:
     v = np.asarray(v, dtype=float)
     n = float(np.linalg.norm(v))
@@ -314,7 +323,7 @@ class Seam:
             raise CellsimError(f"seam {self.name!r}: the surface normal runs along the seam at "
                                f"{s * 1e3:.1f} mm from its start (it must be across the seam)")
         n = n / np.linalg.norm(n)
-        e = self.torch_side * np.cross(n, t)
+        e = self.torch_side * _cross3(n, t)
         w = np.deg2rad(self.torch_work_angle_deg)
         tau = np.deg2rad(self.torch_travel_angle_deg)
         a_perp = -(np.cos(w) * n + np.sin(w) * e)

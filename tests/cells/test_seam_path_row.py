@@ -90,3 +90,25 @@ def test_planted_standoff_sign_is_caught(monkeypatch: pytest.MonkeyPatch) -> Non
                 surface_normal=[0, 0, 1], standoff_m=0.01)
     assert _rows_differ(seam, [0.5])
     seam_measure.clear_caches()
+
+
+_components = st.one_of(st.floats(allow_nan=False, allow_infinity=False, width=64),
+                        st.sampled_from([0.0, -0.0, 1.0, -1.0, 1e-310, 1e300]))
+
+
+@settings(max_examples=300, deadline=None)
+@given(a=st.lists(_components, min_size=3, max_size=3),
+       b=st.lists(_components, min_size=3, max_size=3))
+def test_the_seams_cross_product_is_numpys_bit_for_bit(a: list[float], b: list[float]) -> None:
+    """The torch axis's cross product (``_cross3``, in Python floats: issue 29, a seam's path
+    of thousands of rows) gives ``np.cross``'s bits, signed zeros, overflow and
+    subnormals included."""
+    x, y = np.array(a), np.array(b)
+    with np.errstate(all="ignore"):
+        want = np.cross(x, y)
+    assert _same(seam_module._cross3(x, y), want)
+
+
+def test_planted_cross_product_order_is_caught() -> None:
+    x, y = np.array([0.3, -1.2, 2.0]), np.array([1.5, 0.25, -0.7])
+    assert not _same(seam_module._cross3(y, x), np.cross(x, y))
