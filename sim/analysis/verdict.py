@@ -285,6 +285,20 @@ def _who(entry: Mapping[str, Any]) -> str:
     return f"{entry['robot']}: " if entry.get("robot") else ""
 
 
+def check_line(check: Mapping[str, Any]) -> str:
+    """One failed check of ``summary.json`` in words: its name, what it is about, and its value
+    against its limit; a drive's saturation as how far the demand went over the drive's limit
+    (its limit is no torque over it), a collision as its depth (none is allowed)."""
+    who = check.get("subject") or check.get("joint") or ""
+    head = f"{check['name']} {who}".rstrip()
+    value, unit = float(check["value"]), check["unit"]
+    if check["name"] == "saturation":
+        return f"{head}: demand up to {value:.4g} {unit} over the drive's limit"
+    if check["name"] == "collision":
+        return f"{head}: {value:.1f} {unit} deep"
+    return f"{head}: {value:.4g} {unit} against the limit {float(check['limit']):.4g} {unit}"
+
+
 def verdict(checks: Sequence[RunCheck]) -> str:
     """``"pass"`` when every check of severity ``error`` passed, else ``"fail"``."""
     return "pass" if all(c.passed for c in checks if c.severity == "error") else "fail"

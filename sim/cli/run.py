@@ -89,6 +89,7 @@ def run(args: argparse.Namespace) -> int:
         from sim.render.gl import configure_gl
 
         configure_gl(args.gl)
+    from sim.analysis.verdict import check_line
     from sim.cli.size import selection_overrides
     from sim.pipeline.run import RunOptions, default_out_dir, run_scenario
     from sim.scenario import load_scenario
@@ -172,13 +173,11 @@ def run(args: argparse.Namespace) -> int:
               f"({collision_phase(c)}), {c['depth_mm']:.1f} mm deep ({c['geoms'][0]}, "
               f"{c['geoms'][1]})")
     for c in warned:
-        print(f"  warning: {c['name']} {c.get('subject') or c['joint']}: {c['value']:.4g} "
-              f"{c['unit']} against the limit {c['limit']:.4g} {c['unit']}")
+        print(f"  warning: {check_line(c)}")
     if failed:
         print(f"  verdict: FAIL ({len(failed)} check(s) failed, {len(warned)} warning(s))")
         for c in failed:
-            print(f"    {c['name']} {c.get('subject') or c['joint']}: {c['value']:.4g} "
-                  f"{c['unit']} against the limit {c['limit']:.4g} {c['unit']}")
+            print(f"    {check_line(c)}")
     else:
         print(f"  verdict: pass ({len(checks)} checks, {len(warned)} warning(s))")
     expected = _expectation(scenario.expect, summary.get("verdict"))

@@ -189,11 +189,13 @@ FAILED_CHECKS_LISTED = 3
 
 def failed_checks_text(summary: Mapping[str, Any]) -> str:
     """Why a variant's verdict failed, for its rows: each failed check of severity error as
-    ``name: subject`` (``tool_payload: the vacuum_gripper holds 2.75 kg, rated 2.04 kg``),
-    the first :data:`FAILED_CHECKS_LISTED`, then how many more; "" when none failed."""
+    ``name: subject`` (``tool_payload: the vacuum_gripper holds 2.75 kg, rated 2.04 kg``), or
+    ``name: joint`` for a joint's check without a subject (``saturation: j2``), the first
+    :data:`FAILED_CHECKS_LISTED`, then how many more; "" when none failed."""
     failed = [c for c in summary.get("checks", ())
               if not c.get("pass", True) and c.get("severity", "error") == "error"]
-    text = "; ".join(f"{c.get('name', '?')}: {c.get('subject', '')}".rstrip(": ")
+    text = "; ".join(f"{c.get('name', '?')}: {c.get('subject') or c.get('joint') or ''}"
+                     .rstrip(": ")
                      for c in failed[:FAILED_CHECKS_LISTED])
     more = len(failed) - FAILED_CHECKS_LISTED
     return text + (f"; and {more} more" if more > 0 else "")
