@@ -275,7 +275,7 @@ def run_variants(runner: Callable[[Variant], Any], variants: list[Variant], work
                 raise
             if closing is None:
                 pool.shutdown(wait=True)
-            else:  # every result is in: the workers exit while the report is written
+            else:  # every result is in: the workers leave (os._exit) while the report is written
                 leaving = threading.Thread(target=pool.shutdown, name="sweep-pool-shutdown",
                                            daemon=True)
                 leaving.start()
