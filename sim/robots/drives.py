@@ -11,10 +11,16 @@ torque-speed curve, the motor torque of a joint torque) is :mod:`sim.robots.driv
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from sim.core.tomlschema import (
+    EFFICIENCY,
+    GEAR_RATIO,
+    ROTOR_INERTIA_KG_M2,
+    SPEED_RPM,
+    TORQUE_NM,
+)
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.robots.drive import Drive
 
@@ -33,21 +39,17 @@ DRIVE_KEYS = {
 _KEY_OF_FIELD = {v: k for k, v in DRIVE_KEYS.items()}
 
 
+#: The range of each drive field (the robot file's and the mechanism file's: a gear ratio of
+#: 1e308 is a typo, and would only fail later, in the model's armature or force range).
+_QUANTITY = {"gear_ratio": GEAR_RATIO, "efficiency": EFFICIENCY,
+             "rotor_inertia": ROTOR_INERTIA_KG_M2, "rated_torque": TORQUE_NM,
+             "peak_torque": TORQUE_NM, "max_speed_rpm": SPEED_RPM}
+
+
 def _check_drive(d: Drive, where: str) -> None:
     k = _KEY_OF_FIELD
     for name in _DRIVE_FIELDS:
-        v = getattr(d, name)
-        if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
-            raise ScenarioError(f"{where}.{k[name]}: must be a finite number, got {v!r}")
-    if d.gear_ratio <= 0:
-        raise ScenarioError(f"{where}.gear_ratio: must be > 0, got {d.gear_ratio!r}")
-    if not 0 < d.efficiency <= 1:
-        raise ScenarioError(f"{where}.efficiency: must be in (0, 1], got {d.efficiency!r}")
-    if d.rotor_inertia < 0:
-        raise ScenarioError(f"{where}.rotor_inertia_kg_m2: must be >= 0, got {d.rotor_inertia!r}")
-    for name in ("rated_torque", "peak_torque", "max_speed_rpm"):
-        if getattr(d, name) <= 0:
-            raise ScenarioError(f"{where}.{k[name]}: must be > 0, got {getattr(d, name)!r}")
+        _QUANTITY[name].read(getattr(d, name), f"{where}.{k[name]}", ScenarioError)
     if d.peak_torque < d.rated_torque:
         raise ScenarioError(f"{where}.peak_torque_nm: {d.peak_torque!r} N m is below "
                             f"rated_torque_nm {d.rated_torque!r} N m")

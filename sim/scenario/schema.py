@@ -16,6 +16,13 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Discriminator, Field
 
 from planners.registry import PLANNERS
 from sim.core.text import PlainText
+from sim.core.tomlschema import (
+    EFFICIENCY,
+    GEAR_RATIO,
+    ROTOR_INERTIA_KG_M2,
+    SPEED_RPM,
+    TORQUE_NM,
+)
 
 #: Names (scenario, phases) are plain folder names: letters, digits, ``_ . -``, not starting
 #: with a dot (``.`` and ``..`` would make the default run folder the working directory or
@@ -236,12 +243,13 @@ class VideoSpec(_Strict):
 class DriveOverrideSpec(_Strict):
     """Drive-train values of one joint that replace the robot's defaults."""
 
-    gear_ratio: float | None = Field(None, gt=0)
-    efficiency: float | None = Field(None, gt=0, le=1)
-    rotor_inertia_kg_m2: float | None = Field(None, ge=0)
-    rated_torque_nm: float | None = Field(None, gt=0)
-    peak_torque_nm: float | None = Field(None, gt=0)
-    max_speed_rpm: float | None = Field(None, gt=0)
+    # the ranges of a robot file's [[drives]] (docs/robot-format.md)
+    gear_ratio: GEAR_RATIO.type | None = None
+    efficiency: EFFICIENCY.type | None = None
+    rotor_inertia_kg_m2: ROTOR_INERTIA_KG_M2.type | None = None
+    rated_torque_nm: TORQUE_NM.type | None = None
+    peak_torque_nm: TORQUE_NM.type | None = None
+    max_speed_rpm: SPEED_RPM.type | None = None
 
 
 class SizingSpec(_Strict):
