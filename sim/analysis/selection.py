@@ -192,6 +192,7 @@ class JointSelection:
         out: dict[str, Any] = {
             "motor": self.chosen.motor.id if self.chosen else None,
             "reducer": self.chosen.reducer.id if self.chosen else None,
+            "ratio": self.chosen.reducer.spec.ratio if self.chosen else None,
             "checks": [c.to_dict() for c in self.chosen.checks] if self.chosen else [],
             "runner_up": self.runner_up.to_dict() if self.runner_up else None,
             "pairs_checked": self.n_pairs,

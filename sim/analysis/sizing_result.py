@@ -338,8 +338,9 @@ class SizingResult:
                 "mean_abs_power": "1/T int |tau qd| dt",
                 "mean_power": "1/T int tau qd dt (net)",
                 "energy": "int |tau qd| dt per cycle; net_energy = int tau qd dt",
-                "motor_torque": "(tau - armature qdd)/(N eta) + J_r N qdd when motoring, "
-                                "(tau - armature qdd) eta/N + J_r N qdd when power flows back",
+                "motor_torque": "(tau - armature qdd)/(N eta) + J_r N qdd when motoring or at "
+                                "standstill (|qd| < 1e-3 rad/s), (tau - armature qdd) eta/N + "
+                                "J_r N qdd when power flows back",
                 "margin_pct": "(limit - used)/limit*100; pass when >= 0",
                 "peak_envelope": f"peak torque to {PEAK_KNEE_FRACTION:g} x max speed, then linear "
                                  "to the rated torque at max speed",

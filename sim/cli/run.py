@@ -96,12 +96,12 @@ def run(args: argparse.Namespace) -> int:
     from sim.simulation.collisions import collision_phase
 
     scenario = load_scenario(args.scenario)
-    select = selection_overrides(args)
+    select = selection_overrides(args, scenario.sizing.select)
     selection = None
-    if select is not None or scenario.sizing.select:
+    if select is not None:
         from sim.pipeline.run import selection_options
 
-        selection = selection_options(scenario, **(select or {}))
+        selection = selection_options(scenario, **select)
     options = RunOptions(
         out_dir=args.out,
         video=not args.no_video,

@@ -134,8 +134,9 @@ def add_selection_args(p: argparse.ArgumentParser) -> None:
     """The actuator-selection flags (shared by ``cellsim size`` and ``cellsim run``)."""
     g = p.add_argument_group(
         "actuator selection", "choose a motor and a reducer per joint from a catalogue over "
-        "the duty cycle (selection.json, selection.csv, a report section); defaults from the "
-        "scenario's [sizing] table")
+        "the duty cycle (selection.json, selection.csv, a report section; a sweep's one row per "
+        "variant and joint); defaults from the "
+        "scenario's [sizing] table, which the flags override")
     g.add_argument("--select", action="store_true",
                    help="choose motors and reducers (also on when the scenario says "
                         "[sizing] select = true)")
@@ -154,13 +155,27 @@ def add_selection_args(p: argparse.ArgumentParser) -> None:
                         "inertia_ratio = \"warning\"")
 
 
-def selection_overrides(args: argparse.Namespace) -> dict | None:
-    """The selection flags given, or None when no selection was asked for."""
-    if not getattr(args, "select", False):
-        return None
-    return {"catalog": None if args.catalog is None else str(args.catalog),
-            "life_h": args.life_h, "dwell_s": args.dwell_s, "rank": args.rank,
-            "inertia_ratio_max": args.inertia_ratio_max}
+def selection_overrides(args: argparse.Namespace, scenario_selects: bool = False
+                        ) -> dict | None:
+    """The selection flags given (over the scenario's ``[sizing]`` keys), or None when no
+    selection was asked for (no ``--select`` and no ``[sizing] select = true``).
+
+    Raises:
+        CellsimError: A selection flag (``--catalog``, ``--life-h``, ...) without a selection
+            to apply it to: it would do nothing.
+    """
+    from sim.errors import CellsimError
+
+    flags = {"catalog": None if args.catalog is None else str(args.catalog),
+             "life_h": args.life_h, "dwell_s": args.dwell_s, "rank": args.rank,
+             "inertia_ratio_max": args.inertia_ratio_max}
+    if getattr(args, "select", False) or scenario_selects:
+        return flags
+    given = [f"--{k.replace('_', '-')}" for k, v in flags.items() if v is not None]
+    if given:
+        raise CellsimError(f"{', '.join(given)}: for an actuator selection; give --select too "
+                           "(or [sizing] select = true in the scenario)")
+    return None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -178,12 +193,12 @@ def run(args: argparse.Namespace) -> int:
         raise CellsimError(f"--workers must be at least 1, got {args.workers}")
     out = args.out or Path("runs") / f"{scenario.name}_sweep"
     workers = args.workers or os.cpu_count() or 1
-    select = selection_overrides(args)
+    select = selection_overrides(args, scenario.sizing.select)
     selection = None
-    if select is not None or scenario.sizing.select:  # loaded once; a bad one fails here
+    if select is not None:  # loaded once; a bad one fails here
         from sim.pipeline.run import selection_options
 
-        selection = selection_options(scenario, **(select or {}))
+        selection = selection_options(scenario, **select)
     if args.plots and not args.keep_runs:
         raise CellsimError("--plots draws each variant's run folder: give --keep-runs too")
     if args.address is not None and args.engine != "ray":
@@ -209,7 +224,8 @@ def run(args: argparse.Namespace) -> int:
                        progress=not args.quiet, engine=args.engine, address=args.address,
                        batch=batch)
     print(f"{len(result.outcomes)} variants in {result.wall_s:.1f} s on {result.workers} "
-          f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.png)")
+          f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.png"
+          f"{', selection.csv, selection.json' if 'selection_csv' in result.files else ''})")
     for o in result.outcomes:  # simulated and sized, but not physically possible: said here too
         if o.rows and o.rows[0].get("verdict") == "fail":
             print(f"  verdict fail, {o.variant.label}: {o.rows[0].get('failed_checks') or 'fail'}")

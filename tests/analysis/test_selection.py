@@ -323,8 +323,9 @@ def test_size_select_writes_the_selection_in_each_variant(tmp_path, small_catalo
                "--dwell-s", "2", "--life-h", "10000", "--out", str(out), "--workers", "1",
                "--quiet", "--keep-runs"])
     assert rc == 0
-    runs = [p.parent for p in out.rglob("selection.json")]  # --keep-runs: one folder each
-    assert len(runs) == 1
+    # --keep-runs: one run folder each, and the sweep's own selection.json of every variant
+    runs = [p.parent for p in out.rglob("selection.json") if p.parent != out]
+    assert len(runs) == 1 and (out / "selection.json").is_file()
     doc = json.loads((runs[0] / "selection.json").read_text())
     assert doc["dwell_s"] == 2.0 and doc["life_h"] == 10000.0
     assert "Actuator selection" in (runs[0] / "report.html").read_text()
@@ -333,10 +334,13 @@ def test_size_select_writes_the_selection_in_each_variant(tmp_path, small_catalo
     rc = main(["size", "lrmate200ic_pick_place", "--select", "--catalog", str(small_catalog),
                "--dwell-s", "2", "--life-h", "10000", "--out", str(tmp_path / "m"),
                "--workers", "1", "--quiet"])
-    assert rc == 0 and not list((tmp_path / "m").rglob("selection.json"))
+    assert rc == 0 and not list((tmp_path / "m").glob("*/selection.json"))
     printed = capsys.readouterr().out
     chosen = next(iter(doc["joints"].values()))
     assert "selection, payload" in printed and chosen["motor"] in printed
+    # the sweep's selection.json holds each variant's choice, the same as its run folder's
+    swept = json.loads((tmp_path / "m" / "selection.json").read_text())["variants"]
+    assert swept[0]["selection"]["joints"] == doc["joints"]
 
 
 #: Words with which a source says a number was not read in it.

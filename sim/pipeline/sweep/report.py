@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from sim.analysis.report import csv_text, figure_png, write_atomic
+from sim.pipeline.sweep.selection_report import selection_markdown, write_selection
 from sim.pipeline.sweep.variants import SweepResult
 
 #: Columns of sweep.csv, in order.
@@ -71,6 +72,7 @@ def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
                   "impossible or out of the robot's or tool's rating: why, per variant.", ""]
         parts += [f"- {label}: {why or 'fail'}" for label, why in verdicts]
         parts.append("")
+    parts += selection_markdown(result)
     if result.failures:
         parts += ["## Failed variants", ""]
         parts += [f"- {o.variant.label}: {o.error}" for o in result.failures]
@@ -169,7 +171,8 @@ def warm_chart() -> None:
 
 
 def write_sweep(out_dir: str | Path, result: SweepResult) -> dict[str, Path]:
-    """Write ``sweep.csv``, ``sweep.json``, ``sweep.png`` (when any variant succeeded) and
+    """Write ``sweep.csv``, ``sweep.json``, ``sweep.png`` (when any variant succeeded),
+    ``selection.csv`` and ``selection.json`` (when the variants made an actuator selection) and
     ``sweep.md`` into ``out_dir`` (atomically). Returns the paths by name."""
     out = Path(out_dir)
     files: dict[str, Path] = {}
@@ -188,6 +191,7 @@ def write_sweep(out_dir: str | Path, result: SweepResult) -> dict[str, Path]:
     if rows:
         files["png"] = write_atomic(out / "sweep.png", sweep_chart(result))
         chart = "sweep.png"
+    files.update(write_selection(out, result))
     files["md"] = write_atomic(out / "sweep.md", sweep_markdown(result, chart))
     return files
 
