@@ -3,6 +3,8 @@
 The scenario is planned as for a run (no simulation), and each phase becomes TP instructions
 that :mod:`sim.scenario.program` reads back to the same tool path at every programmed point:
 
+* a joint phase that does not move (a hold where a program must start with a move):
+  ``J P[n] t sec FINE`` to where it is, ``t`` its duration;
 * a joint phase: ``J P[n] x% FINE`` to its end, a joint position in the controller's
   convention (:mod:`sim.robots.maker`), ``x`` the phase's largest peak joint speed as a share
   of that joint's limit (rounded up to a whole percent, at least 1); its via knots are not
@@ -269,6 +271,13 @@ def _export_robot(scenario: Scenario, work: Scenario, motion: Motion, ctx: Carte
         q_end = np.asarray(motion.at(pm.t1).q[0], dtype=float)
         if isinstance(ph, HoldPhase):
             ins.append(LSOther("wait", ph.duration))
+        elif isinstance(ph, JointPhase) and _still(pm):
+            # a joint phase that does not move (a hold at the start, where a program must
+            # begin with a move; a robot's wait for another's): J to where it is, in its time
+            k = add_pos(q_end[n:], joints_deg=tuple(
+                float(v) for v in np.rad2deg(to_maker(robot, q_end[:n]))))
+            ins.append(LSMotion("J", ("P", k), float(f"{pm.t1 - pm.t0:.6g}"), "sec", None,
+                                line=0))
         elif isinstance(ph, JointPhase):
             ts = np.linspace(pm.t0, pm.t1, 401)
             peak = np.abs(pm.trajectory.at(ts).qd).max(axis=0)
@@ -321,6 +330,18 @@ def _export_robot(scenario: Scenario, work: Scenario, motion: Motion, ctx: Carte
                     for obj, k in user_frames.items()]
     table = write_weave_schedules(schedules, name.upper()) if schedules else None
     return write_ls(name, ins, positions, comment=work.name), notes, table
+
+
+#: A joint phase whose joints (and axes) stay within this of where it starts, rad (m), is a
+#: hold: exported as ``J P[n] t sec`` to where it is.
+STILL_TOL = 1e-9
+
+
+def _still(pm: PhaseMotion) -> bool:
+    """Whether a joint phase's robot joints and axes stay where the phase starts (sampled at
+    401 instants, within :data:`STILL_TOL`)."""
+    q = np.asarray(pm.trajectory.at(np.linspace(pm.t0, pm.t1, 401)).q, dtype=float)
+    return bool(np.max(np.abs(q - q[0])) <= STILL_TOL)
 
 
 def _axes_move(motion: Motion, pm: PhaseMotion, n: int) -> bool:
