@@ -10,12 +10,12 @@ frames (``<name>_tcp_pos``/``_tcp_quat``, ``<name>_arc_on``), its own phases and
 tool follows them (``context.partners[name]``); their entries join ``summary["weld"]``,
 ``["cartesian_speed"]`` and ``["weave"]`` with ``"robot": "<name>"`` (the first robot's get
 ``"robot": "robot"``), and ``summary["robots"]`` gives each robot's model, tool, frame 0, joints,
-phases, cycle end, tool point deviation, tracking errors and closest approach to a singularity.
-A cell with one robot gets neither (its summary as before, key for key).
+phases, cycle end, tool point deviation, tracking errors and closest approach to a singularity
+(a cell with one robot gets neither: its summary as before, key for key).
 
 Owns which phases are measured and the run's summary; the measurement along one seam is
-:mod:`sim.simulation.seam_measure`'s (its names importable from here as before). May import:
-planners, :mod:`sim.core`, :mod:`sim.scenario` and the simulation modules.
+:mod:`sim.simulation.seam_measure`'s (importable from here as before). May import: planners,
+:mod:`sim.core`, :mod:`sim.scenario`, the simulation modules.
 """
 
 from __future__ import annotations
@@ -413,7 +413,7 @@ def make_summary(scenario: Scenario, built: BuiltCell, motion: Motion, rec: Simu
         "max_tracking_error_deg": [float(x * 1e3 if u == "mm" else np.degrees(x))
                                    for x, u in zip(track, units, strict=True)],
         "max_tcp_deviation_mm": float(np.max(dev) * 1e3),
-        "torque_rms_diff_pct_of_peak": [float(100 * d / p) if p > 0 else 0.0
+        "torque_rms_diff_pct_of_peak": [float(100 * d / p) if p > 1e-6 * max(peak_id) else None
                                         for d, p in zip(rms_diff, peak_id, strict=True)],
         "actions": [{"t": t, "action": act} for t, act in motion.actions],
         "weld": weld_metrics(a, motion, built, torch_axis, measured),
