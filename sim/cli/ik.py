@@ -51,7 +51,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "orientation); for 5-axis robots A is implied by the position")
     p.add_argument("--tool", metavar="NAME", default=None,
                    help="the tcp is this tool's tip: a shipped tool (see `cellsim list`) or a "
-                        "tool file (docs/cell-format.md); default: the flange centre (no tool)")
+                        "tool file (docs/cell-format.md); default: the model's own tcp, the "
+                        "flange centre (the seeds' lrmate100ib and robot_5r have their torch "
+                        "built in: their tcp is its tip, 145 and 300 mm past the flange)")
     p.add_argument("--maker", action="store_true",
                    help="also print the joint values in the maker's convention (FANUC: J3 from "
                         "the horizontal, FANUC's signs), as the controller shows them")

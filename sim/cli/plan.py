@@ -41,7 +41,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenario", metavar="SCENARIO",
                    help="a scenario file, or a shipped scenario's name (see `cellsim list`)")
     p.add_argument("--json", action="store_true",
-                   help="print JSON (coefficients in radians, ascending powers)")
+                   help="print JSON (coefficients in radians, metres on a linear axis such "
+                        "as a track's; ascending powers; each joint's name and unit given)")
     p.set_defaults(func=run)
 
 
@@ -79,16 +80,25 @@ def planned_lanes(motion: Motion) -> list[tuple[str, list[PhaseMotion]]]:
 
 def plan_json(scenario: Scenario, planned: list[PhaseMotion],
               lanes: list[tuple[str, list[PhaseMotion]]] | None = None) -> dict[str, Any]:
-    """The ``--json`` document of a planned scenario (coefficients in radians); with a cell's
+    """The ``--json`` document of a planned scenario (coefficients in radians, metres on a
+    linear axis; each joint named, with its unit); with a cell's
     other robots (``lanes``), ``"robots"``: ``[{"name": str, "phases": [...]}]`` (their
     phases as the first robot's, joints indexed from 1 in their own robot)."""
-    out: dict[str, Any] = {"scenario": scenario.name, "phases": _phases_json(planned)}
+    first = scenario.system
+    out: dict[str, Any] = {"scenario": scenario.name, "phases": _phases_json(
+        planned, list(first.joints), list(first.linear))}
     if lanes:
-        out["robots"] = [{"name": name, "phases": _phases_json(ph)} for name, ph in lanes]
+        work = {w.name: w for w in scenario.partners}
+        out["robots"] = [{"name": name, "phases": _phases_json(
+            ph, list(work[name].robot.joints) if name in work else [],
+            list(work[name].robot.linear) if name in work else [])} for name, ph in lanes]
     return out
 
 
-def _phases_json(planned: list[PhaseMotion]) -> list[dict[str, Any]]:
+def _phases_json(planned: list[PhaseMotion], names: list[str], linear: list[bool]
+                 ) -> list[dict[str, Any]]:
+    """The phases' segments; each joint with its name and its coefficients' unit (``rad``,
+    ``m`` on a linear axis) where ``names`` has it."""
     phases = []
     for pp in planned:
         traj = pp.trajectory
@@ -104,7 +114,11 @@ def _phases_json(planned: list[PhaseMotion]) -> list[dict[str, Any]]:
                     "normalized": [float(c) for c in traj.normalized_coefficients[s][j]],
                     "real": [float(c) for c in traj.real_coefficients[s][j]],
                 })
-            joints.append({"index": j + 1, "segments": segments})
+            joint: dict[str, Any] = {"index": j + 1}
+            if j < len(names):
+                joint["name"] = names[j]
+                joint["unit"] = "m" if j < len(linear) and linear[j] else "rad"
+            joints.append({**joint, "segments": segments})
         phases.append({
             "name": pp.phase.name,
             "planner": pp.phase.planner,

@@ -40,6 +40,20 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def fps_arg(text: str) -> float:
+    """``--fps``: a frame rate in :data:`~sim.core.tomlschema.FPS`'s range."""
+    from sim.core.tomlschema import FPS
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    bad = FPS.problem(value)
+    if bad:
+        raise argparse.ArgumentTypeError(bad)
+    return value
+
+
 def _jobs(text: str) -> int:
     try:
         value = int(text)
@@ -70,7 +84,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="width of each camera view, pixels, even (default 640)")
     p.add_argument("--height", type=_positive_int, default=480,
                    help="height, pixels, even (default 480)")
-    p.add_argument("--fps", type=_positive_float, default=30.0,
+    p.add_argument("--fps", type=fps_arg, default=30.0,
                    help="frames per second (default 30); frames = floor(duration*fps/speed)+1")
     p.add_argument("--speed", type=_positive_float, default=1.0,
                    help="playback speed, simulated seconds per second of video (default 1; "

@@ -25,6 +25,8 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from sim.cli.render import fps_arg
+
 if TYPE_CHECKING:
     from sim.scenario.schema import ExpectSpec
 
@@ -49,7 +51,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="OpenGL backend for the video (default: the first that works)")
     p.add_argument("--width", type=int, help="video width per camera, pixels")
     p.add_argument("--height", type=int, help="video height, pixels")
-    p.add_argument("--fps", type=float, help="video frames per second")
+    p.add_argument("--fps", type=fps_arg, help="video frames per second (1-1000)")
     p.add_argument("--video-speed", type=float, metavar="X",
                    help="video playback speed, simulated seconds per second of video (4: a "
                         "time-lapse four times faster than real time)")

@@ -15,7 +15,7 @@ import numpy as np
 
 from sim.errors import CellsimError
 from sim.robots.kinematics.model import kinematic_model
-from sim.robots.kinematics.workspace import plot_workspace
+from sim.robots.kinematics.workspace import plot_workspace, written_by_workspace
 from sim.robots.registry import get_robot
 
 
@@ -25,7 +25,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Write a PNG of the robot's reachable section (joint-space map with the "
                     "singular curves, x-z section) and print its reach: the largest distance "
                     "from the J1 axis of the wrist centre and of the tcp within the joint ranges.")
-    p.add_argument("robot", metavar="ROBOT", help="robot name (see `cellsim list`)")
+    p.add_argument("robot", metavar="ROBOT", help="robot name (see `cellsim list`): one of the "
+                   "seeds' families (lrmate100ib, lrmate200ic5l, robot_5r), whose singular "
+                   "curves the map draws; another robot is refused in one line")
     p.add_argument("--out", metavar="FILE.png", default=None,
                    help="PNG to write (default: workspace_<robot>.png in the current folder)")
     p.set_defaults(func=run)
@@ -45,6 +47,9 @@ def run(args: argparse.Namespace) -> int:
     if out.is_dir() or out.is_symlink():
         raise CellsimError(f"--out: {str(out)!r} is a folder or a symbolic link; name a new "
                            ".png file")
+    if out.exists() and not written_by_workspace(out):
+        raise CellsimError(f"--out: {str(out)!r} exists and cellsim workspace did not write it; "
+                           "name a new .png file (or remove it)")
     model = kinematic_model(spec)
     reach = plot_workspace(model, out, title=f"{spec.title} ({spec.name}) workspace")
     ranges = "joint ranges from the model" if model.lower is not None else \

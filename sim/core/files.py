@@ -26,6 +26,14 @@ def naming(path: str | Path) -> Iterator[None]:
         raise
 
 
+def new_file_mode() -> int:
+    """The mode ``open`` gives a new file: ``0o666`` less the process's umask (a file written
+    through a temporary one, created ``0o600``, gets it before it takes its name)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def write_atomic(path: str | Path, data: bytes | str) -> Path:
     """Write ``data`` to ``path`` through a temporary file and ``os.replace``.
 
@@ -50,7 +58,7 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
             fh.write(raw)
             fh.flush()
             os.fsync(fh.fileno())
-        os.chmod(tmp, 0o644)
+        os.chmod(tmp, new_file_mode())
         os.replace(tmp, path)
     except BaseException:
         try:

@@ -179,6 +179,8 @@ SPEED_RPM = Quantity("a motor speed", "rpm", 1e-3, 1e6)
 LIFE_H = Quantity("a rated life", "h", 1.0, 1e7)
 #: A motor's thermal time constant, s.
 TIME_CONSTANT_S = Quantity("a thermal time constant", "s", 1e-3, 1e6)
+#: A video's frame rate, frames per second (a time-lapse is [video] speed, not a low rate).
+FPS = Quantity("a video frame rate", "fps", 1.0, 1000.0)
 
 
 def quantity_at(root: type[BaseModel], loc: tuple[Any, ...]) -> Quantity | None:
@@ -350,7 +352,7 @@ def load_toml(path: Path, root: type[M], error: type[Exception]) -> tuple[M, dic
         raise error(f"{path}: {describe(exc, root)}") from None
 
 
-__all__ = ["ANGLE_DEG", "ANGLE_RAD", "EFFICIENCY", "GEAR_RATIO", "INERTIA_KG_M2",
+__all__ = ["ANGLE_DEG", "ANGLE_RAD", "EFFICIENCY", "FPS", "GEAR_RATIO", "INERTIA_KG_M2",
     "JOINT_ACCEL_DEG_S2", "JOINT_DEG", "JOINT_RAD", "JOINT_SPEED_DEG_S", "JOINT_SPEED_RAD_S",
     "LENGTH_M", "LENGTH_MM", "LIFE_H", "MASS_KG", "MIN_PRINCIPAL_INERTIA_KG_M2", "PAYLOAD_KG",
     "ROTOR_INERTIA_KG_M2", "SPEED_RPM", "TIME_CONSTANT_S", "TORQUE_NM", "Columns", "Quantity",

@@ -441,9 +441,11 @@ def write_program(scenario: Scenario, out: str | Path) -> tuple[list[str], list[
             does not.
     """
     def refuse_existing(path: Path) -> None:
-        if path.exists():
-            raise ScenarioError(f"{path}: exists; cellsim does not overwrite files it did not "
-                                "write (choose another --out)")
+        if path.is_dir():
+            raise ScenarioError(f"{path}: is a folder; --out names the .ls file to write")
+        if path.exists() or path.is_symlink():
+            raise ScenarioError(f"{path}: exists; cellsim export never replaces a file "
+                                "(choose another --out, or remove it)")
 
     out = Path(out)
     refuse_existing(out)
@@ -489,15 +491,18 @@ def _write_new(path: Path, text: str) -> None:
     import os
     import tempfile
 
+    from sim.core.files import new_file_mode
+
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     with os.fdopen(fd, "w", encoding="utf-8") as fh:
         fh.write(text)
+    os.chmod(tmp, new_file_mode())  # the umask's mode, not mkstemp's 0o600
     try:
         os.link(tmp, path)  # fails if path appeared meanwhile: never replaced
     except FileExistsError:
         os.unlink(tmp)
-        raise ScenarioError(f"{path}: exists; cellsim does not overwrite files it did not "
-                            "write") from None
+        raise ScenarioError(f"{path}: exists; cellsim export never replaces a file "
+                            "(choose another --out, or remove it)") from None
     except OSError:
         os.replace(tmp, path)
     else:

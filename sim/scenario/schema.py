@@ -18,6 +18,7 @@ from planners.registry import PLANNERS
 from sim.core.text import PlainText
 from sim.core.tomlschema import (
     EFFICIENCY,
+    FPS,
     GEAR_RATIO,
     ROTOR_INERTIA_KG_M2,
     SPEED_RPM,
@@ -236,7 +237,7 @@ class VideoSpec(_Strict):
     cameras: list[str] | None = Field(None, min_length=1)
     width: VideoSide | None = None
     height: VideoSide | None = None
-    fps: float | None = Field(None, gt=0)
+    fps: FPS.type | None = None
     speed: float | None = Field(None, gt=0)
 
 

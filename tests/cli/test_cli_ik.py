@@ -156,6 +156,39 @@ def test_workspace_png_and_reach(capsys, tmp_path):
     assert reach_mm == pytest.approx(892.0, abs=0.5)
 
 
+def test_workspace_replaces_its_own_picture_and_refuses_anyone_elses(capsys, tmp_path):
+    """``--out`` over a file: a picture ``cellsim workspace`` wrote (its PNG's Software text) is
+    replaced, as a second run of the same command does; any other file is refused in one line
+    and left as it was (it was overwritten: found by a new-user trial); the pictures take the
+    umask's mode."""
+    import os
+
+    out_png = tmp_path / "ws.png"
+    for _ in range(2):
+        code, _out, err = _run(capsys, "workspace", "robot_5r", "--out", str(out_png))
+        assert code == 0, err
+    assert oct(out_png.stat().st_mode & 0o777) == oct(0o666 & ~_umask())
+    precious = tmp_path / "mine.png"
+    precious.write_text("my precious")
+    code, _out, err = _run(capsys, "workspace", "robot_5r", "--out", str(precious))
+    assert code == 2 and precious.read_text() == "my precious"
+    assert err.strip().splitlines() == [
+        f"cellsim: error: --out: {str(precious)!r} exists and cellsim workspace did not write "
+        "it; name a new .png file (or remove it)"]
+    other = tmp_path / "plot.png"  # a PNG someone else drew: refused too
+    other.write_bytes(out_png.read_bytes().replace(b"cellsim workspace", b"matplotlib v3.9.0"))
+    assert _run(capsys, "workspace", "robot_5r", "--out", str(other))[0] == 2
+    assert os.path.getsize(other) == os.path.getsize(out_png) + 0
+
+
+def _umask() -> int:
+    import os
+
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def test_reach_definition_against_closed_form():
     from sim.robots.kinematics.workspace import compute_reach
 
@@ -272,3 +305,18 @@ def test_a_pose_with_no_solution_exits_2_with_one_line_for_every_kind_of_robot(k
                           "--euler-zyx-deg", f"{a:.9f}", f"{b:.9f}", f"{g:.9f}", "--json")
     assert code == 0, (kind, err)
     assert json.loads(out)["solutions"], kind
+
+
+def test_the_help_says_where_the_default_tcp_is(capsys):
+    """``ik --help``'s default tcp: the flange centre, except the seeds' models with a built-in
+    torch, whose tcp the help places 145 and 300 mm past the flange (it said "the flange centre
+    (no tool)" for all: found by a new-user trial); the numbers are the models' own."""
+    from sim.cells.compose import robot_statics
+
+    with pytest.raises(SystemExit):
+        main(["ik", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "their tcp is its tip, 145 and 300 mm past the flange" in text
+    got = {n: round(float(np.linalg.norm(robot_statics(ROBOTS[n]).tcp_minus_flange)) * 1e3, 1)
+           for n in ("lrmate100ib", "robot_5r", "lrmate200ic5l")}
+    assert got == {"lrmate100ib": 145.0, "robot_5r": 300.0, "lrmate200ic5l": 0.0}

@@ -183,3 +183,24 @@ def test_a_program_longer_than_the_bound_is_refused_at_its_line(tmp_path, capsys
     # the file's lines: /PROG, /MN, two frame lines, the J move, then the L moves
     assert f"gen.ls: line {MAX_PROGRAM_MOTIONS + 5}: the program has " \
            f"{MAX_PROGRAM_MOTIONS + 1:,} motion instructions" in err
+
+
+def test_plan_json_names_each_joint_and_its_unit(capsys):
+    """``plan --json`` names each joint and gives its coefficients' unit: radians, metres on a
+    linear axis (a track's coefficients are in metres, and nothing said so: found by a new-user
+    trial); the track's position at its phase's start, from the JSON in metres, is the text
+    output's constant term in mm over 1000 (the same plan, two units)."""
+    assert main(["plan", "track_beam_weld", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    joints = doc["phases"][0]["joints"]
+    assert [(j["name"], j["unit"]) for j in joints] == \
+        [(f"j{k}", "rad") for k in range(1, 7)] + [("track_travel", "m")]
+    assert main(["plan", "track_beam_weld"]) == 0
+    text = capsys.readouterr().out
+    seg = joints[6]["segments"][0]
+    lines = text.splitlines()
+    at = next(i for i, ln in enumerate(lines) if "joint track_travel (mm)" in ln)
+    normalized = next(ln for ln in lines[at:] if "normalized:" in ln)
+    constant_mm = float(normalized.split()[-1])  # "-10 t^4 +20 t^3 -1500": the t^0 term
+    assert seg["normalized"][0] * 1e3 == pytest.approx(constant_mm, abs=1e-6)
+    assert seg["normalized"][4] * 1e3 == pytest.approx(-10.0, abs=1e-6)  # the t^4 term

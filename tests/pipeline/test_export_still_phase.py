@@ -9,12 +9,15 @@ shipped two-robot weld runs back with its robots' arc starts 2.6 s apart, as the
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
+from sim.errors import ScenarioError
 from sim.pipeline.export import write_program
 from sim.scenario import load_scenario
 from sim.simulation.compile import build
@@ -77,6 +80,12 @@ def test_a_still_joint_phase_is_held_for_its_time(tmp_path: Path, hold: float, l
 def test_the_two_robot_weld_keeps_its_stagger(tmp_path: Path) -> None:
     out = tmp_path / "tee.ls"
     write_program(load_scenario("two_robot_tee_weld"), out)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    for f in (out, tmp_path / "tee_r2.ls"):  # the umask's mode, not a temporary file's 0o600
+        assert f.stat().st_mode & 0o777 == 0o666 & ~mask
+    with pytest.raises(ScenarioError, match="exists; cellsim export never replaces a file"):
+        write_program(load_scenario("two_robot_tee_weld"), out)
     back = tmp_path / "tee_tp.toml"
     back.write_text('name = "tee_tp"\ndescription = "x"\nrobot = "lrmate200ic5l"\ncell = "two_robot_tee"\n'
                     'tool = "mig_torch"\nprogram = "tee.ls"\n[robots.r2]\n'

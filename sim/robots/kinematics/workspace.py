@@ -97,6 +97,22 @@ def compute_reach(model: KinematicModel) -> Reach:
     return Reach(wrist=wr, tcp=tc, q_wrist=full(xw[None], arm)[0], q_tcp=full(xt[None], free)[0])
 
 
+#: The PNG's ``Software`` text: marks a picture ``cellsim workspace`` wrote (another run may
+#: replace it; any other file at ``--out`` is refused).
+PNG_SOFTWARE = "cellsim workspace"
+
+
+def written_by_workspace(path: str | Path) -> bool:
+    """Whether ``path`` is a PNG that :func:`plot_workspace` wrote (its ``Software`` text)."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(path) as im:
+            return im.format == "PNG" and im.info.get("Software") == PNG_SOFTWARE
+    except (OSError, UnidentifiedImageError, ValueError, SyntaxError):  # PIL: a broken PNG
+        return False
+
+
 def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> Reach:
     """Draw the workspace section (module docstring) into a PNG; return the reach.
 
@@ -169,7 +185,7 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
 
     try:
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=90)
+        fig.savefig(buf, format="png", dpi=90, metadata={"Software": PNG_SOFTWARE})
         write_atomic(out, buf.getvalue())  # a full disk leaves no half-written picture
     finally:
         plt.close(fig)
