@@ -26,6 +26,7 @@ from typing import NoReturn
 import numpy as np
 
 from sim.core.rotations import euler_zyx_to_matrix, make_transform
+from sim.core.text import mm_text
 from sim.errors import KinematicsError, UnreachableError
 from sim.robots.kinematics.ik import solve_ik
 from sim.robots.kinematics.model import kinematic_model
@@ -114,8 +115,8 @@ def _run_arm(args: argparse.Namespace) -> int:
 
             gap, inner, outer = reach_gap(arm.opw, make_transform(R, p))
             if gap > 1e-9:
-                why += (f"; the wrist centre is {1e3 * gap:.1f} mm outside the arm's reach, J2 "
-                        f"to wrist centre between {1e3 * inner:.1f} and {1e3 * outer:.1f} mm")
+                why += (f"; the wrist centre is {mm_text(gap)} mm outside the arm's reach, J2 "
+                        f"to wrist centre between {mm_text(inner)} and {mm_text(outer)} mm")
         _no_solution(arm.name, args, why)
     shown = sols if args.all else sols[:1]
     if args.json:

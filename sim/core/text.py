@@ -43,4 +43,11 @@ def printable(text: str) -> str:
     return _CONTROL.sub(lambda m: repr(m.group())[1:-1], text)
 
 
-__all__ = ["PlainText", "check_plain", "printable"]
+def mm_text(length_m: float) -> str:
+    """A length in m as mm for a message: one decimal, or 4 significant digits from 1e9 mm up
+    (a typed 1e308 mm is not printed as 300 digits)."""
+    mm = 1e3 * float(length_m)
+    return f"{mm:.1f}" if abs(mm) < 1e9 else f"{mm:.4g}"
+
+
+__all__ = ["PlainText", "check_plain", "mm_text", "printable"]

@@ -75,6 +75,8 @@ def resolve_scenario(ref: str | Path) -> Path:
     if path.is_file() or (path.exists() and not path.is_dir()):
         return path  # a FIFO or device too: read_input refuses it in one line
     shipped = shipped_scenarios()
+    if path.is_dir() and str(ref) not in shipped:
+        raise ScenarioError(f"{ref}: a folder, not a scenario file")
     if str(ref) not in shipped and (path.suffix == ".toml" or path.parent != Path(".")):
         raise ScenarioError(f"{ref}: no such scenario file")
     return shipped.get(str(ref))

@@ -25,6 +25,7 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from sim.core.text import mm_text
 from sim.errors import KinematicsError, UnreachableError
 from sim.robots.families.base import KinematicFamily
 
@@ -91,8 +92,8 @@ class ChainFamily(KinematicFamily):
             gap, inner, outer = reach_gap(self.arm.opw, flange)
             if gap > 1e-9:
                 return UnreachableError(
-                    f"{head}: the wrist centre is {1e3 * gap:.1f} mm outside the arm's reach "
-                    f"(J2 to wrist centre between {1e3 * inner:.1f} and {1e3 * outer:.1f} mm)",
+                    f"{head}: the wrist centre is {mm_text(gap)} mm outside the arm's reach "
+                    f"(J2 to wrist centre between {mm_text(inner)} and {mm_text(outer)} mm)",
                     gap)
         return UnreachableError(head, 0.0)
 

@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.core.rotations import rot_x, rot_y, rot_z
+from sim.core.text import mm_text
 from sim.errors import SingularityWarning, UnreachableError
 from sim.robots.families.base import KinematicFamily, annulus_gap
 from sim.robots.kinematics.closed_form import fk_fanuc6
@@ -153,7 +154,7 @@ class Fanuc6(KinematicFamily):
         if not sols:
             gap = min(gaps)
             raise UnreachableError(
-                f"pose unreachable: the wrist centre is {1e3 * gap:.1f} mm outside the arm's "
+                f"pose unreachable: the wrist centre is {mm_text(gap)} mm outside the arm's "
                 f"reach (J2 to wrist centre between {1e3 * abs(d3 - L):.1f} and "
                 f"{1e3 * (d3 + L):.1f} mm)", gap)
         return sols

@@ -44,6 +44,7 @@ from sim.core.rotations import (
     rot_z,
     wrap_to_pi,
 )
+from sim.core.text import mm_text
 from sim.errors import KinematicsError, SingularityWarning, UnreachableError
 from sim.robots.families.base import KinematicFamily, annulus_gap
 from sim.robots.kinematics.closed_form import fk_5r
@@ -170,7 +171,7 @@ class FiveR(KinematicFamily):
         if not sols:
             gap = min(gaps)
             raise UnreachableError(
-                f"pose unreachable: the wrist point (J4 axis) is {1e3 * gap:.1f} mm outside the "
+                f"pose unreachable: the wrist point (J4 axis) is {mm_text(gap)} mm outside the "
                 f"arm's reach (J2 to J4 between {1e3 * abs(d1 - l2):.1f} and "
                 f"{1e3 * (d1 + l2):.1f} mm)", gap)
         return sols

@@ -72,9 +72,10 @@ def decimate(arrays: Mapping[str, np.ndarray], timestep: float, record_hz: float
 
 
 def sample_rate(t: np.ndarray) -> float:
-    """The median sampling rate of a time array, Hz."""
+    """The median sampling rate of a time array, Hz, to 9 significant digits (a 1 ms record
+    is 1000 Hz, not the 999.9999999999991 its float steps give)."""
     dt = np.diff(np.asarray(t, float))
-    return float(1.0 / np.median(dt)) if dt.size else 0.0
+    return float(f"{1.0 / np.median(dt):.9g}") if dt.size else 0.0
 
 
 #: Joint arrays written to ``trajectory.csv`` (one column per joint: ``q_ref_j1``, ...).
