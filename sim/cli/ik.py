@@ -57,7 +57,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "built in: their tcp is its tip, 145 and 300 mm past the flange)")
     p.add_argument("--maker", action="store_true",
                    help="also print the joint values in the maker's convention (FANUC: J3 from "
-                        "the horizontal, FANUC's signs), as the controller shows them")
+                        "the horizontal, FANUC's signs), as the controller shows them; a robot "
+                        "without a [maker] table (not a FANUC) prints its own values")
     p.add_argument("--all", action="store_true", help="print every solution, not only the best")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=run)

@@ -453,17 +453,21 @@ def test_a_modified_dh_table_equals_its_textbook_product(tmp_path):
 
 
 # ---------------------------------------------------------------------------- maker's joints
-@pytest.mark.parametrize("robot", ["lrmate100ib", "lrmate200ic5l"])
+@pytest.mark.parametrize("robot", ["lrmate100ib", "lrmate200ic5l", "m10ia", "m20ia"])
 def test_fanuc_j3_is_measured_from_the_horizontal(robot):
     """The J2/J3 interaction, checked on the arm itself: with the maker's J3 fixed, the
     forearm's elevation (J3 axis to the wrist, in the arm plane) does not change with J2, and a
-    change of the maker's J3 turns it by that much; maps both ways are inverse."""
-    from sim.robots.kinematics.model import closed_form_model
+    change of the maker's J3 turns it by that much; maps both ways are inverse. The M-10iA and
+    M-20iA (ROS-Industrial URDFs, fanuc_driver's J23_factor = 1 as for the 200iC) had no maker
+    table: --maker and cellsim export printed the URDF's serial J3 (found by a new-user
+    trial)."""
+    from sim.robots.kinematics.model import kinematic_model
     from sim.robots.maker import from_maker, to_maker
     from sim.robots.registry import ROBOTS
 
     spec = ROBOTS[robot]
-    km = closed_form_model(spec)
+    assert spec.maker_matrix
+    km = kinematic_model(spec)
     wrist = 3 if spec.n_joints == 5 else 4
 
     def elevation(maker_deg):
