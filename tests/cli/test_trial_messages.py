@@ -42,3 +42,19 @@ def test_a_records_rate_is_its_rate(dt: float, n: int) -> None:
     t = np.arange(n) * dt
     assert sample_rate(t) == float(f"{1.0 / dt:.9g}")
     assert sample_rate(np.arange(82593) * 1e-3) == 1000.0
+
+
+def test_the_run_line_gives_the_steps_time_in_significant_digits(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A short run printed "0.624 s simulated in 0.00 s": the MuJoCo steps' time now has 3
+    significant digits and says what it is (summary.json's wall_s)."""
+    import json
+    import re
+
+    out = tmp_path / "run"
+    main(["run", "kacso_lrmate100ib_sequence1", "--out", str(out), "--no-video", "--no-plots"])
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if "simulated in" in ln)
+    got = re.search(r"simulated in (\S+) s of MuJoCo steps", line)
+    assert got, line
+    wall = json.loads((out / "summary.json").read_text())["wall_s"]
+    assert float(got.group(1)) == float(f"{wall:.3g}") > 0.0
