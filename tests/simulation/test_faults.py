@@ -172,14 +172,15 @@ def test_sweep_ranges_are_bounded(tmp_path, capsys):
 
 @pytest.mark.render
 def test_frame_counts_are_bounded(tmp_path, capsys):
-    """`cellsim render --fps 1e7`: one line naming --fps, the count and the limit; no hang."""
+    """`cellsim render --fps 1000 --speed 0.001` (2 million frames of a 2 s run; a rate over
+    1000 fps is refused as a rate): one line naming --fps, the count and the limit; no hang."""
     import sim.render.gl as gl
     from sim.render.synthetic import write_synthetic_run
 
     gl.configure_gl()
     run = write_synthetic_run(tmp_path / "run", duration=2.0)
     start = time.process_time()
-    rc = main(["render", str(run), "--fps", "1e7", "--quiet"])
+    rc = main(["render", str(run), "--fps", "1000", "--speed", "0.001", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and "--fps" in err and "108,000" in err and err.count("\n") == 1, err
     assert time.process_time() - start < 20.0  # CPU time, not wall time
