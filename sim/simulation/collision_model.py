@@ -17,6 +17,7 @@ May import: :mod:`sim.errors` and the compiled cell.
 
 from __future__ import annotations
 
+import copy
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -320,6 +321,17 @@ class CollisionModel:
             raise InternalError(f"the check model does not compile: {exc}") from exc
         m.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         return m
+
+    def rebound(self, built: BuiltCell) -> CollisionModel:
+        """This check model for ``built``: another compile of the same composed cell whose
+        checked geoms, bodies and joints are this one's (a sweep's other payload, which
+        changes only masses and its unchecked marker; the caller makes sure:
+        :func:`sim.simulation.collision_reuse.check_model`). A shallow copy: the check models
+        and their data are shared, the compiled cell read for joints and bounds is
+        ``built``'s."""
+        other = copy.copy(self)
+        other.built = built
+        return other
 
     def reach_from_joint(self, joint: int) -> float:
         """Upper bound of the distance from a joint's anchor to any point of a checked geom it

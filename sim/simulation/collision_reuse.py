@@ -89,6 +89,8 @@ SLACK_M = 5e-5
 KEPT = 4
 
 _CACHE: OrderedDict[str, ReferenceScan] = OrderedDict()
+#: Check models kept per process (the latest first), for other payloads of their cells.
+_MODELS: list[CollisionModel] = []
 #: Reference scans made and found in the cache by this process, and variants whose
 #: collisions were checked in full after all (a contact not ruled out, or a cell not reusable).
 STATS = {"scans": 0, "hits": 0, "full": 0}
@@ -125,6 +127,50 @@ def reusable(built: BuiltCell) -> bool:
     return (not cell.partners and not built.part_qpos and not cell.mechanisms
             and len(built.joint_ids) == cell.robot.n_joints
             and built.model.nq == len(built.robot_qpos))
+
+
+#: What a compiled cell's check model reads from it, as whole arrays: the kinematic tree, the
+#: geoms' kinds, owners and collision bits, the meshes, exclusions and names.
+_SAME_ARRAYS = ("body_parentid", "body_weldid", "body_pos", "body_quat", "jnt_type",
+                "jnt_bodyid", "jnt_qposadr", "jnt_pos", "jnt_axis", "qpos0", "geom_type",
+                "geom_bodyid", "geom_contype", "geom_conaffinity", "geom_group",
+                "geom_dataid", "mesh_vertadr", "mesh_vert", "mesh_face", "exclude_signature",
+                "names")
+#: ... and for the checked geoms only (a payload's marker, never checked, grows with it).
+_SAME_CHECKED = ("geom_size", "geom_pos", "geom_quat", "geom_rbound")
+
+
+def same_checked_geometry(a: BuiltCell, b: BuiltCell, checked: Sequence[int]) -> bool:
+    """Whether a check model made for ``a`` checks ``b`` as one made for ``b`` would: the
+    same composed cell (its tree, tool, objects and parts: a sweep's other payload), compiled
+    to the same bodies, joints, meshes, exclusions and names, with the ``checked`` geoms
+    where and as large as ``a``'s. Masses and unchecked geoms may differ."""
+    ma, mb = a.model, b.model
+    if a.cell.mjcf is not b.cell.mjcf or a.cell.robot is not b.cell.robot:
+        return False
+    if any(getattr(ma, n) != getattr(mb, n) for n in ("nq", "nbody", "njnt", "ngeom", "nmesh",
+                                                          "nmeshvert", "nmeshface", "nexclude",
+                                                          "nnames")):
+        return False
+    if any(not np.array_equal(getattr(ma, n), getattr(mb, n)) for n in _SAME_ARRAYS):
+        return False
+    rows = np.asarray(sorted(checked), dtype=int)
+    return all(np.array_equal(getattr(ma, n)[rows], getattr(mb, n)[rows])
+               for n in _SAME_CHECKED)
+
+
+def check_model(built: BuiltCell) -> CollisionModel:
+    """The check model of ``built``: one made in this process for another payload of the same
+    cell (:func:`same_checked_geometry`; :meth:`CollisionModel.rebound`), else a new one
+    (kept: the latest :data:`KEPT`). The same checks, bit for bit, without compiling the check
+    models again (two compiles per sweep variant)."""
+    for cm in _MODELS:
+        if same_checked_geometry(cm.built, built, list(cm.geoms)):
+            return cm.rebound(built)
+    cm = CollisionModel(built)
+    _MODELS.insert(0, cm)
+    del _MODELS[KEPT:]
+    return cm
 
 
 def geometry_key(cm: CollisionModel) -> bytes:
@@ -383,7 +429,7 @@ def collisions_from_reference(built: BuiltCell, samples: MotionSamples,
     scan (module docstring). ``q_ref``: the reference's joint positions at
     ``coarse_samples(samples)``; ``scan``: scan the reference when it is not in the cache
     (else check in full)."""
-    cm = cm or CollisionModel(built)
+    cm = cm or check_model(built)
     allowed = allowed_contacts(cm, samples, phase_seams, weaves)
     reasons = sorted({a.reason for a in allowed})
     coarse = _col.coarse_samples(samples)
@@ -404,8 +450,10 @@ def collisions_from_reference(built: BuiltCell, samples: MotionSamples,
 
 
 def clear_cache() -> None:
-    """Forget every reference scan of this process (and zero :data:`STATS`)."""
+    """Forget every reference scan and check model of this process (and zero
+    :data:`STATS`)."""
     _CACHE.clear()
+    _MODELS.clear()
     STATS.update(scans=0, hits=0, full=0)
 
 
@@ -416,6 +464,6 @@ def _full(cm: CollisionModel, samples: MotionSamples, phase_names: Sequence[str]
 
 
 __all__ = ["ANCHOR_GAP_M", "KEPT", "NEAR_RANGE_M", "SLACK_M", "STATS", "ReferenceScan",
-           "anchor_samples", "clear_cache", "collisions_from_reference", "deviation",
-           "geometry_key", "joint_gap", "lower_bounds", "reference_key", "reference_scan",
-           "reusable", "scanned_intervals"]
+           "anchor_samples", "check_model", "clear_cache", "collisions_from_reference",
+           "deviation", "geometry_key", "joint_gap", "lower_bounds", "reference_key",
+           "reference_scan", "reusable", "same_checked_geometry", "scanned_intervals"]
