@@ -316,6 +316,40 @@ class Seam:
         p = self.point(s)
         return (p if self.standoff_m == 0.0 else p - self.standoff_m * a), t, a
 
+    def path_rows(self, s: NDArray[np.float64]) -> tuple[NDArray[np.float64],
+                                                        NDArray[np.float64],
+                                                        NDArray[np.float64]]:
+        """:meth:`path_row` at each arc length of ``s`` (m, (m,), within the seam), stacked:
+        tool points, tangents and torch axes, (m, 3) each. An arc's rows are computed as
+        arrays (the same operations element by element; each row's dot products and norm
+        as :meth:`path_row` takes them), a line's or polyline's row by row."""
+        s = np.asarray(s, dtype=float)
+        if self.kind != "arc" or s.size == 0:
+            rows = [self.path_row(float(x)) for x in s]
+            return tuple(np.array(v).reshape(-1, 3) for v in zip(*rows, strict=True)) \
+                if rows else (np.zeros((0, 3)),) * 3  # type: ignore[return-value]
+        for x in (s.min(), s.max()):
+            self._check_s(float(x))
+        r, c, u, v = self._radius, self._center, self._u, self._v  # type: ignore[attr-defined]
+        th = s / r
+        sin, cos = np.sin(th)[:, None], np.cos(th)[:, None]
+        t = -sin * u + cos * v
+        sn = self.surface_normal
+        n = sn - np.array([sn @ ti for ti in t])[:, None] * t
+        norm = np.array([np.linalg.norm(ni) for ni in n])
+        if np.any(norm < _EPS):
+            k = int(np.argmax(norm < _EPS))
+            self._torch_axis(float(s[k]), t[k])  # raises, naming where
+        n = n / norm[:, None]
+        e = self.torch_side * np.stack([n[:, 1] * t[:, 2] - n[:, 2] * t[:, 1],
+                                        n[:, 2] * t[:, 0] - n[:, 0] * t[:, 2],
+                                        n[:, 0] * t[:, 1] - n[:, 1] * t[:, 0]], axis=1)
+        w = np.deg2rad(self.torch_work_angle_deg)
+        tau = np.deg2rad(self.torch_travel_angle_deg)
+        a = np.cos(tau) * -(np.cos(w) * n + np.sin(w) * e) + np.sin(tau) * t
+        p = c + r * (cos * u + sin * v)
+        return (p if self.standoff_m == 0.0 else p - self.standoff_m * a), t, a
+
     def _torch_axis(self, s: float, t: NDArray[np.float64]) -> NDArray[np.float64]:
         """:meth:`torch_axis` at ``s`` given the tangent ``t`` there."""
         n = self.surface_normal - (self.surface_normal @ t) * t

@@ -215,9 +215,9 @@ class ToolPointPath:
                 n = max(3, int(np.ceil(L / h)) + 1)
             ss = np.linspace(0.0, L, n)
             s_all.append(s0 + ss)
-            rows += [seg.path_row(x) for x in ss]
+            rows.append(seg.path_rows(ss))
             s0 += L
-        point, tangent, axis = (np.array(v) for v in zip(*rows, strict=True))
+        point, tangent, axis = (np.concatenate(v) for v in zip(*rows, strict=True))
         s_arr = np.concatenate(s_all)
         for v in (s_arr, point, tangent, axis):  # shared by every caller of a kept path
             v.setflags(write=False)

@@ -112,3 +112,68 @@ def test_the_seams_cross_product_is_numpys_bit_for_bit(a: list[float], b: list[f
 def test_planted_cross_product_order_is_caught() -> None:
     x, y = np.array([0.3, -1.2, 2.0]), np.array([1.5, 0.25, -0.7])
     assert not _same(seam_module._cross3(y, x), np.cross(x, y))
+
+
+@st.composite
+def tilted_arcs(draw: st.DrawFn) -> Seam:
+    """Arcs in a drawn plane, with a drawn surface normal (not along the plane's normal)."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**16)))
+    r = rng.uniform(0.02, 1.5)
+    ang = np.cumsum(np.r_[rng.uniform(-3, 3), rng.uniform(0.1, 3.0, 2)])
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    pts = rng.uniform(-1, 1, 3) + (q[:, :2] @ np.vstack([r * np.cos(ang), r * np.sin(ang)])).T
+    normal = q[:, 2] + rng.uniform(-0.4, 0.4, 3)
+    return Seam("arc", "arc", pts, None, draw(st.floats(-80.0, 80.0)),
+                draw(st.floats(-45.0, 45.0)), surface_normal=normal,
+                torch_side=draw(st.sampled_from([1, -1])),
+                standoff_m=draw(st.sampled_from([0.0, 0.004, 0.0153])))
+
+
+def _stacked_rows(seam: Seam, s: np.ndarray) -> tuple[np.ndarray, ...]:
+    return tuple(np.array(v) for v in zip(*(seam.path_row(float(x)) for x in s), strict=True))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seam=st.one_of(seams(), tilted_arcs()),
+       fractions=st.lists(st.floats(0.0, 1.0), min_size=1, max_size=50))
+def test_path_rows_are_path_row_at_each_arc_length_bit_for_bit(seam: Seam,
+                                                               fractions: list[float]) -> None:
+    """:meth:`Seam.path_rows` (issue 29: an arc's rows as arrays, a path of thousands of rows
+    in a millisecond or two) gives each row :meth:`Seam.path_row` gives, bit for bit."""
+    for seg in seam.segments():
+        s = np.array([0.0, *fractions, 1.0]) * seg.length()
+        got = seg.path_rows(s)
+        for g, w in zip(got, _stacked_rows(seg, s), strict=True):
+            assert _same(g, w)
+
+
+def test_planted_arc_row_fault_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A fault planted in the arrays' torch axis (the work angle's sine dropped) is caught by
+    the row-by-row oracle."""
+    seam = Seam("a", "arc", [[0.3, 0, 0], [0, 0.3, 0], [-0.3, 0, 0]], None, 40.0, 10.0,
+                surface_normal=[0, 0, 1])
+    s = np.linspace(0.0, seam.length(), 17)
+    real_deg2rad = np.deg2rad
+
+    def off(x):  # type: ignore[no-untyped-def]
+        return real_deg2rad(x) * (1.0 + 1e-12)
+
+    monkeypatch.setattr(seam_module.np, "deg2rad", off)
+    got = seam.path_rows(s)
+    monkeypatch.setattr(seam_module.np, "deg2rad", real_deg2rad)
+    assert not _same(got[2], _stacked_rows(seam, s)[2])
+
+
+def test_a_surface_normal_along_an_arc_is_refused_as_row_by_row() -> None:
+    """An arc whose surface normal runs along the seam somewhere (a normal in its plane):
+    the arrays refuse it with the row-by-row message, naming where."""
+    from sim.errors import CellsimError
+
+    seam = Seam("a", "arc", [[0.3, 0, 0], [0, 0.3, 0], [-0.3, 0, 0]], None, 40.0, 10.0,
+                surface_normal=[1.0, 0.0, 0.0])
+    s = np.linspace(0.0, seam.length(), 9)
+    with pytest.raises(CellsimError) as rows:
+        seam.path_rows(s)
+    with pytest.raises(CellsimError) as row:
+        _stacked_rows(seam, s)
+    assert str(rows.value) == str(row.value) and "surface normal runs along" in str(row.value)
