@@ -15,7 +15,8 @@ and prints the largest relative difference of the peak and RMS torques.
 
 By default (issue 29's acceptance) it prints instead, for the weld plate:
 
-* the pool's start-up on its own (start ``--workers`` warmed workers, one no-op each);
+* the pool's start-up on its own (start ``--workers`` warmed workers, one no-op each), the
+  median of ``--repeat`` pools (it varies by a tenth of a second from one to the next);
 * one metrics-only variant's wall time against its ``simulate`` stage (target <= 1.3): the
   first variant of a plan in a process (it scans the plan's reference) and a variant that
   reuses its plan (another payload at the same speed: what every further variant of a plan
@@ -25,9 +26,12 @@ By default (issue 29's acceptance) it prints instead, for the weld plate:
   own simulate stages: a slower speed scale simulates a longer cycle): 6 payloads at one speed
   (one plan: each worker scans its reference once and reuses it) and a 2 x 3 grid (three plans
   over two workers: a plan and its reference scan per task that has it, four in all), each
-  with and without the reuse; the tables with and without the reuse must be identical. Below
-  each sweep's line: how much of its wall the pool took (the rest: loading the scenario and
-  writing the report), the variants' own wall times and their stages, summed.
+  with and without the reuse; the tables with and without the reuse must be identical. Each
+  sweep runs ``--repeat`` times, each time in a new Python process as ``cellsim size`` runs
+  it (its report's chart imports matplotlib every time); every run's ratio is printed and the
+  figures are of the median run. Below each sweep's line: how much of its wall the pool took
+  (the rest: loading the scenario and writing the report), the variants' own wall times and
+  their stages, summed.
 
 Wall times on a machine shared with other jobs say little: CPU times (this process's, and the
 workers' from ``getrusage``) and the load average are printed beside them.
@@ -49,10 +53,14 @@ import math
 import os
 import platform
 import resource
+import statistics
+import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 
@@ -136,6 +144,43 @@ def evaluate_without_reuse(variant: Variant) -> object:
     return evaluate_variant(variant)
 
 
+def one_sweep(spec: str) -> None:
+    """``--one-sweep SPEC``: run one sweep (SPEC: JSON with the scenario, payloads, speed
+    scales, workers and whether the plan's scan is reused) and print its figures as one JSON
+    line: the wall time of ``run_sweep`` (its scenario load, pool, variants and report), the
+    workers' CPU, the pool's wall, each variant's stages, wall and cycle, and the table."""
+    a = json.loads(spec)
+    runner = evaluate_variant if a["reuse"] else evaluate_without_reuse
+    with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
+        c0, w0 = children_cpu(), time.perf_counter()
+        res = run_sweep(a["scenario"], a["payloads"], a["speeds"], runner,
+                        workers=a["workers"], out_dir=Path(tmp) / "sweep", progress=False,
+                        raise_on_failure=False)
+        wall, cpu = time.perf_counter() - w0, children_cpu() - c0
+    print(json.dumps({"wall": wall, "cpu": cpu, "wall_s": res.wall_s,
+                      "failures": len(res.failures), "table": table(res),
+                      "outcomes": [{"timings_s": o.timings_s, "wall_s": o.wall_s,
+                                    "duration_s": o.rows[0]["duration_s"] if o.rows else None}
+                                   for o in res.outcomes]}))
+
+
+def sweep_in_a_new_process(scenario: str, payloads: list[float], speeds: list[float],
+                           workers: int, reuse: bool) -> Any:
+    """:func:`one_sweep` in a new Python process; its figures as attributes (``outcomes``
+    with ``timings_s``, ``wall_s`` and ``rows[0]["duration_s"]``, as a sweep's)."""
+    spec = json.dumps({"scenario": scenario, "payloads": payloads, "speeds": speeds,
+                       "workers": workers, "reuse": reuse})
+    done = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--one-sweep", spec],
+                          capture_output=True, text=True, check=True)
+    got = json.loads(done.stdout.strip().splitlines()[-1])
+    outcomes = [SimpleNamespace(timings_s=o["timings_s"], wall_s=o["wall_s"],
+                                rows=[{"duration_s": o["duration_s"]}])
+                for o in got["outcomes"]]
+    return SimpleNamespace(wall=got["wall"], cpu=got["cpu"], wall_s=got["wall_s"],
+                           outcomes=outcomes, failures=[None] * got["failures"],
+                           table=got["table"])
+
+
 def load() -> str:
     return f"load average {os.getloadavg()[0]:.2f}, {os.getloadavg()[1]:.2f} (1, 5 min)"
 
@@ -171,13 +216,22 @@ def one_variant(scenario: str, payload: float, speed: float) -> dict:
             "cpu_over_simulate_cpu": cpu / sim_cpu}
 
 
-def acceptance(scenario: str, workers: int) -> dict:
-    out: dict = {"scenario": scenario, "workers": workers, "load_start": load()}
+def acceptance(scenario: str, workers: int, repeat: int = 3) -> dict:
+    out: dict = {"scenario": scenario, "workers": workers, "repeat": repeat,
+                 "load_start": load()}
     print(f"{scenario}, {workers} workers, {os.cpu_count()} CPUs; {load()}", flush=True)
-    c0 = children_cpu()
-    start = pool_startup_s(workers, "spawn", scenario)
-    out["pool_startup_s"], out["pool_startup_cpu_s"] = start, children_cpu() - c0
-    print(f"pool start-up ({workers} warmed workers, one no-op each): {start:.2f} s wall, "
+    # the start-up varies by a tenth of a second from one pool to the next: the bound takes
+    # the median of `repeat` pools
+    starts, cpus = [], []
+    for _ in range(repeat):
+        c0 = children_cpu()
+        starts.append(pool_startup_s(workers, "spawn", scenario))
+        cpus.append(children_cpu() - c0)
+    start = statistics.median(starts)
+    out["pool_startup_s"], out["pool_startup_cpu_s"] = start, statistics.median(cpus)
+    out["pool_startup_runs_s"] = starts
+    print(f"pool start-up ({workers} warmed workers, one no-op each): {start:.2f} s wall "
+          f"(median of {', '.join(f'{x:.2f}' for x in starts)}), "
           f"{out['pool_startup_cpu_s']:.2f} s CPU (workers)", flush=True)
     evaluate_variant(Variant(0.5, 0.9, scenario))  # imports, in this process
     for label, enabled, payloads in (("without reuse", False, (1.0, 3.0)),
@@ -208,13 +262,19 @@ def acceptance(scenario: str, workers: int) -> dict:
                                          ("2 payloads x 3 speeds", [1.0, 3.0], [0.8, 0.9, 1.0])):
         for label, runner in (("with reuse", evaluate_variant),
                               ("without reuse", evaluate_without_reuse)):
-            with tempfile.TemporaryDirectory(prefix="bench_sweep_") as tmp:
-                c0, w0 = children_cpu(), time.perf_counter()
-                res = run_sweep(scenario, payloads, speeds, runner, workers=workers,
-                                out_dir=Path(tmp) / "sweep", progress=False,
-                                raise_on_failure=False)
-                wall, cpu = time.perf_counter() - w0, children_cpu() - c0
-            tables[(grid_label, label)] = table(res)
+            # `repeat` sweeps, each in a new Python process as `cellsim size` runs one (its
+            # report's chart imports matplotlib each time); the figures below are of the
+            # median one by its ratio to its own bound
+            runs = []
+            for _ in range(repeat):
+                res = sweep_in_a_new_process(scenario, payloads, speeds, workers,
+                                             reuse=runner is evaluate_variant)
+                wall, cpu = res.wall, res.cpu
+                sims = sum(o.timings_s.get("simulate", float("nan")) for o in res.outcomes)
+                runs.append((wall / (1.5 * sims / workers + start), wall, cpu, res))
+            ratios = [r[0] for r in runs]
+            _, wall, cpu, res = sorted(runs, key=lambda r: r[0])[len(runs) // 2]
+            tables[(grid_label, label)] = res.table
             n = len(res.outcomes)
             # the variants' own simulate stages (in their workers; a slower speed scale is a
             # longer cycle), and the simulation's CPU scaled by each variant's cycle duration
@@ -235,7 +295,8 @@ def acceptance(scenario: str, workers: int) -> dict:
                                                   "variants_wall_sum_s": sum(
                                                       o.wall_s for o in res.outcomes),
                                                   "stages_sum_s": stages,
-                                                  "failures": len(res.failures)}
+                                                  "failures": len(res.failures),
+                                                  "ratios_of_the_runs": ratios}
             print(f"sweep {grid_label} {label}: {wall:.1f} s wall vs bound {bound:.1f} s "
                   f"(1.5 x {sims:.1f} s of its {n} simulate stages / {workers} + {start:.2f} s "
                   f"start-up; with {n} x one variant's {sim_one:.2f} s: "
@@ -244,6 +305,8 @@ def acceptance(scenario: str, workers: int) -> dict:
                   f"included) vs 1.5 x {cycles:.2f} cycles x {sim_cpu:.2f} s = {cpu_bound:.1f} s "
                   f"({cpu / cpu_bound:.2f}x; less the start-up's "
                   f"{(cpu - out['pool_startup_cpu_s']) / cpu_bound:.2f}x); {load()}", flush=True)
+            print(f"  ({repeat} runs: " + ", ".join(f"{x:.3f}x" for x in ratios)
+                  + " the bound; the median run above)", flush=True)
             rec = out[f"sweep {grid_label} {label}"]
             print(f"  (pool {res.wall_s:.1f} s of it; the variants' own wall summed "
                   f"{rec['variants_wall_sum_s']:.1f} s, stages summed: "
@@ -267,12 +330,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--warp", action="store_true",
                     help="Warp-CPU parity on 8 variants of --warp-scenario instead")
     ap.add_argument("--warp-scenario", default="kacso_lrmate100ib_sequence1")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="acceptance: pools started and sweeps run this many times each; the "
+                         "medians are reported (default 3)")
     ap.add_argument("--json", type=Path, default=None, help="write the numbers here")
+    ap.add_argument("--one-sweep", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.one_sweep:
+        one_sweep(args.one_sweep)
+        return 0
     info = {"python": platform.python_version(), "cpu_count": os.cpu_count(),
             "machine": platform.machine()}
     if not args.warp and not args.scale:
-        out = acceptance(args.scenario, args.workers or 2)
+        out = acceptance(args.scenario, args.workers or 2, max(1, args.repeat))
         if args.json:
             args.json.write_text(json.dumps({**info, **out}, indent=2) + "\n")
         return 0
