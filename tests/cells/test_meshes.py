@@ -152,10 +152,14 @@ def _check_damaged(tmp_path: Path, data: st.DataObject, budget: float) -> None:
     if np.any(counts == 1):  # open (the oracle counts the edges itself): the hull, said so
         assert len(pieces) == 1 and said and "open" in said[0]
         assert _same_hull(pieces[0], used[0] * 1e-3)
-    # every piece lies within the hull of the file's own vertices (Qhull's facets)
+    # every piece lies within the hull of the file's own vertices (Qhull's facets), up to
+    # CoACD's own rounding: its pieces' vertices reach a few micrometres past the hull of a
+    # damaged bracket (measured: up to 3.4 um on the 0.2 m bracket with a vertex moved 35 mm,
+    # 1.7e-5 of its size), so the hull is widened by 1e-4 of the vertices' extent
     eq = ConvexHull(used[0] * 1e-3).equations
+    tol = 1e-4 * float(np.ptp(used[0] * 1e-3, axis=0).max())
     for p in pieces:
-        assert np.all(p @ eq[:, :3].T + eq[:, 3] <= 1e-6)
+        assert np.all(p @ eq[:, :3].T + eq[:, 3] <= tol)
 
 
 @settings(max_examples=4, deadline=None, derandomize=True,
