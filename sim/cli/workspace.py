@@ -29,7 +29,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "seeds' families (lrmate100ib, lrmate200ic5l, robot_5r), whose singular "
                    "curves the map draws; another robot is refused in one line")
     p.add_argument("--out", metavar="FILE.png", default=None,
-                   help="PNG to write (default: workspace_<robot>.png in the current folder)")
+                   help="PNG to write (default: workspace_<robot>.png in the current folder); an "
+                        "existing file is replaced only if cellsim workspace wrote it there")
     p.set_defaults(func=run)
 
 

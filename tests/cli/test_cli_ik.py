@@ -158,9 +158,9 @@ def test_workspace_png_and_reach(capsys, tmp_path):
 
 def test_workspace_replaces_its_own_picture_and_refuses_anyone_elses(capsys, tmp_path):
     """``--out`` over a file: a picture ``cellsim workspace`` wrote (its PNG's Software text) is
-    replaced, as a second run of the same command does; any other file is refused in one line
-    and left as it was (it was overwritten: found by a new-user trial); the pictures take the
-    umask's mode."""
+    replaced, as a second run of the same command does; any other file, a copy of such a
+    picture at another place included, is refused in one line and left as it was (both were
+    overwritten: found by new-user trials); the pictures take the umask's mode."""
     import os
 
     out_png = tmp_path / "ws.png"
@@ -179,6 +179,15 @@ def test_workspace_replaces_its_own_picture_and_refuses_anyone_elses(capsys, tmp
     other.write_bytes(out_png.read_bytes().replace(b"cellsim workspace", b"matplotlib v3.9.0"))
     assert _run(capsys, "workspace", "robot_5r", "--out", str(other))[0] == 2
     assert os.path.getsize(other) == os.path.getsize(out_png) + 0
+    # a picture cellsim wrote, copied elsewhere, is the user's file there (it was overwritten:
+    # found by a new-user trial); at its own place it is still replaced
+    copied = tmp_path / "keep" / "mypic.png"
+    copied.parent.mkdir()
+    copied.write_bytes(out_png.read_bytes())
+    code, _out, err = _run(capsys, "workspace", "robot_5r", "--out", str(copied))
+    assert code == 2 and "cellsim workspace did not write it" in err
+    assert copied.read_bytes() == out_png.read_bytes()
+    assert _run(capsys, "workspace", "robot_5r", "--out", str(out_png))[0] == 0
 
 
 def _umask() -> int:

@@ -100,15 +100,20 @@ def compute_reach(model: KinematicModel) -> Reach:
 #: The PNG's ``Software`` text: marks a picture ``cellsim workspace`` wrote (another run may
 #: replace it; any other file at ``--out`` is refused).
 PNG_SOFTWARE = "cellsim workspace"
+#: The PNG's text naming the file it was written as (its absolute path): a picture copied or
+#: moved elsewhere is the user's file there, not cellsim's.
+PNG_WRITTEN_AS = "cellsim written as"
 
 
 def written_by_workspace(path: str | Path) -> bool:
-    """Whether ``path`` is a PNG that :func:`plot_workspace` wrote (its ``Software`` text)."""
+    """Whether ``path`` is a PNG that :func:`plot_workspace` wrote at this very place (its
+    ``Software`` text and the absolute path it was written as)."""
     from PIL import Image, UnidentifiedImageError
 
     try:
         with Image.open(path) as im:
-            return im.format == "PNG" and im.info.get("Software") == PNG_SOFTWARE
+            return (im.format == "PNG" and im.info.get("Software") == PNG_SOFTWARE
+                    and im.info.get(PNG_WRITTEN_AS) == str(Path(path).resolve()))
     except (OSError, UnidentifiedImageError, ValueError, SyntaxError):  # PIL: a broken PNG
         return False
 
@@ -185,7 +190,8 @@ def plot_workspace(model: KinematicModel, out: str | Path, title: str = "") -> R
 
     try:
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=90, metadata={"Software": PNG_SOFTWARE})
+        fig.savefig(buf, format="png", dpi=90,
+                    metadata={"Software": PNG_SOFTWARE, PNG_WRITTEN_AS: str(out.resolve())})
         write_atomic(out, buf.getvalue())  # a full disk leaves no half-written picture
     finally:
         plt.close(fig)
