@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 import traceback
 import warnings
@@ -28,8 +29,26 @@ COMMANDS = ("list", "plan", "ik", "workspace", "check", "run", "size", "render",
             "export")
 
 
+class Parser(argparse.ArgumentParser):
+    """``argparse`` with cellsim's way of refusing input: a mistake on the command line (an
+    unknown option, a missing or malformed value) is one line naming the command and the
+    option, and exit 2, as every other input mistake (argparse's own usage block before it
+    buried the line that says what is wrong); a value that starts with a minus and a digit
+    (``--payload -1,2``) is a value, not an unknown option (as Python 3.13's argparse reads
+    it), so that the option's own check says what is wrong with it. Sub-command parsers are of
+    this class too."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"-\.?\d")
+
+    def error(self, message: str) -> Any:  # argparse's signature: NoReturn
+        self.exit(2, printable(f"{self.prog}: error: {message} (see {self.prog} --help)")
+                  + "\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="cellsim",
         description="Physics simulation of industrial robot welding and pick cells on MuJoCo.",
     )
