@@ -2,9 +2,9 @@
 kinematics.
 
 Position in mm in the robot's ``frame0``; orientation of its ``tcp`` frame as Z-Y-X Euler
-angles in degrees, ``R = Rz(A) Ry(B) Rx(G)`` (seed 000 eq. 6); default: the tcp orientation at
-the home configuration (q = 0). Solutions are printed best first (inside the joint ranges,
-then closest to home; see :mod:`sim.robots.kinematics.ik`), in degrees, only the best unless
+angles in degrees, ``R = Rz(A) Ry(B) Rx(G)`` (seed 000 eq. 6); default: the tcp orientation in
+the zero pose (q = 0). Solutions are printed best first (inside the joint ranges,
+then closest to the zero pose; see :mod:`sim.robots.kinematics.ik`), in degrees, only the best unless
 ``--all``. For the 5-axis robots A is implied by the position: a disagreeing A is replaced
 (one note on stderr). A pose with no solution is one line on stderr and exit code 2, for every
 kind of robot (shipped, a robot folder, an arm as data with a closed form or the numeric
@@ -28,7 +28,7 @@ import numpy as np
 from sim.core.rotations import euler_zyx_to_matrix, make_transform
 from sim.core.text import mm_text
 from sim.errors import KinematicsError, UnreachableError
-from sim.robots.kinematics.ik import solve_ik
+from sim.robots.kinematics.ik import listed, solve_ik
 from sim.robots.kinematics.model import kinematic_model
 from sim.robots.registry import resolve_robot
 
@@ -39,7 +39,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Analytic inverse kinematics: joint values (deg) that put the robot's tcp "
                     "at X Y Z (mm, frame0) with orientation R = Rz(A) Ry(B) Rx(G) (deg). "
                     "Solutions are listed best first: inside the joint ranges, then closest "
-                    "to home (joint distance weighted by 1/max speed).")
+                    "to the zero pose, every joint at 0 (joint distance weighted by 1/max "
+                    "speed).")
     p.add_argument("robot", metavar="ROBOT",
                    help="robot name (see `cellsim list`), or an arm as data: a URDF file, a "
                         "robot.toml or its folder (closed form when ortho-parallel with a "
@@ -48,8 +49,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         p.add_argument(axis.lower(), metavar=axis, type=float,
                        help=f"tcp {axis.lower()} in frame0, mm")
     p.add_argument("--euler-zyx-deg", metavar=("A", "B", "G"), nargs=3, type=float, default=None,
-                   help="tcp orientation, Z-Y-X Euler angles in degrees (default: the home "
-                        "orientation); for 5-axis robots A is implied by the position")
+                   help="tcp orientation, Z-Y-X Euler angles in degrees (default: the tcp's "
+                        "orientation in the zero pose, every joint at 0, not a cell's home "
+                        "pose); for 5-axis robots A is implied by the position")
     p.add_argument("--tool", metavar="NAME", default=None,
                    help="the tcp is this tool's tip: a shipped tool (see `cellsim list`) or a "
                         "tool file (docs/cell-format.md); default: the model's own tcp, the "
@@ -163,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
         R = euler_zyx_to_matrix(a, b, g)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        sols = solve_ik(model, make_transform(R, p))
+        sols = listed(solve_ik(model, make_transform(R, p)))
     for w in caught:
         print(f"cellsim: warning: {w.message}", file=sys.stderr)
     if not sols:

@@ -31,7 +31,7 @@ from sim.robots.families.five_r import PLANE_TOL, SINGULAR_TOL, ik_5r_seed
 from sim.robots.kinematics.model import KinematicModel
 
 __all__ = ["IKSolution", "PLANE_TOL", "SINGULAR_TOL", "SingularityWarning", "ik_5r_seed",
-           "ik_path", "ranking_cost", "solve_ik"]
+           "ik_path", "listed", "ranking_cost", "solve_ik"]
 
 
 @dataclass(frozen=True)
@@ -111,6 +111,24 @@ def solve_ik(model: KinematicModel, pose: ArrayLike, current: ArrayLike | None =
             out.append(IKSolution(q=rep, within_limits=bool(model.within_limits(rep)),
                                   branch=branch, cost=ranking_cost(model, rep, cur)))
     out.sort(key=lambda s: (not s.within_limits, s.cost))
+    return out
+
+
+def listed(solutions: Sequence[IKSolution]) -> list[IKSolution]:
+    """The solutions as ``cellsim ik`` lists them: every one inside the joint ranges; of those
+    outside, one per posture (the first, so the best ranked, of the whole-turn variants of a
+    joint that :func:`solve_ik` gives for each, which are the same posture), as
+    :meth:`sim.robots.arm.Arm.ik` lists an arm given as data (the same arm by name listed 24
+    solutions and by its file 14: found by a session's trial)."""
+    out: list[IKSolution] = []
+    seen: list[NDArray[np.float64]] = []
+    for s in solutions:
+        if not s.within_limits:
+            w = wrap_to_pi(np.asarray(s.q, dtype=float))
+            if any(np.abs(wrap_to_pi(w - v)).max() < 1e-9 for v in seen):
+                continue
+            seen.append(w)
+        out.append(s)
     return out
 
 
