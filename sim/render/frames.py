@@ -361,20 +361,12 @@ class CollisionPainter:
     def __init__(self, model: Any, collisions: Sequence[dict[str, Any]]) -> None:
         import mujoco
 
+        from sim.simulation.collision_model import painted_geoms
+
         self._mj = mujoco
         self.intervals: list[tuple[float, float, frozenset[int]]] = []
         for c in collisions:
-            ids: set[int] = set()
-            for name in c.get("all_geoms", c.get("geoms", ())):
-                g = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, str(name))
-                if g < 0:
-                    continue
-                body = int(model.geom_bodyid[g])
-                bname = model.body(body).name
-                if bname.startswith("robot/") and not bname.startswith("robot/tool/"):
-                    ids.update(int(k) for k in np.flatnonzero(model.geom_bodyid == body))
-                else:
-                    ids.add(g)
+            ids = painted_geoms(model, [str(n) for n in c.get("all_geoms", c.get("geoms", ()))])
             if ids:
                 t0, t1 = float(c["t0"]), float(c["t1"])
                 pad = max(0.0, MIN_PAINT_S - (t1 - t0)) / 2.0

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -46,6 +47,9 @@ _AFFINITY = {LINK: 1 | 2 | 4 | 8, TOOL: 1 | 4 | 8, CELL: 1 | 2 | 8, PART: 1 | 2 
 _AFFINITY_ROBOTS = {**_AFFINITY, TOOL: 1 | 2 | 4 | 8}
 #: The first robot's name (its MJCF prefix).
 LEAD = "robot"
+#: The name dm_control gives a geom a model file left unnamed (``robot//unnamed_geom_18``):
+#: reported as ``<body>#<k>`` (which link touched), as an unnamed one.
+_DM_CONTROL_UNNAMED = re.compile(r"/unnamed_geom_\d+$")
 ROLE_CODE = {LINK: 0, TOOL: 1, CELL: 2, PART: 3}
 
 
@@ -214,7 +218,7 @@ class CollisionModel:
             body = int(src.geom_bodyid[g])
             bname = src.body(body).name
             gname = src.geom(g).name
-            if not gname:
+            if _unnamed(gname):
                 unnamed[body] = unnamed.get(body, 0) + 1
                 gname = f"{bname}#{unnamed[body] - 1}"
             robot = next((r for r in self.robots if bname.startswith(f"{r}/")
@@ -412,6 +416,48 @@ class CollisionModel:
         first = np.ones(s.size, bool)
         first[1:] = (s[1:] != s[:-1]) | (g1[1:] != g1[:-1]) | (g2[1:] != g2[:-1])
         return Contacts(s[first], g1[first], g2[first], dist[first])
+
+
+def _unnamed(name: str) -> bool:
+    """A geom the model file left unnamed: no name, or the one dm_control gives it when it
+    attaches a model (``robot//unnamed_geom_18``)."""
+    return not name or bool(_DM_CONTROL_UNNAMED.search(name))
+
+
+def geom_id(model: Any, name: str) -> int:
+    """Id of the geom a finding names (-1 when the model has none): a name of the model, or
+    ``<body>#<k>``, the k-th geom of that body that the model file left unnamed (as
+    :class:`CollisionModel` names it)."""
+    import mujoco
+
+    g = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name))
+    if g >= 0 or "#" not in name:
+        return g
+    body_name, _, k = name.rpartition("#")
+    body = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body_name))
+    if body < 0 or not k.isdigit():
+        return -1
+    mine = [i for i in np.flatnonzero(np.asarray(model.geom_bodyid) == body)
+            if _unnamed(model.geom(int(i)).name)]
+    return int(mine[int(k)]) if int(k) < len(mine) else -1
+
+
+def painted_geoms(model: Any, names: Sequence[str]) -> frozenset[int]:
+    """Geom ids a picture of a finding paints for its geoms (names as :func:`geom_id` reads
+    them): a robot link's every geom (its collision geoms are hidden in pictures, so the
+    whole link is painted), a tool's, the cell's or a part's geom itself."""
+    ids: set[int] = set()
+    for name in names:
+        g = geom_id(model, str(name))
+        if g < 0:
+            continue
+        body = int(model.geom_bodyid[g])
+        bname = model.body(body).name
+        if bname.startswith(f"{LEAD}/") and not bname.startswith(f"{LEAD}/tool/"):
+            ids.update(int(k) for k in np.flatnonzero(np.asarray(model.geom_bodyid) == body))
+        else:
+            ids.add(g)
+    return frozenset(ids)
 
 
 def coarse_scan(cm: CollisionModel, qpos: NDArray[np.float64], samples: NDArray[np.int64]

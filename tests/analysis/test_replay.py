@@ -227,3 +227,28 @@ def test_the_first_view_frames_every_robot_over_the_whole_cycle(name, scenario_r
         assert (np.abs(ndc) + rad[:, None] <= 1.0 + 1e-9).all(), (name, i, np.abs(ndc).max())
         lo, hi = np.minimum(lo, ndc.min(axis=0)), np.maximum(hi, ndc.max(axis=0))
     assert ((hi - lo) / 2 >= 0.4).any(), (name, lo, hi)
+
+
+def test_a_robot_links_collision_paints_the_links_visible_geoms():
+    """A finding names a robot link's collision geom (hidden in pictures; one the model file
+    left unnamed is ``<body>#<k>``): the page paints that link's visible geoms, as the video
+    does, and a name the model does not have paints nothing."""
+    from sim.scenario import load_scenario
+    from sim.simulation.collision_model import LINK, CollisionModel
+    from sim.simulation.compile import build
+
+    built = build(load_scenario("lrmate200ic_weld_plate"))
+    model = built.model
+    link = next(cg for cg in CollisionModel(built).geoms.values()
+                if cg.role == LINK and "#" in cg.name and cg.name.startswith("robot/link"))
+    body = int(model.geom_bodyid[link.id])
+    t = np.linspace(0.0, 1.0, 11)
+    arrays = {"t": t, "qpos": np.tile(model.qpos0, (t.size, 1)), "tcp_pos": np.zeros((t.size, 3)),
+              "arc_on": np.zeros(t.size, bool)}
+    summary = {"scenario": "s", "collisions": [
+        {"t0": 0.2, "t1": 0.4, "geoms": [link.name, "nowhere"], "bodies": ["a", "b"]}]}
+    p = build_payload(model, arrays, summary, [f"j{i}" for i in range(6)], fps=10)
+    shown = {g["name"] for g in p["geoms"] if g["body"] == body}
+    assert shown and set(p["collisions"][0]["geoms"]) >= shown
+    assert all(model.geom(int(model.geom(n).id)).bodyid == body
+               for n in p["collisions"][0]["geoms"])

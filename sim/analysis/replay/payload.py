@@ -155,8 +155,16 @@ def build_payload(model: Any, arrays: Mapping[str, NDArray[Any]], summary: Mappi
                        "labels": [joints[i] if i < len(joints) else f"j{i + 1}"
                                   for i in range(y.shape[0])]})
     clear = summary.get("clearance")
+    from sim.simulation.collision_model import painted_geoms
+
+    def page_names(names: Any) -> list[str]:
+        """The page's names (as :func:`~sim.analysis.replay.scene.geoms_and_meshes` gives them) of the geoms a finding paints:
+        a robot link's visible geoms, as the video paints it (its collision geoms are hidden)."""
+        ids = painted_geoms(model, [str(g) for g in names])
+        return [model.geom(g).name or f"geom{g}" for g in sorted(ids)]
+
     collisions = [{"t0": float(c["t0"]), "t1": float(c["t1"]),
-                   "geoms": [str(g) for g in c.get("all_geoms", c.get("geoms", []))],
+                   "geoms": page_names(c.get("all_geoms", c.get("geoms", []))),
                    "bodies": [str(b) for b in c.get("bodies", [])],
                    "depth_mm": _num(c.get("depth_mm"))}
                   for c in summary.get("collisions") or [] if isinstance(c, Mapping)
