@@ -506,17 +506,20 @@ class RunResult:
         Raises:
             RunFolderError: Not a finished run folder, or a damaged ``summary.json``.
         """
+        from sim.core.arguments import path_argument
         from sim.simulation import runfolder
 
-        folder = Path(path)
+        folder = path_argument(path, "path", error=RunFolderError)
         where = f"run folder {str(folder)!r}"
         if not folder.is_dir():
-            raise RunFolderError(f"{where} does not exist or is not a folder")
+            raise RunFolderError(f"{where} does not exist or is not a folder", file=str(folder))
         if runfolder.marker_state(folder) == "writing":
-            raise RunFolderError(f"{where} is a run that was still being written, not a result")
+            raise RunFolderError(f"{where} is a run that was still being written, not a result",
+                                 file=str(folder))
         summary = runfolder.read_run_json(folder, runfolder.SUMMARY_JSON)
         if summary is None:
-            raise RunFolderError(f"{where} has no summary.json (not a finished run)")
+            raise RunFolderError(f"{where} has no summary.json (not a finished run)",
+                                 file=str(folder))
         sizing = runfolder.read_run_json(folder, runfolder.SIZING_JSON)
         return cls.from_summary(summary, sizing, path=folder)
 

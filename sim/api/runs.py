@@ -9,23 +9,42 @@ past a limit) is not an exception but a ``"fail"`` verdict with its failed check
 
 from __future__ import annotations
 
-import dataclasses
 import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from sim.api.results import RunResult
+from sim.core.arguments import (
+    choice_argument,
+    count_argument,
+    flag_argument,
+    got,
+    optional_path_argument,
+)
+from sim.errors import UsageError
+from sim.pipeline.options import BACKENDS, changed_options
 from sim.pipeline.run import RunOptions, evaluate_scenario, run_and_write, selection_options
 from sim.pipeline.sweep import SweepResult, run_sweep, validate_payloads, validate_speed_scales
+from sim.pipeline.sweep.engines import ENGINES
 from sim.scenario import Scenario, load_scenario
 
 ScenarioLike = Scenario | str | os.PathLike[str]
 
 
 def _scenario(scenario: ScenarioLike) -> Scenario:
-    return scenario if isinstance(scenario, Scenario) else load_scenario(
-        scenario if isinstance(scenario, str) else Path(scenario))
+    """A scenario, loaded where it is a path or a name (anything else: one line naming
+    ``scenario``, :func:`~sim.scenario.load_scenario`)."""
+    return scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+
+
+def _options(options: Any, default: RunOptions) -> RunOptions:
+    if options is None:
+        return default
+    if not isinstance(options, RunOptions):
+        raise UsageError(f"options: expected sim.RunOptions(...) or None, got {got(options)}",
+                         key="options")
+    return options
 
 
 def evaluate(scenario: ScenarioLike, options: RunOptions | None = None) -> RunResult:
@@ -43,7 +62,7 @@ def evaluate(scenario: ScenarioLike, options: RunOptions | None = None) -> RunRe
     Raises:
         CellsimError: A user mistake (bad file, unreachable target, unstable simulation).
     """
-    options = options or RunOptions(video=False, plots=False, progress=False)
+    options = _options(options, RunOptions(video=False, plots=False, progress=False))
     return RunResult.from_evaluation(evaluate_scenario(_scenario(scenario), options))
 
 
@@ -63,7 +82,7 @@ def run(scenario: ScenarioLike, options: RunOptions | None = None, **changes: An
     Raises:
         CellsimError: A user mistake, or no working OpenGL backend for a video.
     """
-    options = dataclasses.replace(options or RunOptions(progress=False), **changes)
+    options = changed_options(_options(options, RunOptions(progress=False)), changes)
     loaded = _scenario(scenario)
     if options.video:
         from sim.render.gl import configure_gl
@@ -108,6 +127,12 @@ def sweep(scenario: ScenarioLike, payloads_kg: Sequence[float] | None = None,
     from sim.pipeline.sweep.evaluation import evaluate_batch, evaluate_variant
 
     loaded = _scenario(scenario)
+    out_dir = optional_path_argument(out_dir, "out_dir")
+    workers = count_argument(workers, "workers")
+    for name, flag in (("keep_runs", keep_runs), ("select", select), ("progress", progress)):
+        flag_argument(flag, name)
+    choice_argument(engine, "engine", ENGINES)
+    choice_argument(backend, "backend", BACKENDS)
     payloads = validate_payloads(payloads_kg if payloads_kg is not None
                                  else [loaded.payload_kg], field="payloads_kg")
     scales = validate_speed_scales(speed_scales, field="speed_scales")

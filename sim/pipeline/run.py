@@ -42,6 +42,7 @@ from sim.analysis.sizing import SizingResult
 from sim.analysis.verdict import run_checks, verdict, warnings_count
 from sim.errors import InternalError, RenderError, RunFolderError
 from sim.pipeline.loads import heaviest_part_kg, tool_load
+from sim.pipeline.options import check_run_options
 from sim.pipeline.stages import Stages
 from sim.scenario import Scenario
 from sim.simulation import runfolder
@@ -86,6 +87,9 @@ class RunOptions:
     selection: Any = None
     csv: bool = False
     backend: str = "mujoco"
+
+    def __post_init__(self) -> None:
+        check_run_options(self)  # each option of its kind, or one line naming it
 
 
 # --------------------------------------------------------------------------------------------

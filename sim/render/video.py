@@ -221,10 +221,11 @@ def check_video_args(model: Any, video_args: Mapping[str, Any]) -> None:
     validate_size(video_args.get("width", 640), video_args.get("height", 480))
     fps = video_args.get("fps", 30.0)
     if not (np.isfinite(fps) and fps > 0):
-        raise RenderError(f"--fps must be a positive number, got {fps!r}")
+        raise RenderError(f"video fps (--fps): must be a positive number, got {fps!r}")
     speed = video_args.get("speed", 1.0)
     if not (np.isfinite(speed) and speed > 0):
-        raise RenderError(f"--video-speed must be a positive number, got {speed!r}")
+        raise RenderError(f"video speed (--video-speed): must be a positive number, got "
+                          f"{speed!r}")
     resolve_jobs(video_args.get("jobs"), 1)  # a bad process count
 
 

@@ -17,6 +17,7 @@ The phases themselves are built by :mod:`sim.scenario.phases`, and planned by
 from __future__ import annotations
 
 import difflib
+import os
 import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -65,7 +66,7 @@ if TYPE_CHECKING:
     from sim.robots.spec import RobotSpec
 
 
-def resolve_scenario(ref: str | Path) -> Path:
+def resolve_scenario(ref: str | os.PathLike[str]) -> Path:
     """Path of a scenario given as a file path or as a shipped scenario's name.
 
     Raises:
@@ -82,7 +83,7 @@ def resolve_scenario(ref: str | Path) -> Path:
     return shipped.get(str(ref))
 
 
-def load_scenario(ref: str | Path) -> Scenario:
+def load_scenario(ref: str | os.PathLike[str]) -> Scenario:
     """Load and validate a scenario file (path or shipped name).
 
     Raises:
@@ -90,6 +91,9 @@ def load_scenario(ref: str | Path) -> Scenario:
             the file and the key.
         UnknownNameError: Unknown scenario name or robot.
     """
+    from sim.core.arguments import path_argument
+
+    path_argument(ref, "scenario", error=ScenarioError)  # a path or a name, not empty
     path = resolve_scenario(ref)
     return parse_scenario(read_input_text(path, ScenarioError, "scenario file"), source=path)
 

@@ -373,13 +373,16 @@ class Scenario:
         """
         import dataclasses
 
-        if not (np.isfinite(speed_scale) and speed_scale > 0):
-            raise ScenarioError(f"speed scale must be a positive number, got {speed_scale!r}")
-        if payload_kg is not None and not (np.isfinite(payload_kg)
-                                           and 0 <= payload_kg <= MAX_PAYLOAD_KG):
-            raise ScenarioError(f"payload_kg must be 0 to {MAX_PAYLOAD_KG:g} kg, got "
-                                f"{payload_kg!r}")
-        s = float(speed_scale)
+        from sim.core.arguments import number_argument
+
+        s = number_argument(speed_scale, "speed_scale", error=ScenarioError)
+        if not (np.isfinite(s) and s > 0):
+            raise ScenarioError(f"speed_scale: must be a positive number, got {speed_scale!r}")
+        if payload_kg is not None:
+            payload_kg = number_argument(payload_kg, "payload_kg", error=ScenarioError)
+            if not (np.isfinite(payload_kg) and 0 <= payload_kg <= MAX_PAYLOAD_KG):
+                raise ScenarioError(f"payload_kg: must be 0 to {MAX_PAYLOAD_KG:g} kg, got "
+                                    f"{payload_kg!r}")
         phases, actions = _scaled(self.phases, self.actions, s)
         partners = []
         for w in self.partners:  # the other robots' work runs faster too
