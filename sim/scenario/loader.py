@@ -28,7 +28,7 @@ from pydantic import BaseModel, ValidationError
 from sim.cells import BARE, resolve_cell, resolve_tool
 from sim.core.files import read_input_text
 from sim.core.resources import shipped_scenarios
-from sim.core.tomlschema import describe
+from sim.core.tomlschema import describe, model_at
 from sim.errors import CellsimError, ScenarioError, UnknownNameError
 from sim.robots.registry import resolve_robot
 from sim.scenario.fanuc_ls import read_ls
@@ -55,8 +55,6 @@ from sim.scenario.schema import (
     LinearPhaseSpec,
     RobotWorkSpec,
     ScenarioSpec,
-    SimulationSpec,
-    VideoSpec,
     WeaveSpec,
 )
 
@@ -387,8 +385,8 @@ def _model_at(loc: tuple[Any, ...], raw: Any,
         return None
     if head == "drives" and len(loc) == 2:
         return DriveOverrideSpec
-    if len(loc) == 1:
-        return {"simulation": SimulationSpec, "video": VideoSpec, "expect": ExpectSpec}.get(head)
+    if len(loc) == 1:  # a table of the top level: [simulation], [video], [sizing], [expect]
+        return model_at(root, loc)
     return None
 
 
