@@ -71,7 +71,7 @@ from sim.errors import CatalogError
 #: 200 reducers, or 2000 motors and 20 reducers.
 MAX_PAIRS = 40_000
 #: A reducer's ratio (above 1: checked with the entry).
-REDUCER_RATIO = Quantity("a reducer ratio", "", 1.0, 1e4)
+REDUCER_RATIO = Quantity("a reducer ratio", "", 1.0, 1e4, lo_open=True)
 #: A motor's rotor inertia (a motor has one).
 MOTOR_INERTIA_KG_M2 = Quantity("a rotor inertia", "kg m^2", 1e-12, 100.0)
 #: A reducer's inertia at its input (0: none given).
@@ -161,8 +161,6 @@ class ReducerSpec(_Entry):
 
     @model_validator(mode="after")
     def _consistent(self) -> ReducerSpec:
-        if self.ratio <= 1:
-            raise ValueError(f"ratio: must be above 1 (a reducer), got {self.ratio!r}")
         if not (self.rated_torque_nm <= self.repeated_peak_torque_nm
                 <= self.momentary_peak_torque_nm):
             raise ValueError("torques must satisfy rated_torque_nm <= repeated_peak_torque_nm "

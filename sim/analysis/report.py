@@ -30,11 +30,20 @@ from typing import Any
 
 import numpy as np
 
-from sim.analysis.catalog import describe_entry
 from sim.analysis.mechanism_report import AXIS_HEAD, mechanism_sections
 from sim.analysis.report_text import num_text, pair_text, pct_text
 from sim.analysis.robot_report import ROBOT_JOINT_HEAD, robot_sections
-from sim.analysis.selection import REPORT_TOP
+from sim.analysis.selection_report import (
+    CHECK_HEAD,
+    RANK_HEAD,
+    SELECTION_HEAD,
+    illustrative,
+    pair_tables,
+    selection_intro,
+    selection_markdown,
+    selection_table,
+    verdict_text,
+)
 from sim.analysis.sizing import (
     CHECK_TITLES,
     PEAK_KNEE_FRACTION,
@@ -249,11 +258,11 @@ def run_verdict_text(summary: Mapping[str, Any]) -> str | None:
 
 
 def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
-                    summary: Mapping[str, Any] | None = None) -> str:
+                    summary: Mapping[str, Any] | None = None, selection: Any = None) -> str:
     """Text of ``sizing.md``: header, the run's verdict (``summary``'s: the same as
     ``report.html`` and ``summary.json``, with its failed checks and warnings), the sizing's
     own verdict paragraph, a section per mechanism (:mod:`sim.analysis.mechanism_report`),
-    table, checks, chart links."""
+    table, checks, the actuator selection (when the run made one), chart links."""
     parts = [f"# Actuator sizing: {result.scenario or 'run'}", ""]
     parts.append(f"Robot: {result.robot or 'n/a'}; cycle duration {result.duration:.3f} s; checks "
                  f"on basis '{result.basis}'.")
@@ -284,6 +293,8 @@ def sizing_markdown(result: SizingResult, chart_names: Sequence[str] = (),
     parts.append(_md_table(_TABLE_HEAD, [_table_cells(j) for j in result.joints]))
     parts += ["", "## Checks", ""]
     parts.append(_md_table(_CHECK_HEAD, [r for j in result.joints for r in _checks_cells(j)]))
+    if selection is not None:
+        parts += ["", *selection_markdown(selection)]
     if chart_names:
         parts += ["", "## Charts", ""]
         for name in chart_names:
@@ -348,50 +359,21 @@ _CLEAR_HEAD = ("phase", "tool (mm)", "tool closest to", "arm (mm)", "arm closest
 
 
 def selection_html(sel: Any) -> list[str]:
-    """The "Actuator selection" section: the choice per joint, its checks and the ranking."""
+    """The "Actuator selection" section: the choice per joint, its checks and the ranking
+    (the rows of :mod:`sim.analysis.selection_report`, as ``sizing.md`` has them)."""
     esc = html.escape
-    o = sel.options
-    out = ["<h2>Actuator selection</h2>",
-           f"<p>Catalogue {esc(o.catalog.name)}: {len(o.catalog.motors)} motors x "
-           f"{len(o.catalog.reducers)} reducers per joint; duty cycle {sel.cycle_s:.4g} s "
-           f"cycle + {o.dwell_s:g} s dwell; reducer life target {o.life_h:g} h; ranked by "
-           f"{esc(o.rank)}; each check on the worse of the inverse dynamics and the simulated "
-           "torque.</p>"]
-    if any(e.illustrative for e in (*o.catalog.motors, *o.catalog.reducers)):
+    out = ["<h2>Actuator selection</h2>", f"<p>{esc(selection_intro(sel))}</p>"]
+    if illustrative(sel):
         out.append('<p class="small">Entries marked [illustrative] hold numbers not verified '
                    "against their datasheet: verify before ordering.</p>")
-    rows = []
-    for j in sel.joints:
-        if j.chosen is None:
-            rows.append((j.joint, "NONE", "", "", "", esc(j.reason), "", f"0 / {j.n_pairs}"))
-            continue
-        c, h = j.chosen, j.chosen.hardest
-        runner = (f"{j.runner_up.motor.id} + {j.runner_up.reducer.id}" if j.runner_up else "-")
-        rows.append((j.joint, describe_entry(c.motor), describe_entry(c.reducer),
-                     f"{c.reducer.spec.ratio:g}", _f(c.mass_kg, 3), f"{h.name} {_pct(h.margin_pct)}",
-                     runner, f"{len(j.passing)} / {j.n_pairs}"))
     cls = "verdict" if sel.all_served else "verdict fail"
-    out.append(f'<p class="{cls}">' + ("Every joint has a pair that passes every check."
-                                       if sel.all_served else
-                                       "Some joint has no pair that passes: see below.") + "</p>")
-    out.append(_html_table(("joint", "motor", "reducer", "ratio", "mass (kg)", "hardest check",
-                            "runner-up", "pairs passing"), rows))
-    for j in sel.joints:
-        pair = j.chosen or j.closest
-        if pair is None:
-            continue
-        title = "chosen" if j.chosen else "closest (fails)"
-        out.append(f"<details><summary>{esc(j.joint)}: {title} {esc(pair.motor.id)} + "
-                   f"{esc(pair.reducer.id)}</summary>")
-        out.append(_html_table(("check", "value", "limit", "unit", "margin", "source",
-                                "severity"),
-                               [(c.name, _f(c.value), _f(c.limit), c.unit, _pct(c.margin_pct),
-                                 c.source, c.severity) for c in pair.checks]))
-        if j.passing:
-            out.append(_html_table(("rank", "motor", "reducer", "mass (kg)", "min margin"),
-                                   [(str(i + 1), p.motor.id, p.reducer.id, _f(p.mass_kg, 3),
-                                     _pct(p.min_margin_pct))
-                                    for i, p in enumerate(j.passing[:REPORT_TOP])]))
+    out.append(f'<p class="{cls}">{esc(verdict_text(sel))}</p>')
+    out.append(_html_table(SELECTION_HEAD, selection_table(sel)))
+    for title, checks, ranking in pair_tables(sel):
+        out.append(f"<details><summary>{esc(title)}</summary>")
+        out.append(_html_table(CHECK_HEAD, checks))
+        if ranking:
+            out.append(_html_table(RANK_HEAD, ranking))
         out.append("</details>")
     return out
 
@@ -574,7 +556,8 @@ def write_sizing(run_dir: str | Path, result: SizingResult, *, charts: bool = Tr
         video = VIDEO_MP4 if (run_dir / VIDEO_MP4).is_file() else None
     else:  # the runner's summary in memory names the video when it wrote one
         video = summary.get("video")
-    written["md"] = write_atomic(run_dir / SIZING_MD, sizing_markdown(result, list(pngs), summary))
+    written["md"] = write_atomic(run_dir / SIZING_MD, sizing_markdown(result, list(pngs), summary,
+                                                                   selection))
     written["html"] = write_atomic(run_dir / REPORT_HTML,
                                    sizing_html(result, pngs, summary, video, selection,
                                                        replay))

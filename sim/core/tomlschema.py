@@ -77,12 +77,14 @@ class Quantity:
         what: The quantity in words, for messages (``"a mass"``).
         unit: Its unit as the key names it (``"kg"``; ``""`` for a pure number).
         lo, hi: The range, inclusive: a value outside is a typo or a unit mistake.
+        lo_open: ``lo`` itself is outside (a reducer's ratio is above 1, not 1).
     """
 
     what: str
     unit: str
     lo: float
     hi: float
+    lo_open: bool = False
 
     def problem(self, value: object) -> str:
         """Why ``value`` is not this quantity ("" when it is): :func:`number_problem`, then
@@ -91,9 +93,12 @@ class Quantity:
         if bad:
             return bad
         v = float(value)  # type: ignore[arg-type]
-        if self.lo <= v <= self.hi:
+        if (self.lo < v if self.lo_open else self.lo <= v) and v <= self.hi:
             return ""
         unit = f" {self.unit}" if self.unit else ""
+        if self.lo_open:
+            return (f"must be above {self.lo:g} and at most {self.hi:g}{unit} ({self.what}), "
+                    f"got {v!r}")
         return f"must be between {self.lo:g} and {self.hi:g}{unit} ({self.what}), got {v!r}"
 
     def read(self, value: object, key: str, error: Callable[[str], BaseException]) -> float:

@@ -273,6 +273,12 @@ mass_kg = 0.05
     (('id = "m100"', 'id = "m50"'), "motors[1] (m50): id 'm50' appears twice"),
     (("efficiency = 0.75", "efficiency = 1.5"), "reducers[0] (r14): efficiency:"),
     (("mass_kg = 0.3", "mass_kg = nan"), "motors[0] (m50): mass_kg: must be a finite number"),
+    # a ratio of 1 and one of -100 got messages that disagreed ("above 1" and "between 1
+    # and 10000", which allows 1): a new-user trial; both now say the same range
+    (("ratio = 100", "ratio = 1"), "reducers[0] (r14): ratio: must be above 1 and at most "
+     "10000 (a reducer ratio), got 1.0"),
+    (("ratio = 100", "ratio = -100"), "reducers[0] (r14): ratio: must be above 1 and at most "
+     "10000 (a reducer ratio), got -100.0"),
 ])
 def test_catalogue_mistakes_are_one_line_naming_file_entry_and_key(tmp_path, edit, message):
     path = tmp_path / "bad.toml"
@@ -559,6 +565,16 @@ def test_the_warnings_counted_are_the_warnings_listed_in_every_report(tmp_path, 
     line = f"Run verdict: {verdict}: {len(summary['checks'])} checks"
     assert line in md and line in page
     assert f"{len(warned)} warning(s)" in md and f"{len(warned)} warning(s)" in page
+    # sizing.md has the "Actuator selection" section report.html has (it had none: a
+    # new-user trial): one row per joint naming selection.json's pair, in both reports
+    doc = json.loads((out / "selection.json").read_text())
+    assert "## Actuator selection" in md and "<h2>Actuator selection</h2>" in page
+    section = md.split("## Actuator selection", 1)[1]
+    for joint, j in doc["joints"].items():
+        row = next(r for r in section.splitlines() if r.startswith(f"| {joint} |"))
+        assert j["motor"] and j["motor"] in row and j["reducer"] in row, row
+        assert f"{joint}: chosen {j['motor']} + {j['reducer']}" in section
+        assert f"{joint}: chosen {j['motor']} + {j['reducer']}" in page
 
 
 def _average_torque(traj, model, k: int, exponent: float) -> tuple[float, float]:
