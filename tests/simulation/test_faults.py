@@ -215,17 +215,11 @@ sample_period_s = {period}
 
 
 @pytest.mark.parametrize("period, passes", [(0.4, False), (0.01, True)])
-def test_a_cartesian_phase_that_misses_its_speed_fails_the_verdict(tmp_path, period, passes,
-                                                                    monkeypatch):
-    """100 mm at 100 mm/s sampled every 0.4 s, its ramps sampled as coarsely (as before
-    :data:`~sim.simulation.motion.sampling.SAMPLES_PER_RAMP`: a planted fault now): the joint
-    interpolation between so few samples runs the tool 7.8 % fast, a failed check; sampled
-    every 10 ms it keeps the speed."""
+def test_a_cartesian_phase_that_misses_its_speed_fails_the_verdict(tmp_path, period, passes):
+    """100 mm at 100 mm/s sampled every 0.4 s: the joint interpolation between so few samples
+    runs the tool 7.8 % fast, a failed check; sampled every 10 ms it keeps the speed."""
     from sim.pipeline.run import RunOptions, run_scenario
     from sim.scenario import load_scenario
-    from sim.simulation.motion import sampling
-
-    monkeypatch.setattr(sampling, "SAMPLES_PER_RAMP", 0)
 
     path = tmp_path / "coarse.toml"
     path.write_text(COARSE.format(period=period))

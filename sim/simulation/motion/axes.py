@@ -374,7 +374,6 @@ def _sampled(phase: CartesianPhase, t0: float, qr0: NDArray[np.float64],
         _ik_knots_refined,
         _into_j1_plane,
         _poses,
-        _ramp_times,
         _sample_times,
         _turn_limited_period,
     )
@@ -396,8 +395,7 @@ def _sampled(phase: CartesianPhase, t0: float, qr0: NDArray[np.float64],
         return _into_j1_plane(poses) if five_axis else poses
 
     period = _turn_limited_period(cart, phase.sample_period, label)
-    ramp = float(cart.profile.ramp_time)
-    ts = _sample_times(cart.duration, period, _ramp_times(cart.duration, ramp, ramp), label)
+    ts = _sample_times(cart.duration, period, np.zeros(0), label)
     ts, q_via = _ik_knots_refined(kin, ts, poses_at, qr0, label, ctx.robot)
     q_full = np.hstack([q_via, axes_at(ts)])
     times = t0 + ts

@@ -32,7 +32,6 @@ from sim.simulation.motion.sampling import (
     _ik_knots_refined,
     _into_j1_plane,
     _poses,
-    _ramp_times,
     _sample_times,
     _turn_limited_period,
     _weave_period,
@@ -510,8 +509,6 @@ def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[C
         if phases[k].weave is not None:
             period = min(period, _weave_period(phases[k].weave))
             extra.append(bounds[k] + win.breakpoints())
-    extra.append(_ramp_times(profile.duration, float(carts[0].profile.ramp_time),
-                             float(carts[-1].profile.ramp_time)))
     ts = _sample_times(profile.duration, period, np.concatenate(extra), labels[0])
 
     def poses_at(ts: NDArray[np.float64]) -> NDArray[np.float64]:

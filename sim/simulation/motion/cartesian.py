@@ -23,7 +23,6 @@ from sim.simulation.motion.programmed import _programmed
 from sim.simulation.motion.sampling import (
     _ik_knots_refined,
     _poses,
-    _ramp_times,
     _sample_times,
     _turn_limited_period,
     _weave_period,
@@ -221,9 +220,7 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
         cart = WeavingTrajectory(cart, phase.weave, kin.family.approach_column)
         extra = cart.breakpoints()
         period = min(period, _weave_period(phase.weave))
-    ramp = float(cart.profile.ramp_time)
-    ts = _sample_times(cart.duration, period, np.r_[extra, _ramp_times(cart.duration, ramp, ramp)],
-                       label)
+    ts = _sample_times(cart.duration, period, extra, label)
     ts, q_via = _ik_knots_refined(kin, ts, lambda x: _poses(cart.at(x)), q0, label, ctx.robot)
     times = t0 + ts
     placed = JointPhase(index=phase.index, name=phase.name, planner=phase.planner, times=times,

@@ -2,8 +2,7 @@
 kinematics of the samples.
 
 Owns the sample times of a move (every sampling period, finer where the tool turns fast or
-weaves and over its start and stop ramps, at a pattern's corners: :func:`_sample_times`,
-:func:`_ramp_times`, :func:`_turn_limited_period`,
+weaves, at a pattern's corners: :func:`_sample_times`, :func:`_turn_limited_period`,
 :func:`_weave_period`), the branch-continuous inverse kinematics of the samples, refined
 where a joint turns fast (:func:`_ik_knots`, :func:`_ik_knots_refined`), the tool poses of
 a state (:func:`_poses`) and a 5-axis arm's poses turned into its plane
@@ -66,21 +65,6 @@ def _turn_limited_period(cart: Any, period: float, label: str) -> float:
 MAX_PHASE_SAMPLES = 1_000_000
 
 
-#: Inverse-kinematics samples over each start and stop ramp of a move. Sampled only every
-#: sampling period, the joint polynomial through a ramp's few samples rang into the constant
-#: speed: the tool ran 1.5 % faster than programmed just after a ramp of three periods (found by
-#: a new-user trial); with 6 samples per ramp 0.36 %, with 12 0.06 % (measured on its cells).
-SAMPLES_PER_RAMP = 12
-
-
-def _ramp_times(duration: float, ramp_in: float, ramp_out: float) -> NDArray[np.float64]:
-    """Sample times over a move's start ramp (``ramp_in`` s) and stop ramp (``ramp_out`` s),
-    :data:`SAMPLES_PER_RAMP` each (extra times for :func:`_sample_times`)."""
-    ramps = [np.linspace(0.0, r, SAMPLES_PER_RAMP + 1)[1:] for r in (ramp_in, ramp_out)]
-    return np.concatenate([ramps[0] if ramp_in > 0 else np.zeros(0),
-                           duration - ramps[1] if ramp_out > 0 else np.zeros(0)])
-
-
 def _sample_times(duration: float, period: float, extra: NDArray[np.float64],
                   label: str) -> NDArray[np.float64]:
     """Sample times over ``[0, duration]``: every ``period`` and at the ``extra`` times (the
@@ -107,10 +91,6 @@ def _sample_times(duration: float, period: float, extra: NDArray[np.float64],
         near = gap < 0.25 * duration / n
         near[[0, -1]] = False
         ts = np.unique(np.r_[ts[~near], extra])
-        # times a rounding apart (a ramp's end on a weave's turn, a phase's end) are one:
-        # placed on the clock (t0 + ts) they could fall on the same float
-        ts = ts[np.r_[True, np.diff(ts) > 1e-9 * max(duration, 1.0)]]
-        ts[-1] = duration
     return ts
 
 
