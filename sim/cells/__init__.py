@@ -35,13 +35,14 @@ a scenario's cell and tool references), :mod:`~sim.cells.builder` (:func:`build_
 :mod:`~sim.cells.toolfile` (tools), :mod:`~sim.cells.seam` (seams). This module only re-exports.
 
 Names in the compiled model: robot joints ``robot/j1..jN``, actuators ``robot/a1..aN`` (the
-drives) and ``robot/friction_j1..`` (each joint's Coulomb friction, :mod:`sim.cells.compose`), sites
-``robot/frame0``, ``robot/flange``, ``robot/tcp`` (moved onto the tool tip), tool elements
+drives) and ``robot/friction_j1..`` (each joint's Coulomb friction, :mod:`sim.cells.compose`),
+sites ``robot/frame0``, ``robot/flange``, ``robot/tcp`` (moved onto the tool tip), tool elements
 ``robot/tool/...`` (tip site ``robot/tool/tip``, suction ``robot/tool/suction``), payload body
-``robot/payload``; cell elements keep their plain names (``part0``, cameras ``overview`` and
-``tool``). A cell file's other robots (``[[robots]]``, :mod:`~sim.cells.partners`) have the same
-names under their own name (``r2/j1``, ``r2/a1``, ``r2/tcp``, ``r2/tool/...``); their joints
-follow the first robot's and the mechanisms' axes in :attr:`Cell.joint_names`.
+``robot/payload`` (at the tcp; massless, its marker invisible, at 0 kg); cell elements keep
+their plain names (``part0``, cameras ``overview`` and ``tool``). A cell file's other robots
+(``[[robots]]``, :mod:`~sim.cells.partners`) have the same names under their own name
+(``r2/j1``, ``r2/a1``, ``r2/tcp``, ``r2/tool/...``); their joints follow the first robot's and
+the mechanisms' axes in :attr:`Cell.joint_names`.
 """
 
 from sim.cells.builder import CELL_DEFAULT, build_cell, resolve_tool

@@ -14,8 +14,9 @@ Steps (:func:`prepare_robot`, :func:`new_world`, :func:`attach_robot`, :func:`fi
 3. The robot's ``tcp`` site is moved onto the tool tip: ``flange + length * approach``, keeping
    its orientation. The tcp therefore lies on the flange axis and the closed forms hold with
    ``l3 = (J4 -> flange) + length`` (5r) or ``r = length`` (fanuc6); see :func:`tool_kinematics`.
-4. ``payload_kg > 0`` adds a body ``robot/payload`` at the tcp: a lumped mass with the inertia of
-   a solid steel sphere (7850 kg/m^3) of that mass, ``I = 2/5 m r^2``; it touches nothing.
+4. A body ``robot/payload`` at the tcp carries the payload: a lumped mass with the inertia of
+   a solid steel sphere (7850 kg/m^3) of that mass, ``I = 2/5 m r^2``; it touches nothing. At
+   0 kg it is massless and its marker invisible (one model structure for every payload).
 5. The world (floor, sky, lights, cameras, offscreen buffer 1920x1080) receives the robot through
    an attachment frame: ``floor`` mount = upright at a height (a riser or column), ``ceiling`` =
    turned 180 deg about the world x axis (base up, J1 axis pointing down) under a ceiling plate.
@@ -296,6 +297,21 @@ def payload_inertia(mass_kg: float) -> float:
     return 0.4 * mass_kg * payload_radius(mass_kg) ** 2
 
 
+#: The payload marker's colour (a translucent sphere at the tcp; invisible at 0 kg).
+PAYLOAD_RGBA = (0.9, 0.8, 0.1, 0.35)
+#: The marker's radius at 0 kg, m (MuJoCo needs a positive size; the marker is invisible).
+EMPTY_MARKER_RADIUS_M = 0.001
+
+
+def payload_marker(mass_kg: float) -> tuple[float, tuple[float, float, float, float]]:
+    """The payload marker sphere's radius (:func:`payload_radius`) and colour: at 0 kg a
+    radius of :data:`EMPTY_MARKER_RADIUS_M` and a transparent colour. It touches nothing and
+    carries no mass (the payload body's inertial is explicit)."""
+    if mass_kg > 0.0:
+        return payload_radius(mass_kg), PAYLOAD_RGBA
+    return EMPTY_MARKER_RADIUS_M, (*PAYLOAD_RGBA[:3], 0.0)
+
+
 def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.0,
                   prefix: str = ROBOT_PREFIX) -> RobotRig:
     """Load the robot, attach the tool at its flange, move its tcp, add the payload.
@@ -363,13 +379,14 @@ def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.
     else:
         tcp_pos = pf + Rf @ (tcp_from_flange * st.approach_flange)
     tcp.pos = tcp_pos
-    if payload_kg > 0.0:
-        r = payload_radius(payload_kg)
-        body = flange_body.add("body", name="payload", pos=tcp_pos)
-        body.add("inertial", pos=[0.0, 0.0, 0.0], mass=payload_kg,
-                 diaginertia=[payload_inertia(payload_kg)] * 3)
-        body.add("geom", name="payload", type="sphere", size=[r], contype=0, conaffinity=0,
-                 group=1, rgba=(0.9, 0.8, 0.1, 0.35))
+    # every cell has the payload body, massless at 0 kg: one model structure for every
+    # payload (a sweep's variants share their cell and its collision scan, 0 kg included)
+    radius, rgba = payload_marker(payload_kg)
+    body = flange_body.add("body", name="payload", pos=tcp_pos)
+    body.add("inertial", pos=[0.0, 0.0, 0.0], mass=payload_kg,
+             diaginertia=[payload_inertia(payload_kg)] * 3)
+    body.add("geom", name="payload", type="sphere", size=[radius], contype=0, conaffinity=0,
+             group=1, rgba=rgba)
     return RobotRig(spec=spec, tool=tool, model=robot, statics=st,
                     tcp_from_flange=tcp_from_flange, tool_body=tool_body,
                     payload_kg=payload_kg, home_q=st.home_q.copy(), tcp_local=tcp_local,

@@ -203,8 +203,9 @@ def _drives(scenario: Scenario) -> Any:
 
 def simulate_batch(scenarios: list[Scenario], prepared: list[tuple[BuiltCell, Any]],
                    options: RunOptions, labels: list[str] | None = None) -> list[Any]:
-    """Simulate prepared variants on MuJoCo Warp, one batch per model structure (a payload of
-    0 kg has no payload body, so it batches apart from the others); records in order."""
+    """Simulate prepared variants on MuJoCo Warp, one batch per model structure (every
+    payload, 0 kg included, has the same: a payload body, massless at 0 kg); records in
+    order."""
     from sim.simulation.warp_batch import simulate_batch as warp_batch
 
     groups: dict[tuple[Any, ...], list[int]] = {}

@@ -12,10 +12,10 @@ model equals a fresh :func:`~sim.simulation.compile.build` of the scenario bit f
 ``MjSpec.to_xml`` writes what ``mj_saveLastXML`` writes (both checked by
 ``tests/simulation/test_build_cache_payload.py``).
 
-Kept only for a payload > 0 (a cell without payload has no payload body) and for cells without
-mechanisms (their servo gains are tuned on the compiled model, payload included); every other
-scenario is built in full. The kept cell's ``mjcf`` tree is shared by the cells built from it:
-its payload elements are set to the payload of the latest one.
+Every cell has the payload body (massless at 0 kg), so 0 kg shares the cell too. Kept only for
+cells without mechanisms (their servo gains are tuned on the compiled model, payload included);
+every other scenario is built in full. The kept cell's ``mjcf`` tree is shared by the cells
+built from it: its payload elements are set to the payload of the latest one.
 """
 
 from __future__ import annotations
@@ -50,10 +50,8 @@ _CELLS: dict[str, _Kept] = {}
 def cell_key(scenario: Scenario) -> str | None:
     """What a cell depends on but for the payload: the scenario without it and without its
     (and its partners') phases and actions, which a speed scale changes and the cell does not
-    read (:meth:`~sim.scenario.Scenario.scaled`); None when it cannot be fingerprinted or has
-    no payload body (then it is built in full)."""
-    if not scenario.payload_kg > 0.0:
-        return None
+    read (:meth:`~sim.scenario.Scenario.scaled`); None when it cannot be fingerprinted (then it
+    is built in full)."""
     try:
         blob = pickle.dumps(dataclasses.replace(
             scenario, payload_kg=0.0, phases=(), actions=(),
@@ -96,11 +94,11 @@ def _build_and_keep(scenario: Scenario, key: str | None) -> BuiltCell:
 def _with_payload(scenario: Scenario, kept: _Kept) -> BuiltCell:
     """The kept cell with the scenario's payload: the spec's payload fields set (as
     :func:`sim.cells.compose.prepare_robot` writes them) and compiled again."""
-    from sim.cells.compose import payload_inertia, payload_radius
+    from sim.cells.compose import payload_inertia, payload_marker
 
     mass = float(scenario.payload_kg)
-    radius, inertia = payload_radius(mass), payload_inertia(mass)
-    _set_payload(kept, mass, inertia, radius)
+    (radius, rgba), inertia = payload_marker(mass), payload_inertia(mass)
+    _set_payload(kept, mass, inertia, radius, rgba)
     try:
         model = kept.spec.compile()
     except ValueError as exc:  # a bug in a cell builder, not a user mistake
@@ -113,6 +111,7 @@ def _with_payload(scenario: Scenario, kept: _Kept) -> BuiltCell:
     el_body.inertial.mass = mass
     el_body.inertial.diaginertia = [inertia] * 3
     el_geom.size = [radius]
+    el_geom.rgba = list(rgba)
     rig = cell._rig
     cell = dataclasses.replace(
         cell, payload_kg=mass,
@@ -120,14 +119,16 @@ def _with_payload(scenario: Scenario, kept: _Kept) -> BuiltCell:
     return assemble(scenario, cell, model, saved_xml, kept.composed.sensors)
 
 
-def _set_payload(kept: _Kept, mass: float, inertia: float, radius: float) -> None:
-    """The payload's mass, principal moments and marker radius in the kept spec."""
+def _set_payload(kept: _Kept, mass: float, inertia: float, radius: float,
+                 rgba: tuple[float, ...]) -> None:
+    """The payload's mass, principal moments, marker radius and colour in the kept spec."""
     body, geom = kept.spec.body(PAYLOAD), kept.spec.geom(PAYLOAD)
     if body is None or geom is None:
         raise InternalError(f"kept cell {kept.composed.cell.name!r} has no {PAYLOAD!r}")
     body.mass = mass
     body.inertia = [inertia] * 3
     geom.size = [radius, 0.0, 0.0]
+    geom.rgba = list(rgba)
 
 
 __all__ = ["KEPT", "PAYLOAD", "build_reusing", "cell_key", "clear"]

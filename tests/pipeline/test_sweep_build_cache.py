@@ -6,7 +6,7 @@ its cell built in full, bit for bit. A planted cell cache that forgets the paylo
 caught by the same comparison.
 
 The scenario: the LR Mate 200iC/5L on the weld table with its torch, a joint move of 1.2 s;
-payloads 1, 3 and 12 kg at speed scales 1 and 1.7 (two plans, one composed cell).
+payloads 1, 0, 3 and 12 kg at speed scales 1 and 1.7 (two plans, one composed cell).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from sim.pipeline.sweep.evaluation import evaluate_variant
 from sim.simulation import build_cache
 from sim.simulation.compile import build
 
-PAYLOADS = [1.0, 3.0, 12.0]
+PAYLOADS = [1.0, 0.0, 3.0, 12.0]  # 0 kg shares the cell too (a massless payload body)
 SPEEDS = [1.0, 1.7]
 
 
@@ -61,13 +61,15 @@ def test_a_sweep_reusing_its_cell_gives_each_variant_s_rows_alone(
     forget_everything()
     composed = count_composes(monkeypatch)
     assert _swept(scenario, tmp_path) == alone
-    assert composed[0] == 1  # one composed cell for the three payloads and two speeds
+    assert composed[0] == 1  # one composed cell for the four payloads and two speeds
 
     # planted fault: a kept cell whose payload keeps the first variant's inertia
     forget_everything()
-    def forgets_inertia(kept: Any, mass: float, inertia: float, radius: float) -> None:
+    def forgets_inertia(kept: Any, mass: float, inertia: float, radius: float,
+                        rgba: tuple[float, ...]) -> None:
         kept.spec.body(build_cache.PAYLOAD).mass = mass
         kept.spec.geom(build_cache.PAYLOAD).size = [radius, 0.0, 0.0]
+        kept.spec.geom(build_cache.PAYLOAD).rgba = list(rgba)
 
     monkeypatch.setattr(build_cache, "_set_payload", forgets_inertia)
     swept = _swept(scenario, tmp_path)

@@ -3,9 +3,10 @@
 before, the cell built for a variant is the one a fresh :func:`sim.simulation.compile.build` of
 that scenario gives, bit for bit: every ``MjModel`` array and scalar (the model's binary MJB
 image, and each array named, for a readable failure), the saved MJCF, every id and the Cartesian
-context; the cell says the new payload. A payload of 0 kg (no payload body) and a cell with
-mechanisms (gains tuned on the compiled model) are built in full. The oracle is a fresh build; a
-planted patch that forgets the payload's inertia, or its marker's radius, is caught."""
+context; the cell says the new payload. A payload of 0 kg (a massless payload body, its marker
+invisible) shares the cell of the other payloads; a cell with mechanisms (gains tuned on the
+compiled model) is built in full. The oracle is a fresh build; a planted patch that forgets the
+payload's inertia, its marker's radius or its marker's colour is caught."""
 
 from __future__ import annotations
 
@@ -109,7 +110,8 @@ def composed_count(monkeypatch: pytest.MonkeyPatch) -> list[int]:
 
 
 @settings(max_examples=4, deadline=None, derandomize=True, database=None)
-@given(payloads=st.lists(st.floats(min_value=1e-3, max_value=40.0, allow_nan=False),
+@given(payloads=st.lists(st.one_of(st.just(0.0),
+                                   st.floats(min_value=1e-3, max_value=40.0, allow_nan=False)),
                          min_size=1, max_size=2),
        scales=st.lists(st.floats(min_value=0.2, max_value=3.0), min_size=1, max_size=2))
 def test_reused_cell_equals_a_fresh_build(weld: Any, payloads: list[float],
@@ -139,39 +141,51 @@ def test_the_cell_is_composed_once_per_scenario(weld: Any, composed_count: list[
     assert composed_count[0] == 3  # another timestep: another cell
 
 
-def test_no_payload_and_mechanisms_are_built_in_full(weld: Any,
-                                                     composed_count: list[int]) -> None:
-    assert build_cache.cell_key(_with(weld, 0.0)) is None
+def test_zero_payload_shares_the_cell_and_mechanisms_are_built_in_full(
+        weld: Any, composed_count: list[int]) -> None:
+    assert build_cache.cell_key(_with(weld, 0.0)) == build_cache.cell_key(_with(weld, 3.0))
+    build_cache.build_reusing(_with(weld, 3.0))
     for _ in range(2):
         got = build_cache.build_reusing(_with(weld, 0.0))
-    assert composed_count[0] == 2
+    assert composed_count[0] == 1
     assert built_differences(got, build(_with(weld, 0.0))) == []
+    assert got.model.body(build_cache.PAYLOAD).mass[0] == 0.0
+    assert got.model.geom(build_cache.PAYLOAD).rgba[3] == 0.0  # no marker drawn
+    again = build_cache.build_reusing(_with(weld, 3.0))  # and back: the marker shows again
+    assert built_differences(again, build(_with(weld, 3.0))) == []
+    assert composed_count[0] == 1
     track = _with(load_scenario("track_beam_weld"), 1.0)
     build_cache.build_reusing(track)
     build_cache.build_reusing(_with(track, 2.0))
-    assert composed_count[0] == 4
+    assert composed_count[0] == 3  # the track's cell, composed for each payload
 
 
-@pytest.mark.parametrize("fault", ["inertia", "radius"])
-def test_a_patch_that_forgets_a_field_is_caught(weld: Any, fault: str,
+@pytest.mark.parametrize(("fault", "field", "to_payload"), [
+    ("inertia", "body_inertia", 3.0), ("radius", "geom_size", 3.0), ("colour", "geom_rgba", 0.0)])
+def test_a_patch_that_forgets_a_field_is_caught(weld: Any, fault: str, field: str,
+                                                to_payload: float,
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     real = build_cache._set_payload
 
-    def forgetful(kept: Any, mass: float, inertia: float, radius: float) -> None:
+    def forgetful(kept: Any, mass: float, inertia: float, radius: float,
+                  rgba: tuple[float, ...]) -> None:
         body, geom = kept.spec.body(build_cache.PAYLOAD), kept.spec.geom(build_cache.PAYLOAD)
-        old_inertia, old_size = body.inertia.copy(), geom.size.copy()
-        real(kept, mass, inertia, radius)
+        old = {"inertia": body.inertia.copy(), "radius": geom.size.copy(),
+               "colour": geom.rgba.copy()}
+        real(kept, mass, inertia, radius, rgba)
         if fault == "inertia":
-            body.inertia = old_inertia
+            body.inertia = old[fault]
+        elif fault == "radius":
+            geom.size = old[fault]
         else:
-            geom.size = old_size
+            geom.rgba = old[fault]
 
     build_cache.clear()
     build_cache.build_reusing(_with(weld, 1.0))
     monkeypatch.setattr(build_cache, "_set_payload", forgetful)
-    got = build_cache.build_reusing(_with(weld, 3.0))
-    found = built_differences(got, build(_with(weld, 3.0)))
-    assert ("body_inertia" if fault == "inertia" else "geom_size") in found
+    got = build_cache.build_reusing(_with(weld, to_payload))
+    found = built_differences(got, build(_with(weld, to_payload)))
+    assert field in found
     assert "xml" in found
     build_cache.clear()
 

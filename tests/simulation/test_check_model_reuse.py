@@ -72,7 +72,8 @@ def _everything(cm: CollisionModel, samples: MotionSamples):
 
 
 @settings(max_examples=6, deadline=None, derandomize=True)
-@given(first=st.floats(0.1, 5.0), other=st.floats(0.1, 5.0), seed=st.integers(0, 2**16))
+@given(first=st.one_of(st.just(0.0), st.floats(0.1, 5.0)),
+       other=st.one_of(st.just(0.0), st.floats(0.1, 5.0)), seed=st.integers(0, 2**16))
 def test_another_payload_is_checked_as_its_own_check_model_checks_it(scenario, first, other,
                                                                        seed):
     cr.clear_cache()
@@ -96,10 +97,15 @@ def test_the_drawn_motions_touch_the_cell(scenario):
     assert sum(touching) >= 4, touching
 
 
-def test_a_cell_without_the_payload_body_gets_its_own_check_model(scenario):
+def test_zero_payload_shares_the_check_model(scenario):
+    """0 kg has the payload body too (massless): its cell shares the other payloads' check
+    model, and checks as the one made for it does (a motion through the cell)."""
     a = build_cache.build_reusing(scenario.scaled(1.0, 2.0))
     b = build_cache.build_reusing(scenario.scaled(1.0, 0.0))
-    assert cr.check_model(b).model is not cr.check_model(a).model
+    reused = cr.check_model(b)
+    assert reused.model is cr.check_model(a).model
+    samples = _motion(b, 3)
+    assert _everything(reused, samples) == _everything(CollisionModel(b), samples)
 
 
 @pytest.mark.parametrize("field", ["geom_size", "geom_pos", "body_pos", "jnt_axis"])

@@ -91,8 +91,8 @@ def test_warp_matches_mujoco_on_a_short_joint_move(tmp_path, robot):
 
 @pytest.mark.slow
 def test_size_with_the_warp_backend_gives_the_mujoco_table(tmp_path, capsys):
-    """Payloads 0 and 2 kg (two model structures: no payload body at 0 kg, so two batches) at
-    two speeds (two durations in one batch), no drive saturated: the sweep table agrees with the CPU backend's within the parity bounds."""
+    """Payloads 0 and 2 kg (one model structure: a massless payload body at 0 kg) at two
+    speeds (two durations in one batch), no drive saturated: the sweep table agrees with the CPU backend's within the parity bounds."""
     path = _scenario(tmp_path, "robot_5r")
     args = ["size", str(path), "--payload", "0,2", "--speed-scale", "0.75,1", "--workers", "1",
             "--quiet"]
