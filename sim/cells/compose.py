@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sim.cells.payload import payload_inertia, payload_marker
 from sim.cells.tools import (
     CONTACT_FIXTURE,
     CUP_BODY,
@@ -62,7 +63,6 @@ ROBOT_PREFIX = "robot"
 #: Name prefix of the robot's friction actuators (``robot/friction_j1``, ...).
 FRICTION_PREFIX = "friction_"
 TOOL_PREFIX = "tool"
-STEEL_DENSITY = 7850.0
 #: Offscreen framebuffer (pixels): large enough for 1280x720 and 1920x1080 renders.
 OFFSCREEN = (1920, 1080)
 
@@ -285,31 +285,6 @@ class RobotRig:
         km = km.with_family(km.family.with_tool(reach))
         km.tcp_offset = transform(km.tcp_offset[:3, :3])
         return km
-
-
-def payload_radius(mass_kg: float) -> float:
-    """Radius of a solid steel sphere of that mass, m (the payload's inertia model)."""
-    return float((3.0 * mass_kg / (4.0 * np.pi * STEEL_DENSITY)) ** (1.0 / 3.0))
-
-
-def payload_inertia(mass_kg: float) -> float:
-    """Each principal moment of the payload's sphere (:func:`payload_radius`), kg m^2."""
-    return 0.4 * mass_kg * payload_radius(mass_kg) ** 2
-
-
-#: The payload marker's colour (a translucent sphere at the tcp; invisible at 0 kg).
-PAYLOAD_RGBA = (0.9, 0.8, 0.1, 0.35)
-#: The marker's radius at 0 kg, m (MuJoCo needs a positive size; the marker is invisible).
-EMPTY_MARKER_RADIUS_M = 0.001
-
-
-def payload_marker(mass_kg: float) -> tuple[float, tuple[float, float, float, float]]:
-    """The payload marker sphere's radius (:func:`payload_radius`) and colour: at 0 kg a
-    radius of :data:`EMPTY_MARKER_RADIUS_M` and a transparent colour. It touches nothing and
-    carries no mass (the payload body's inertial is explicit)."""
-    if mass_kg > 0.0:
-        return payload_radius(mass_kg), PAYLOAD_RGBA
-    return EMPTY_MARKER_RADIUS_M, (*PAYLOAD_RGBA[:3], 0.0)
 
 
 def prepare_robot(spec: RobotSpec, tool: ToolSpec | None, payload_kg: float = 0.0,

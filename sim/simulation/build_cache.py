@@ -94,7 +94,7 @@ def _build_and_keep(scenario: Scenario, key: str | None) -> BuiltCell:
 def _with_payload(scenario: Scenario, kept: _Kept) -> BuiltCell:
     """The kept cell with the scenario's payload: the spec's payload fields set (as
     :func:`sim.cells.compose.prepare_robot` writes them) and compiled again."""
-    from sim.cells.compose import payload_inertia, payload_marker
+    from sim.cells.payload import payload_inertia, payload_marker
 
     mass = float(scenario.payload_kg)
     (radius, rgba), inertia = payload_marker(mass), payload_inertia(mass)
