@@ -221,13 +221,18 @@ sample_period_s = 1.0
 """
 
 
-def test_path_deviation_metric_against_the_line(tmp_path):
-    """Via points 40 mm apart: the joint polynomial leaves the straight seam between them. The
-    summary's max_path_deviation_mm equals the largest distance of the recorded tool point
-    from the seam's line (computed here from the cell's seam end points)."""
+def test_path_deviation_metric_against_the_line(tmp_path, monkeypatch):
+    """Via points 40 mm apart, not halved where the polynomial leaves the move (a planted
+    fault: :data:`~sim.simulation.motion.sampling.PATH_REFINEMENTS` 0): the joint polynomial
+    leaves the straight seam between them. The summary's max_path_deviation_mm equals the
+    largest distance of the recorded tool point from the seam's line (computed here from the
+    cell's seam end points)."""
     from sim.cells import CELLS, build_cell
     from sim.cells.tools import TOOLS
     from sim.robots.registry import ROBOTS
+    from sim.simulation.motion import sampling
+
+    monkeypatch.setattr(sampling, "PATH_REFINEMENTS", 0)
 
     s = _run(parse_scenario(COARSE_LINE, source="coarse.toml"), tmp_path / "c")
     (weld,) = s["weld"]

@@ -215,11 +215,18 @@ sample_period_s = {period}
 
 
 @pytest.mark.parametrize("period, passes", [(0.4, False), (0.01, True)])
-def test_a_cartesian_phase_that_misses_its_speed_fails_the_verdict(tmp_path, period, passes):
-    """100 mm at 100 mm/s sampled every 0.4 s: the joint interpolation between so few samples
-    runs the tool 7.8 % fast, a failed check; sampled every 10 ms it keeps the speed."""
+def test_a_cartesian_phase_that_misses_its_speed_fails_the_verdict(tmp_path, period, passes,
+                                                                    monkeypatch):
+    """100 mm at 100 mm/s sampled every 0.4 s, without the planner's halving of the intervals
+    where the joint polynomial leaves the move (a planted fault:
+    :data:`~sim.simulation.motion.sampling.PATH_REFINEMENTS` 0): the joint interpolation
+    between so few samples runs the tool 7.8 % fast, a failed check; sampled every 10 ms it
+    keeps the speed."""
     from sim.pipeline.run import RunOptions, run_scenario
     from sim.scenario import load_scenario
+    from sim.simulation.motion import sampling
+
+    monkeypatch.setattr(sampling, "PATH_REFINEMENTS", 0)
 
     path = tmp_path / "coarse.toml"
     path.write_text(COARSE.format(period=period))

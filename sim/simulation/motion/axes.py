@@ -371,6 +371,7 @@ def _sampled(phase: CartesianPhase, t0: float, qr0: NDArray[np.float64],
     polynomial through both (:func:`plan_coordinated`)."""
     from sim.simulation.motion.programmed import _programmed
     from sim.simulation.motion.sampling import (
+        Carried,
         _ik_knots_refined,
         _into_j1_plane,
         _poses,
@@ -396,7 +397,10 @@ def _sampled(phase: CartesianPhase, t0: float, qr0: NDArray[np.float64],
 
     period = _turn_limited_period(cart, phase.sample_period, label)
     ts = _sample_times(cart.duration, period, np.zeros(0), label)
-    ts, q_via = _ik_knots_refined(kin, ts, poses_at, qr0, label, ctx.robot)
+    carried = Carried(axes_at, lambda qe, poses: np.linalg.inv(
+        moving_frame(ctx, ctx0, mech, qe0, qe)) @ poses, lambda x: _poses(cart.at(x)))
+    ts, q_via = _ik_knots_refined(kin, ts, poses_at, qr0, label, ctx.robot,
+                                  planner=phase.planner, carried=carried)
     q_full = np.hstack([q_via, axes_at(ts)])
     times = t0 + ts
     placed = JointPhase(index=phase.index, name=phase.name, planner=phase.planner, times=times,

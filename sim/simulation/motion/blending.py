@@ -33,6 +33,7 @@ from sim.simulation.motion.sampling import (
     _into_j1_plane,
     _poses,
     _sample_times,
+    _smooth_weave,
     _turn_limited_period,
     _weave_period,
 )
@@ -522,7 +523,9 @@ def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[C
             poses = _into_j1_plane(poses)
         return poses
 
-    ts, q_via = _ik_knots_refined(kin, ts, poses_at, q0, labels[0], ctx.robot, one_branch)
+    smooth = all(_smooth_weave(ph.weave) for ph in phases)
+    ts, q_via = _ik_knots_refined(kin, ts, poses_at, q0, labels[0], ctx.robot, one_branch,
+                                  planner=phases[0].planner if smooth else None)
     times = t0 + ts
     placed = JointPhase(index=phases[0].index, name=phases[0].name, planner=phases[0].planner,
                         times=times, durations=np.diff(times), q=q_via)

@@ -24,6 +24,7 @@ from sim.simulation.motion.sampling import (
     _ik_knots_refined,
     _poses,
     _sample_times,
+    _smooth_weave,
     _turn_limited_period,
     _weave_period,
 )
@@ -221,7 +222,8 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
         extra = cart.breakpoints()
         period = min(period, _weave_period(phase.weave))
     ts = _sample_times(cart.duration, period, extra, label)
-    ts, q_via = _ik_knots_refined(kin, ts, lambda x: _poses(cart.at(x)), q0, label, ctx.robot)
+    ts, q_via = _ik_knots_refined(kin, ts, lambda x: _poses(cart.at(x)), q0, label, ctx.robot,
+                                  planner=phase.planner if _smooth_weave(phase.weave) else None)
     times = t0 + ts
     placed = JointPhase(index=phase.index, name=phase.name, planner=phase.planner, times=times,
                         durations=np.diff(times), q=q_via)
