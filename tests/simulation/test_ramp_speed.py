@@ -74,19 +74,26 @@ def _off_line(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(r - np.outer(r @ u, u), axis=1).max())
 
 
-def _planned_move(x0, y0, z0, d, speed_mm_s, period_s):
-    text = HEAD.format(x0=x0, y0=y0, z0=z0, x1=x0 + d[0], y1=y0 + d[1], z1=z0 + d[2],
-                       speed=speed_mm_s, period=period_s)
+#: Period of the oracle's tool points, s.
+DT = 1e-3
+
+
+def _tool_points(text: str) -> np.ndarray:
+    """The planned tool points (mm, frame 0) of the scenario's phase ``move`` every
+    :data:`DT`: the arm's forward kinematics (its DH product) of the planned joint values."""
     sc = parse_scenario(text, source="ramps.toml")
     built = build(sc)
     motion = build_motion(sc, built.context)
     pm = next(p for p in motion.phases if p.name == "move")
-    dt = 1e-3
-    t = np.arange(pm.t0, pm.t1, dt)
     kin = built.context.kinematics
-    q = np.asarray(motion.at(t).q, dtype=float)[:, :kin.n_joints]
-    p = np.asarray(kin.fk(q))[:, :3, 3] * 1e3
-    return t, _speeds(p, dt), _off_line(p, p[0], p[-1])
+    q = np.asarray(motion.at(np.arange(pm.t0, pm.t1, DT)).q, dtype=float)[:, :kin.n_joints]
+    return np.asarray(kin.fk(q))[:, :3, 3] * 1e3
+
+
+def _planned_move(x0, y0, z0, d, speed_mm_s, period_s):
+    p = _tool_points(HEAD.format(x0=x0, y0=y0, z0=z0, x1=x0 + d[0], y1=y0 + d[1],
+                                 z1=z0 + d[2], speed=speed_mm_s, period=period_s))
+    return _speeds(p, DT), _off_line(p, p[0], p[-1])
 
 
 @settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -96,7 +103,7 @@ def _planned_move(x0, y0, z0, d, speed_mm_s, period_s):
 def test_a_straight_move_never_runs_above_its_speed(x0, y0, z0, d, speed, period):
     if math.hypot(*d) < 30.0:
         return  # too short to have a cruise between its ramps
-    t, v, off = _planned_move(x0, y0, z0, d, speed, period)
+    v, off = _planned_move(x0, y0, z0, d, speed, period)
     assert v.max() <= speed * (1.0 + OVERSHOOT), (v.max(), speed)
     assert v[v.size // 2] == pytest.approx(speed, rel=OVERSHOOT)
     assert off <= OFF_LINE_MM, off
@@ -137,18 +144,10 @@ def test_an_arc_keeps_its_speed_and_circle(cx, cy, cz, r, start_deg, sweep, turn
         cx=cx, cy=cy, cz=cz, sweep=turn * sweep, speed=speed, period=period,
         orientation=orientation)
     try:
-        sc = parse_scenario(text, source="arc.toml")
-        built = build(sc)
-        motion = build_motion(sc, built.context)
+        p = _tool_points(text)
     except CellsimError:
         reject()  # out of reach or past a joint range: not this test's subject
-    pm = next(p for p in motion.phases if p.name == "move")
-    dt = 1e-3
-    t = np.arange(pm.t0, pm.t1, dt)
-    kin = built.context.kinematics
-    q = np.asarray(motion.at(t).q, dtype=float)[:, :kin.n_joints]
-    p = np.asarray(kin.fk(q))[:, :3, 3] * 1e3
-    v = _speeds(p, dt)
+    v = _speeds(p, DT)
     assert v.max() <= speed * (1.0 + OVERSHOOT), (v.max(), speed)
     assert v[v.size // 2] == pytest.approx(speed, rel=OVERSHOOT)
     off = np.hypot(np.hypot(p[:, 0] - cx, p[:, 1] - cy) - r, p[:, 2] - cz)
@@ -162,10 +161,10 @@ def test_the_trials_approach_keeps_its_speed_and_line_and_without_halving_did_no
     from sim.simulation.motion import sampling
 
     args = (330.0, 120.0, -60.0, (0.0, 150.0, 0.0), 40.0, 0.1)
-    _, v, off = _planned_move(*args)
+    v, off = _planned_move(*args)
     assert v.max() <= 40.0 * (1.0 + OVERSHOOT) and off <= OFF_LINE_MM
     monkeypatch.setattr(sampling, "PATH_REFINEMENTS", 0)
-    _, v, off = _planned_move(*args)
+    v, off = _planned_move(*args)
     assert v.max() > 40.0 * (1.0 + 2 * OVERSHOOT)
 
 
