@@ -157,15 +157,20 @@ def drawn_bbox(img: np.ndarray) -> np.ndarray:
 
 
 def _robot_setup(page: Page, model, qpos0):
-    """Only the moving bodies drawn, the camera close to them (aimed by mujoco's kinematics)."""
+    """Only the moving bodies drawn, the camera close to those with a drawn geom (aimed by
+    mujoco's kinematics; a massless payload's invisible marker does not move the aim)."""
     import mujoco
+
+    from sim.analysis.replay.scene import geoms_and_meshes
 
     moving = page.js("window.cellsimReplay.movingBodies")
     page.js("(b) => window.cellsimReplay.solo(b)", moving)
     data = mujoco.MjData(model)
     data.qpos[:] = qpos0
     mujoco.mj_kinematics(model, data)
-    ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in moving]
+    drawn = {g["body"] for g in geoms_and_meshes(model)[0]}
+    ids = [i for i in (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in moving)
+           if i in drawn]
     target = data.xpos[ids].mean(axis=0)
     eye = target + [2.4, -2.7, 1.5]
     page.js("(a) => window.cellsimReplay.look(a[0], a[1], 45)", [eye.tolist(), target.tolist()])
