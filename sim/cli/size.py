@@ -43,8 +43,9 @@ MAX_SWEEP_VALUES = 10_000
 
 def parse_float_list(text: str, field: str = "value") -> list[float]:
     """Numbers from a command-line list: ``"0,2.5,5"`` or an inclusive range ``"0:10:2.5"``
-    (items may mix: ``"0,1:3:1"``). Duplicates are dropped (with a warning naming them), the
-    order kept.
+    (items may mix: ``"0,1:3:1"``), in order, repeats kept: the values' own checks
+    (:func:`~sim.pipeline.sweep.validate_payloads`) refuse a bad one first, then drop the
+    repeats with a warning naming them.
 
     Args:
         text: The option's text.
@@ -81,9 +82,7 @@ def parse_float_list(text: str, field: str = "value") -> list[float]:
             out.extend(round(a + k * step, 12) for k in range(count))
         else:
             out.append(_number(item, field))
-    from sim.pipeline.sweep.variants import unique_values
-
-    return unique_values(out, field)  # a repeated value: a warning, the variant runs once
+    return out
 
 
 def register(sub: argparse._SubParsersAction) -> None:

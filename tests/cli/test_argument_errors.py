@@ -18,7 +18,7 @@ import contextlib
 import io
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from sim.cli import COMMANDS, build_parser, main
@@ -107,9 +107,11 @@ def test_no_command_and_an_unknown_command_are_one_line(capsys):
 
 @settings(max_examples=10, deadline=None)
 @given(values=st.lists(st.floats(-1e4, -1e-3), min_size=1, max_size=3))
+@example(values=[-1.0, -1.0])  # a repeat: refused in one line, with no warning about it
 def test_a_negative_value_reaches_the_options_own_check(values):
     """``--payload -1,2`` is a negative payload (refused by its check, naming the option
-    and the value), not an unknown option ``-1,2``."""
+    and the value), not an unknown option ``-1,2``; a repeated bad value is refused before
+    any warning about the repeat."""
     text = ",".join(f"{v:g}" for v in values)
     line = _refused(["size", "lrmate200ic_weld_plate", "--payload", text + ",2"])
     assert "--payload" in line and "expected one argument" not in line

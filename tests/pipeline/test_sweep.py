@@ -25,6 +25,7 @@ from sim.pipeline.sweep import (
     Variant,
     make_variants,
     run_sweep,
+    validate_speed_scales,
 )
 
 G, L, K = 9.81, 0.5, 3.0
@@ -201,9 +202,11 @@ def test_parse_float_list() -> None:
     assert parse_float_list(" 1 , 0.5 ", field="--speed") == [1.0, 0.5]
     assert parse_float_list("0:10:2.5", field="--payload") == [0.0, 2.5, 5.0, 7.5, 10.0]
     assert parse_float_list("0.5:1.1:0.2,2", field="--speed") == pytest.approx([0.5, 0.7, 0.9, 1.1, 2])
+    assert parse_float_list("1,1,2", field="--speed") == [1.0, 1.0, 2.0]
     with pytest.warns(CellsimWarning, match=r"--speed: 1 given more than once; each variant "
                       "runs once"):  # dropped, not silently (a new-user trial)
-        assert parse_float_list("1,1,2", field="--speed") == [1.0, 2.0]
+        assert validate_speed_scales(parse_float_list("1,1,2", field="--speed"),
+                                     field="--speed") == [1.0, 2.0]
 
 
 @pytest.mark.parametrize("text, fragment", [
