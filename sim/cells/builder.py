@@ -119,9 +119,10 @@ def build_cell(cell: CellSpec | None, robot: RobotSpec, *,
     rig = prepare_robot(spec_r, tool_spec, payload)
     layout = cspec.build(rig, mount)
     home_q = layout.home_q if layout.home_q is not None else rig.home_q
-    compiled = add_home_keyframe(layout.world, rig, home_q, layout.mechanisms, layout.partners)
+    compiled, home_qpos = add_home_keyframe(layout.world, rig, home_q, layout.mechanisms,
+                                            layout.partners)
     if layout.mechanisms:
-        tune_gains(layout.world, layout.mechanisms, compiled)
+        tune_gains(layout.world, layout.mechanisms, compiled, home_qpos)
     p = ROBOT_PREFIX
     axes = [n for pm in layout.mechanisms for n in pm.joint_names]
     friction = [a.friction for pm in layout.mechanisms for a in pm.spec.axes]

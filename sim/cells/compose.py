@@ -542,9 +542,10 @@ def compile_model(world: mjcf.RootElement) -> mujoco.MjModel:
 
 def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np.float64],
                       mechanisms: tuple[PlacedMechanism, ...] = (),
-                      partners: tuple[Any, ...] = ()) -> mujoco.MjModel:
+                      partners: tuple[Any, ...] = ()) -> tuple[mujoco.MjModel, NDArray[np.float64]]:
     """Add keyframe ``home``: robot at ``home_q``, the mechanisms at their home, the other
-    robots at theirs, free bodies where built, suction off; the model compiled with it."""
+    robots at theirs, free bodies where built, suction off. Returns the model compiled before
+    the keyframe was added (the same but for the keyframe) and the keyframe's ``qpos``."""
     import mujoco
 
     try:  # the MJCF written and parsed once: the keyframe is added to its spec as well
@@ -565,9 +566,8 @@ def add_home_keyframe(world: mjcf.RootElement, rig: RobotRig, home_q: NDArray[np
         if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT:
             jid = m.actuator_trnid[a, 0]
             ctrl[a] = qpos[m.jnt_qposadr[jid]]
-    key = world.keyframe.add("key", name="home", qpos=qpos, ctrl=ctrl)
-    spec.add_key(name="home", qpos=key.qpos, ctrl=key.ctrl)
-    return spec.compile()
+    world.keyframe.add("key", name="home", qpos=qpos, ctrl=ctrl)
+    return m, qpos
 
 
 def suction_actuator_name(rig: RobotRig) -> str | None:

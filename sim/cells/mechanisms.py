@@ -152,19 +152,19 @@ def add_mechanism(world: mjcf.RootElement, pm: PlacedMechanism) -> mjcf.Element:
 
 
 def tune_gains(world: mjcf.RootElement, mechanisms: tuple[PlacedMechanism, ...],
-               model: Any) -> None:
+               model: Any, home_qpos: Any) -> None:
     """Set each mechanism axis's servo gains from its inertia at home (module docstring).
 
     Args:
         world: The composed world.
         mechanisms: Its mechanisms.
-        model: The world compiled once (``mujoco.MjModel``), at its home keyframe.
+        model: The world compiled once (``mujoco.MjModel``).
+        home_qpos: Its ``qpos`` at home (the home keyframe's), (nq,).
     """
     import mujoco
 
     data = mujoco.MjData(model)
-    if model.nkey:
-        mujoco.mj_resetDataKeyframe(model, data, 0)
+    data.qpos[:] = home_qpos
     mujoco.mj_forward(model, data)
     M = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, M)

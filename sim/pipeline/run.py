@@ -254,7 +254,7 @@ def _judge(scenario: Scenario, built: BuiltCell, motion: Any, options: RunOption
     # post-processing reads the record in memory, never the files a run writes
     record = runfolder.RunRecord.from_arrays(
         arrays, joints=list(summary["joints"]), phases=summary["phases"],
-        model_path=model_path, model_xml=None if model_path is not None else built.xml,
+        model_path=model_path, model_xml=None if model_path is not None else lambda: built.xml,
         summary=summary)
     with stages.stage("sizing"):
         sizing = _size(scenario, built, record, summary) if options.sizing else None

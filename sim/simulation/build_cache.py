@@ -104,7 +104,13 @@ def _with_payload(scenario: Scenario, kept: _Kept) -> BuiltCell:
     except ValueError as exc:  # a bug in a cell builder, not a user mistake
         raise InternalError(f"cell {kept.composed.cell.name!r} does not compile: {exc}") \
             from exc
-    saved_xml = kept.spec.to_xml()
+    def saved_xml() -> str:
+        # when first asked for (a metrics-only variant never asks): the spec's payload set
+        # back to this one's first (a later variant may have set its own since), the same
+        # text as written right after this compile (tests/simulation/test_build_cache.py)
+        _set_payload(kept, mass, inertia, radius, rgba)
+        return str(kept.spec.to_xml())
+
     cell = kept.composed.cell
     root = cell.mjcf  # the shared tree follows the latest payload
     el_body, el_geom = root.find("body", PAYLOAD), root.find("geom", PAYLOAD)

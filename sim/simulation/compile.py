@@ -9,6 +9,7 @@ actuators, suction actuator, part free joints), resolved here and nowhere else.
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -54,7 +55,7 @@ class BuiltCell:
 
     cell: Cell
     model: Any
-    xml: str
+    _xml: str | Callable[[], str]
     robot_qpos: NDArray[np.int64]
     robot_dof: NDArray[np.int64]
     robot_act: NDArray[np.int64]
@@ -69,6 +70,15 @@ class BuiltCell:
     friction_act: NDArray[np.int64]
     partner_cols: dict[str, slice] = field(default_factory=dict)
     partner_tcp: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def xml(self) -> str:
+        """The compiled model as MJCF; written when first asked for where the cell was built
+        from a kept spec (:mod:`sim.simulation.build_cache`: a metrics-only sweep variant never
+        asks)."""
+        if callable(self._xml):
+            self._xml = self._xml()
+        return self._xml
 
 
 # --------------------------------------------------------------------------------------------
@@ -151,10 +161,11 @@ def compile_composed(composed: ComposedCell) -> tuple[Any, str]:
     return model, saved_xml
 
 
-def assemble(scenario: Scenario, cell: Cell, model: Any, saved_xml: str,
+def assemble(scenario: Scenario, cell: Cell, model: Any, saved_xml: str | Callable[[], str],
              sensors: list[tuple[str, int]]) -> BuiltCell:
     """The :class:`BuiltCell` of a compiled cell: every id, the sensors' slices and the
-    Cartesian context, resolved from ``model``."""
+    Cartesian context, resolved from ``model``; ``saved_xml``: its MJCF, or what writes it
+    when first asked for."""
     import mujoco
 
     from sim.cells.compose import FRICTION_PREFIX

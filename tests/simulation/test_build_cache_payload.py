@@ -124,6 +124,19 @@ def test_reused_cell_equals_a_fresh_build(weld: Any, payloads: list[float],
         assert built_differences(got, build(variant)) == []
 
 
+def test_a_cells_mjcf_asked_for_after_later_variants_is_its_own(weld: Any) -> None:
+    # a reused cell writes its MJCF when first asked for (a metrics-only variant never asks),
+    # from the kept spec that later variants have set to their own payloads since
+    build_cache.clear()
+    build_cache.build_reusing(_with(weld, 2.0))
+    got = {p: build_cache.build_reusing(_with(weld, p)) for p in (0.0, 4.5, 1.25)}
+    for p in (4.5, 0.0, 1.25, 4.5):
+        want = build(_with(weld, p))
+        assert got[p].xml == want.xml
+        assert mujoco.MjModel.from_xml_string(got[p].xml).body(build_cache.PAYLOAD).mass[0] == p
+    build_cache.clear()
+
+
 def test_the_cell_is_composed_once_per_scenario(weld: Any, composed_count: list[int]) -> None:
     first = build_cache.build_reusing(_with(weld, 1.0))
     second = build_cache.build_reusing(_with(weld, 5.0))

@@ -9,7 +9,7 @@ May import: :mod:`sim.errors` and the run folder's schema and confinement.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -57,9 +57,21 @@ class RunRecord:
     joints: list[str]
     phases: list[Phase] = field(default_factory=list)
     model_path: Path | None = None
-    model_xml: str | None = None
+    _model_xml: str | Callable[[], str] | None = field(default=None, repr=False)
     summary: dict[str, Any] = field(default_factory=dict)
     source: Path | None = None
+
+    @property
+    def model_xml(self) -> str | None:
+        """MJCF text of the cell, or None (then ``model_path``); a record made in memory
+        writes it when first asked for (a metrics-only sweep variant never asks)."""
+        if callable(self._model_xml):
+            self._model_xml = self._model_xml()
+        return self._model_xml
+
+    @model_xml.setter
+    def model_xml(self, text: str | None) -> None:
+        self._model_xml = text
 
     @property
     def where(self) -> str:
@@ -146,7 +158,7 @@ class RunRecord:
         joints: list[str],
         phases: list[Phase] | list[dict[str, Any]] | None = None,
         model_path: str | Path | None = None,
-        model_xml: str | None = None,
+        model_xml: str | Callable[[], str] | None = None,
         summary: dict[str, Any] | None = None,
     ) -> RunRecord:
         """Builds a record from arrays in memory (same names and shapes as trajectory.npz).
@@ -156,7 +168,8 @@ class RunRecord:
             joints: Joint names (columns of the joint arrays).
             phases: Phases as :class:`Phase` or summary-style dicts.
             model_path: Path of the cell's MJCF, or None with ``model_xml``.
-            model_xml: MJCF text, alternative to ``model_path``.
+            model_xml: MJCF text, alternative to ``model_path`` (or what writes it when
+                first asked for).
             summary: Optional summary dict.
 
         Returns:
@@ -170,7 +183,7 @@ class RunRecord:
             joints=list(joints),
             phases=[_phase(p, f"phases[{i}]") for i, p in enumerate(phases or [])],
             model_path=Path(model_path) if model_path is not None else None,
-            model_xml=model_xml,
+            _model_xml=model_xml,
             summary=dict(summary or {}),
         )
         record.validate()
