@@ -62,6 +62,7 @@ if _TYPE_CHECKING:
         CellsimError,
         CellsimWarning,
         InternalError,
+        LimitError,
         ReachError,
         RenderError,
         RunFolderError,
@@ -77,9 +78,9 @@ __all__ = [
     "RunResult", "Saturation", "Scenario", "SelectedDrive", "SizedJoint", "SizingCheck",
     "SweepResult", "WeldResult", "evaluate", "load_scenario", "run", "sweep",
     # the exception tree (sim.errors; CellsimError is its root)
-    "CatalogError", "CellsimError", "CellsimWarning", "InternalError", "ReachError",
-    "RenderError", "RunFolderError", "ScenarioError", "SimulationError", "SweepError",
-    "UnknownNameError",
+    "CatalogError", "CellsimError", "CellsimWarning", "InternalError", "LimitError",
+    "ReachError", "RenderError", "RunFolderError", "ScenarioError", "SimulationError",
+    "SweepError", "UnknownNameError",
     "__version__",
 ]
 

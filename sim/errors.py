@@ -27,6 +27,20 @@ class ReachError(ScenarioError):
     (``cellsim check`` reports it as a finding; elsewhere it is a scenario mistake)."""
 
 
+class LimitError(ScenarioError):
+    """The reference motion takes a joint past its range where a later phase cannot be
+    planned from (``cellsim check`` reports each line as a ``limit`` finding).
+
+    Attributes:
+        lines: One per violation, naming the phase, joint, time, value and limit.
+    """
+
+    def __init__(self, lines: list[str]) -> None:
+        more = f" (and {len(lines) - 1} more)" if len(lines) > 1 else ""
+        super().__init__(lines[0] + more)
+        self.lines = list(lines)
+
+
 class KinematicsError(CellsimError):
     """Base class of kinematics errors."""
 

@@ -50,8 +50,12 @@ def planned_motion(scenario: Scenario) -> Motion:
     """The scenario's motion on one clock (Cartesian phases through the cell's IK; a cell's
     other robots' in :attr:`Motion.lanes`); limit violations warned on stderr."""
     context = None
+    # the cell is built where a phase needs it: a Cartesian move or a pose target (its IK), a
+    # joint move that starts from the cell's home (a TP program's first move, a phase with
+    # durations_s and no start), or other robots
     if scenario.partners or any(
-            isinstance(p, CartesianPhase) or (isinstance(p, JointPhase) and p.target is not None)
+            isinstance(p, CartesianPhase) or (isinstance(p, JointPhase) and (
+                p.target is not None or bool(np.isnan(p.q[0]).any())))
             for p in scenario.phases):
         from sim.simulation.compile import build
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sim.errors import ReachError
+from sim.errors import LimitError, ReachError
 from sim.scenario import Scenario
 from sim.simulation.collisions import (
     check_motion,
@@ -83,6 +83,9 @@ def check_scenario(scenario: Scenario, *, dt: float = CHECK_DT_S) -> CheckResult
     t0 = time.perf_counter()
     try:
         motion = build_motion(scenario, built.context)
+    except LimitError as exc:  # a later phase could not start where this one left a joint
+        res.findings += [Finding("limit", line) for line in exc.lines]
+        return res
     except ReachError as exc:
         res.findings.append(Finding("reach", str(exc)))
         return res

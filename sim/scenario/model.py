@@ -52,6 +52,8 @@ class JointPhase:
             move with them on the phase's one time law (:mod:`sim.simulation.motion.axes`).
         downhand: With a seam pose target: the positioner carrying the seam ends where the
             seam's start is welded downhand.
+        origin: Where a TP program's move is written (``prog.ls: line 12 (J P[3])``); empty
+            for a scenario's own phase (:func:`phase_label`).
     """
 
     index: int
@@ -68,6 +70,7 @@ class JointPhase:
     speed_pct: float | None = None
     axes: dict[str, float] = field(default_factory=dict)
     downhand: bool = False
+    origin: str = ""
 
     @property
     def t0(self) -> float:
@@ -179,6 +182,7 @@ class CartesianPhase:
         time_scale: How many times faster than written the phase runs
             (:meth:`Scenario.scaled`): the default ramps' least duration is divided by it, as
             the written times are.
+        origin: As :attr:`JointPhase.origin`.
     """
 
     index: int
@@ -210,6 +214,7 @@ class CartesianPhase:
     follow: str | None = None
     axes: dict[str, float] = field(default_factory=dict)
     time_scale: float = 1.0
+    origin: str = ""
 
     def seam_as_welded(self, seam: Seam) -> Seam:
         """The seam this phase welds: ``seam`` (the cell's seam named ``self.seam``) with the
@@ -224,12 +229,14 @@ class CartesianPhase:
 
 @dataclass(frozen=True)
 class HoldPhase:
-    """The robot holds the pose where the previous phase ended, for ``duration`` s."""
+    """The robot holds the pose where the previous phase ended, for ``duration`` s
+    (``origin``: as :attr:`JointPhase.origin`, a TP program's WAIT)."""
 
     index: int
     name: str
     duration: float
     kind: str = "hold"
+    origin: str = ""
 
 
 @dataclass(frozen=True)
@@ -243,6 +250,16 @@ class Action:
 
 
 Phase = JointPhase | CartesianPhase | HoldPhase
+
+
+def phase_label(where: str, phase: Any) -> str:
+    """How a message names a phase of the scenario file ``where``: ``where: phases[2]
+    (weld)``; a TP program's move by its program line, ``where: prog.ls: line 12 (C P[5]
+    P[6]) (line012_C)``."""
+    origin = getattr(phase, "origin", "")
+    if origin:
+        return f"{where}: {origin} ({phase.name})"
+    return f"{where}: phases[{phase.index}] ({phase.name})"
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ from typing import Any
 from planners.errors import PlannerError
 from planners.registry import get_planner
 from sim.errors import ScenarioError
-from sim.scenario.model import JointPhase, Scenario
+from sim.scenario.model import JointPhase, Scenario, phase_label
 
 
 @dataclass(frozen=True)
@@ -29,8 +29,8 @@ def plan_phase(phase: JointPhase, where: str = "") -> Any:
     try:
         return get_planner(phase.planner)(phase.times, phase.q, **phase.boundary)
     except PlannerError as exc:
-        prefix = f"{where}: " if where else ""
-        raise ScenarioError(f"{prefix}phases[{phase.index}] ({phase.name}): {exc}") from None
+        label = phase_label(where, phase) if where else phase_label("", phase)[2:]
+        raise ScenarioError(f"{label}: {exc}") from None
 
 
 def plan_scenario(scenario: Scenario) -> list[PlannedPhase]:

@@ -240,7 +240,8 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                 if float(ins.value) <= 0.0:  # WAIT 0: nothing to hold
                     continue
                 phases.append(HoldPhase(index=index, name=f"line{ins.line:03d}_wait",
-                                        duration=float(ins.value)))
+                                        duration=float(ins.value),
+                                        origin=f"{src}: line {ins.line} (WAIT)"))
                 index += 1
                 if pending_start:  # the arc starts while the robot waits (a start dwell)
                     actions.append(Action("arc_on", None, phases[-1].name, "start"))
@@ -313,7 +314,8 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
             cell_axes.current.update(moved)
             phase = JointPhase(index=index, name=name, planner="434", times=times,
                                durations=durations, q=q, target=ptarget,
-                               speed_pct=pct, blend_fraction=fraction, axes=moved)
+                               speed_pct=pct, blend_fraction=fraction, axes=moved,
+                               origin=_origin(src, mo))
         else:
             if not phases:
                 raise err(mo.line, "the program's first motion must be a J move (it leaves "
@@ -349,7 +351,7 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
                           orientation="euler", to=p, frame=frame_name(mo.line),
                           euler_zyx=_zyx(R), blend_fraction=fraction, move_time=move_time,
                           flange=ut == 0, weave=weave, config=target.config,
-                          axes=moved if moving else {})
+                          axes=moved if moving else {}, origin=_origin(src, mo))
             if mo.kind == "C":
                 via = position(mo.via, mo.line)
                 axes_of(via)  # checked; the axes follow the path to the end point
@@ -376,6 +378,13 @@ def program_phases(prog: LSProgram, robot, start_q: NDArray[np.float64],
     if not isinstance(phases[0], JointPhase):
         raise err(motions[0].line, "the program's first motion must be a J move")
     return _unblend_coordinated(phases, coord, lines, src, warnings), actions, warnings
+
+
+def _origin(src: str, mo: LSMotion) -> str:
+    """Where a move is written: ``prog.ls: line 12 (C P[5] P[6])`` (a C move's via point,
+    then its end)."""
+    points = ([mo.via] if mo.via is not None else []) + [mo.target]
+    return f"{src}: line {mo.line} ({mo.kind} {' '.join(f'{k}[{n}]' for k, n in points)})"
 
 
 def _unblend_coordinated(phases: list, coord: set[int], lines: dict[int, int], src: str,

@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from sim.errors import CellError, CellsimError, InternalError
 from sim.scenario import Scenario
 from sim.simulation.motion import CartesianContext
+from sim.simulation.motion.checks import MAX_STEPS
 
 if TYPE_CHECKING:  # sim.cells imports mujoco: the command line picks MUJOCO_GL first
     from sim.cells import Cell
@@ -203,7 +204,8 @@ def assemble(scenario: Scenario, cell: Cell, model: Any, saved_xml: str | Callab
                            world_from_frame0=np.asarray(cell.world_from_frame0, dtype=float),
                            frames=dict(cell.frames), home_q=np.asarray(cell.home_q, float),
                            flange_to_tcp=np.linalg.inv(site_T(fl)) @ site_T(tcp_site),
-                           robot=scenario.robot, **_mechanism_context(cell))
+                           robot=scenario.robot, max_phase_s=MAX_STEPS * float(model.opt.timestep),
+                           **_mechanism_context(cell))
     cols, start_col = {}, len(cell.joint_names) - sum(cr.robot.n_joints for cr in cell.partners)
     for cr in cell.partners:  # each other robot plans with its own kinematics and seams
         t_p, f0_p = model.site(cr.tcp_site).id, model.site(cr.frame0_site).id
@@ -216,7 +218,7 @@ def assemble(scenario: Scenario, cell: Cell, model: Any, saved_xml: str | Callab
             frames=dict(cell.frames), home_q=np.asarray(cr.home_q, float),
             flange_to_tcp=np.linalg.inv(site_T(model.site(cr.flange_site).id)) @ site_T(t_p),
             robot=cr.robot, seam_mechanism=dict(ctx.seam_mechanism),
-            frame_mechanism=dict(ctx.frame_mechanism))
+            frame_mechanism=dict(ctx.frame_mechanism), max_phase_s=ctx.max_phase_s)
         cols[cr.name] = slice(start_col, start_col + cr.robot.n_joints)
         start_col += cr.robot.n_joints
     limits = np.where(model.actuator_forcelimited[robot_act, None].astype(bool),

@@ -133,7 +133,10 @@ def test_a_planted_mujoco_py_in_the_working_directory_is_never_run(tmp_path, mon
 
 
 @pytest.mark.parametrize("edit, words", [
-    (("speed_mm_s = 8.0", "speed_mm_s = 1e-9", 1), ["inverse-kinematics samples", "1,000,000"]),
+    (("speed_mm_s = 8.0", "speed_mm_s = 1e-9", 1), ["the move lasts", "longer than a run can "
+                                                     "simulate", "2,000,000"]),
+    (("speed_mm_s = 8.0", "speed_mm_s = 8.0\nsample_period_s = 1e-6", 1),
+     ["inverse-kinematics samples", "1,000,000"]),
     (("[video]", "[simulation]\ntimestep_s = 1e-9\n\n[video]", 1), ["steps", "2,000,000",
                                                                     "simulation.timestep_s"]),
     (("[video]", "[simulation]\nsettle_s = 1e9\n\n[video]", 1), ["settle_s", "2,000,000"]),

@@ -395,8 +395,8 @@ def _sampled(phase: CartesianPhase, t0: float, qr0: NDArray[np.float64],
         # spline through exact samples) leaves it a few hundredths of a degree out of it
         return _into_j1_plane(poses) if five_axis else poses
 
-    period = _turn_limited_period(cart, phase.sample_period, label)
-    ts = _sample_times(cart.duration, period, np.zeros(0), label)
+    period = _turn_limited_period(cart, phase.sample_period, label, ctx.max_phase_s)
+    ts = _sample_times(cart.duration, period, np.zeros(0), label, ctx.max_phase_s)
     carried = Carried(axes_at, lambda qe, poses: np.linalg.inv(
         moving_frame(ctx, ctx0, mech, qe0, qe)) @ poses, lambda x: _poses(cart.at(x)))
     ts, q_via = _ik_knots_refined(kin, ts, poses_at, qr0, label, ctx.robot,

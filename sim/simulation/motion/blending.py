@@ -500,7 +500,8 @@ def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[C
         windows.append(win)
     # samples: every period (finer where the tool turns fast), at the phase ends, and at the
     # weaves' turns
-    period = _turn_limited_period(traj, min(ph.sample_period for ph in phases), labels[0])
+    period = _turn_limited_period(traj, min(ph.sample_period for ph in phases), labels[0],
+                                  ctx.max_phase_s)
     extra = [np.array(bounds[1:-1])]
     for i, (t_a, t_b) in blend_t.items():  # each corner sampled on its own, finer as it turns
         turn = float(np.degrees(getattr(laws[i], "angle", 0.0)))
@@ -510,7 +511,8 @@ def _time_blended(phases: list[CartesianPhase], labels: list[str], moves: list[C
         if phases[k].weave is not None:
             period = min(period, _weave_period(phases[k].weave))
             extra.append(bounds[k] + win.breakpoints())
-    ts = _sample_times(profile.duration, period, np.concatenate(extra), labels[0])
+    ts = _sample_times(profile.duration, period, np.concatenate(extra), labels[0],
+                       ctx.max_phase_s)
 
     def poses_at(ts: NDArray[np.float64]) -> NDArray[np.float64]:
         which = np.clip(np.searchsorted(np.array(bounds), ts, side="right") - 1, 0, m - 1)

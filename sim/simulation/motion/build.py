@@ -14,8 +14,9 @@ import dataclasses
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.errors import ScenarioError
+from sim.errors import KinematicsError, LimitError, ScenarioError
 from sim.scenario import CartesianPhase, HoldPhase, JointPhase, Scenario, plan_phase
+from sim.scenario.model import phase_label
 from sim.simulation.motion import axes
 from sim.simulation.motion.blending import (
     _blends,
@@ -24,7 +25,11 @@ from sim.simulation.motion.blending import (
     _plan_blended,
 )
 from sim.simulation.motion.cartesian import _plan_cartesian
-from sim.simulation.motion.checks import _check_end_config, _check_phase_continuity
+from sim.simulation.motion.checks import (
+    _check_end_config,
+    _check_phase_continuity,
+    limit_violations,
+)
 from sim.simulation.motion.context import CartesianContext
 from sim.simulation.motion.joint import _joint_blend, _solve_target, _timed_by_speed
 from sim.simulation.motion.timeline import HoldTrajectory, Motion, PhaseMotion
@@ -57,101 +62,109 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     todo = list(scenario.phases)
     pending: tuple[NDArray[np.float64], dict[str, NDArray[np.float64]],
                    NDArray[np.float64] | None] | None = None
-    while todo:
-        phase = todo.pop(0)
-        label = f"{where}: phases[{phase.index}] ({phase.name})"
-        if isinstance(phase, CartesianPhase):
-            _check_seam_blends(phase, todo[0] if todo else None, context, label)
-        if isinstance(phase, CartesianPhase) and (_blends(phase)
-                                                  or _is_polyline(phase, context)):
-            if context is None:
-                raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
-            group = [phase]
-            while _blends(group[-1]) and todo and isinstance(todo[0], CartesianPhase):
-                group.append(todo.pop(0))
-            if len(group) == 1 and _blends(phase) and not _is_polyline(phase, context):
-                raise ScenarioError(f"{label}.blend_mm: the next phase is not a linear or "
-                                    "circular move to blend into (leave blend_mm out)")
-            labels = [f"{where}: phases[{ph.index}] ({ph.name})" for ph in group]
-            if n_axes:
-                assert q is not None
-                _no_coordination(group, labels)
-                ctx_p = axes.posed(context, q[n:])
-                planned = [axes.held(pm, q[n:]) for pm in
-                           _plan_blended(group, t, q[:n], ctx_p, labels)]
-            else:
-                ctx_p, planned = context, _plan_blended(group, t, q, context, labels)
-            for pm, lb in zip(planned, labels, strict=True):
-                if phases:
-                    _check_phase_continuity(phases[-1], pm, label, joints)
-                _check_end_config(_robot_part(pm, n), ctx_p, lb)
-                phases.append(pm)
-            t = phases[-1].t1
-            q = phases[-1].trajectory.at(phases[-1].t1).q
-            continue
-        if isinstance(phase, JointPhase):
-            if q is None and np.isnan(phase.q[0]).any():  # a TP program starts at home
-                if context is None or context.home_q is None:
-                    raise ScenarioError(f"{label}: the start pose needs the cell's home")
-                qs = phase.q.copy()
-                qs[0] = context.home_q
-                phase = dataclasses.replace(phase, q=qs)
-                q = np.asarray(context.home_q, dtype=float)
-                if n_axes:
-                    q = np.concatenate([q, q_axes_home])
-            if n_axes:
-                pm = _joint_phase_with_axes(phase, t, q, n, q_axes_home, context, system, label,
-                                            todo)
-                if phases:
-                    _check_phase_continuity(phases[-1], pm, label, joints)
-                phases.append(pm)
-                t = pm.t1
-                q = pm.trajectory.at(pm.t1).q
-                continue
-            placed = phase.with_start(t, q)
-            solved_end = None
-            if pending is not None:  # the previous joint phase blends into this one
-                qs = placed.q.copy()
-                qs[0] = pending[0]
-                placed = dataclasses.replace(placed, q=qs,
-                                             boundary={**placed.boundary, **pending[1]})
-                solved_end = pending[2]  # its pose target, solved by the blend
-                pending = None
-            if phase.target is not None:
+    try:
+        while todo:
+            phase = todo.pop(0)
+            label = phase_label(where, phase)
+            if isinstance(phase, CartesianPhase):
+                _check_seam_blends(phase, todo[0] if todo else None, context, label)
+            if isinstance(phase, CartesianPhase) and (_blends(phase)
+                                                      or _is_polyline(phase, context)):
                 if context is None:
-                    raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
-                placed = placed.with_end(solved_end if solved_end is not None
-                                         else _solve_target(phase, placed.q[0], context, label))
-            if phase.speed_pct is not None:
-                placed = _timed_by_speed(placed, scenario.robot, label)
-            if phase.blend > 0 or phase.blend_fraction > 0:
-                placed, pending = _joint_blend(placed, todo[0] if todo else None, context, label,
-                                               scenario.robot)
-            traj = plan_phase(placed, where)
-            pm = PhaseMotion(placed, placed.t0, placed.t1, traj, knot_times=placed.times.copy())
-        elif isinstance(phase, HoldPhase):
-            traj = HoldTrajectory(t, phase.duration, q)
-            pm = PhaseMotion(phase, t, t + phase.duration, traj, knot_times=np.array([t]))
-        elif isinstance(phase, CartesianPhase):
-            if context is None:
-                raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
-            if n_axes and (phase.downhand or phase.follow is not None or phase.axes):
-                pm = axes.plan_coordinated(phase, t, q, context, label)
-            elif n_axes:
-                ctx_p = axes.posed(context, q[n:])
-                pm = _plan_cartesian(phase, t, q[:n], ctx_p, label)
-                _check_end_config(pm, ctx_p, label)
-                pm = axes.held(pm, q[n:])
-            else:
-                pm = _plan_cartesian(phase, t, q, context, label)
-                _check_end_config(pm, context, label)
-        else:  # pragma: no cover - the loader only makes the kinds above
-            raise ScenarioError(f"{label}: unknown phase kind {phase.kind!r}")
-        if phases:
-            _check_phase_continuity(phases[-1], pm, label, joints)
-        phases.append(pm)
-        t = pm.t1
-        q = pm.trajectory.at(pm.t1).q
+                    raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
+                group = [phase]
+                while _blends(group[-1]) and todo and isinstance(todo[0], CartesianPhase):
+                    group.append(todo.pop(0))
+                if len(group) == 1 and _blends(phase) and not _is_polyline(phase, context):
+                    raise ScenarioError(f"{label}.blend_mm: the next phase is not a linear or "
+                                        "circular move to blend into (leave blend_mm out)")
+                labels = [phase_label(where, ph) for ph in group]
+                if n_axes:
+                    assert q is not None
+                    _no_coordination(group, labels)
+                    ctx_p = axes.posed(context, q[n:])
+                    planned = [axes.held(pm, q[n:]) for pm in
+                               _plan_blended(group, t, q[:n], ctx_p, labels)]
+                else:
+                    ctx_p, planned = context, _plan_blended(group, t, q, context, labels)
+                for pm, lb in zip(planned, labels, strict=True):
+                    if phases:
+                        _check_phase_continuity(phases[-1], pm, label, joints)
+                    _check_end_config(_robot_part(pm, n), ctx_p, lb)
+                    phases.append(pm)
+                t = phases[-1].t1
+                q = phases[-1].trajectory.at(phases[-1].t1).q
+                continue
+            if isinstance(phase, JointPhase):
+                if q is None and np.isnan(phase.q[0]).any():  # a TP program starts at home
+                    if context is None or context.home_q is None:
+                        raise ScenarioError(f"{label}: the start pose needs the cell's home")
+                    qs = phase.q.copy()
+                    qs[0] = context.home_q
+                    phase = dataclasses.replace(phase, q=qs)
+                    q = np.asarray(context.home_q, dtype=float)
+                    if n_axes:
+                        q = np.concatenate([q, q_axes_home])
+                if n_axes:
+                    pm = _joint_phase_with_axes(phase, t, q, n, q_axes_home, context, system, label,
+                                                todo)
+                    if phases:
+                        _check_phase_continuity(phases[-1], pm, label, joints)
+                    phases.append(pm)
+                    t = pm.t1
+                    q = pm.trajectory.at(pm.t1).q
+                    continue
+                placed = phase.with_start(t, q)
+                solved_end = None
+                if pending is not None:  # the previous joint phase blends into this one
+                    qs = placed.q.copy()
+                    qs[0] = pending[0]
+                    placed = dataclasses.replace(placed, q=qs,
+                                                 boundary={**placed.boundary, **pending[1]})
+                    solved_end = pending[2]  # its pose target, solved by the blend
+                    pending = None
+                if phase.target is not None:
+                    if context is None:
+                        raise ScenarioError(f"{label}: a pose target needs the robot's kinematics")
+                    placed = placed.with_end(solved_end if solved_end is not None
+                                             else _solve_target(phase, placed.q[0], context, label))
+                if phase.speed_pct is not None:
+                    placed = _timed_by_speed(placed, scenario.robot, label)
+                if phase.blend > 0 or phase.blend_fraction > 0:
+                    placed, pending = _joint_blend(placed, todo[0] if todo else None, context,
+                                                   label, scenario.robot)
+                traj = plan_phase(placed, where)
+                pm = PhaseMotion(placed, placed.t0, placed.t1, traj, knot_times=placed.times.copy())
+            elif isinstance(phase, HoldPhase):
+                traj = HoldTrajectory(t, phase.duration, q)
+                pm = PhaseMotion(phase, t, t + phase.duration, traj, knot_times=np.array([t]))
+            elif isinstance(phase, CartesianPhase):
+                if context is None:
+                    raise ScenarioError(f"{label}: Cartesian phases need the robot's kinematics")
+                if n_axes and (phase.downhand or phase.follow is not None or phase.axes):
+                    pm = axes.plan_coordinated(phase, t, q, context, label)
+                elif n_axes:
+                    ctx_p = axes.posed(context, q[n:])
+                    pm = _plan_cartesian(phase, t, q[:n], ctx_p, label)
+                    _check_end_config(pm, ctx_p, label)
+                    pm = axes.held(pm, q[n:])
+                else:
+                    pm = _plan_cartesian(phase, t, q, context, label)
+                    _check_end_config(pm, context, label)
+            else:  # pragma: no cover - the loader only makes the kinds above
+                raise ScenarioError(f"{label}: unknown phase kind {phase.kind!r}")
+            if phases:
+                _check_phase_continuity(phases[-1], pm, label, joints)
+            phases.append(pm)
+            t = pm.t1
+            q = pm.trajectory.at(pm.t1).q
+    except (ScenarioError, KinematicsError):
+        # a phase that cannot be planned from where an earlier one left a joint past its
+        # range: the range is the mistake to name (the later phase's IK or branch error
+        # only follows from it)
+        _earlier_limit(scenario, phases, system.n_joints - sum(
+            w.robot.n_joints for w in scenario.partners))
+        raise
     n_lead = system.n_joints - sum(w.robot.n_joints for w in scenario.partners)
     motion = Motion(phases=phases, actions=[], n_joints=n_lead)
     motion.actions = _resolve_actions(scenario, motion)
@@ -159,6 +172,18 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
         motion.lanes = _plan_partners(scenario, context, motion.t0)
         motion.n_joints = system.n_joints
     return motion
+
+
+def _earlier_limit(scenario: Scenario, phases: list[PhaseMotion], n_lead: int) -> None:
+    """Raise :class:`LimitError` with every joint-range violation of the ``phases`` planned
+    so far (the first robot's; positions only), if any."""
+    if not phases:
+        return
+    found = limit_violations(dataclasses.replace(scenario, partners=()),
+                             Motion(phases=list(phases), actions=[], n_joints=n_lead),
+                             speed=False, accel=False)
+    if found:
+        raise LimitError(found) from None
 
 
 def _plan_partners(scenario: Scenario, context: CartesianContext | None, t0: float

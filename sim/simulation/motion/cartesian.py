@@ -214,14 +214,14 @@ def _plan_cartesian(phase: CartesianPhase, t0: float, q0: NDArray[np.float64],
     T0 = np.asarray(kin.fk(q0), dtype=float)
     cart, seam = _phase_cart(phase, T0[:3, 3], T0[:3, :3], ctx, label)
     extra = np.zeros(0)
-    period = _turn_limited_period(cart, phase.sample_period, label)
+    period = _turn_limited_period(cart, phase.sample_period, label, ctx.max_phase_s)
     if phase.weave is not None:
         from planners.weave import WeavingTrajectory
 
         cart = WeavingTrajectory(cart, phase.weave, kin.family.approach_column)
         extra = cart.breakpoints()
         period = min(period, _weave_period(phase.weave))
-    ts = _sample_times(cart.duration, period, extra, label)
+    ts = _sample_times(cart.duration, period, extra, label, ctx.max_phase_s)
     ts, q_via = _ik_knots_refined(kin, ts, lambda x: _poses(cart.at(x)), q0, label, ctx.robot,
                                   planner=phase.planner if _smooth_weave(phase.weave) else None)
     times = t0 + ts

@@ -16,6 +16,7 @@ import numpy as np
 
 from sim.errors import ReachError, ScenarioError
 from sim.scenario import CartesianPhase, Scenario
+from sim.scenario.model import phase_label
 from sim.simulation.motion.context import CartesianContext
 from sim.simulation.motion.timeline import HoldTrajectory, Motion, PhaseMotion
 
@@ -34,19 +35,25 @@ def check_size(scenario: Scenario, motion: Motion, timestep: float) -> int:
     """
     for k, pm in enumerate(motion.phases):
         if pm.t1 - pm.t0 < timestep:
-            raise ScenarioError(f"{scenario.source.name}: phases[{k}] ({pm.name}) lasts "
+            raise ScenarioError(f"{phase_label(scenario.source.name, pm.phase)} lasts "
                                 f"{pm.t1 - pm.t0:.3g} s, shorter than one timestep "
                                 f"({timestep:g} s, simulation.timestep_s): the drives could not "
                                 "follow it; make it longer or drop it")
     total = motion.duration + scenario.simulation.settle_s
     steps = total / timestep if timestep > 0 else float("inf")
     if not np.isfinite(steps) or steps > MAX_STEPS:
+        longest = max(motion.phases, key=lambda pm: pm.t1 - pm.t0)
+        what = phase_label("", longest.phase)[2:]
+        if not getattr(longest.phase, "origin", ""):  # a scenario's phase: its keys
+            what += {"hold": ": duration_s", "joint": ": durations_s or time_s"}.get(
+                longest.kind, ": speed_mm_s")
         raise ScenarioError(
             f"{scenario.source.name}: the cycle lasts {motion.duration:.4g} s plus "
             f"simulation.settle_s {scenario.simulation.settle_s:g} s; at a timestep of "
             f"{timestep:g} s (simulation.timestep_s) that is {steps:.3g} steps, more than "
-            f"{MAX_STEPS:,}: shorten the phases (durations_s, time_s, speed_mm_s) or the "
-            "settling, or raise the timestep")
+            f"{MAX_STEPS:,}: shorten the phases (the longest, "
+            f"{longest.t1 - longest.t0:.4g} s: {what}) or the settling, or raise the "
+            "timestep")
     return int(np.ceil(steps))
 
 
@@ -80,7 +87,7 @@ def limit_violations(scenario: Scenario, motion: Motion, *, speed: bool = True,
             linear=list(system.linear[:k]))
         for v in found:
             pm = next((p for p in group if p.t0 <= v.time <= p.t1), group[0])
-            out.append(f"{where}: phases[{pm.phase.index}] ({pm.name}): {v.message()}")
+            out.append(f"{phase_label(where, pm.phase)}: {v.message()}")
     for work, (name, lane) in zip(scenario.partners, motion.lanes, strict=True):
         sub = scenario.partner_scenario(work)
         sub = dataclasses.replace(sub, source=scenario.source.with_name(

@@ -41,6 +41,9 @@ class CartesianContext:
             the cell's own context (at home, with its mechanisms); None otherwise.
         partners: The cell's other robots' contexts (their kinematics, frame 0, home and the
             seams as their tools follow them), by name; their motion is planned with them.
+        max_phase_s: The longest move a run of the cell can simulate, s
+            (:data:`~sim.simulation.motion.checks.MAX_STEPS` steps of its timestep): a
+            Cartesian move longer than that is refused before it is sampled.
     """
 
     kinematics: Any
@@ -56,6 +59,7 @@ class CartesianContext:
     robot_on: str | None = None
     moving: Any = None
     partners: dict[str, CartesianContext] = field(default_factory=dict)
+    max_phase_s: float = float("inf")
 
     @property
     def n_axes(self) -> int:

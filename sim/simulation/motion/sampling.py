@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.errors import CellsimError, ReachError, ScenarioError
+from sim.simulation.motion.checks import MAX_STEPS
 
 #: Least number of inverse-kinematics samples per weave cycle and per corner blend. Patterns
 #: with corners (zigzag, triangle, dwells) get twice as many: the joint polynomial rounds a
@@ -47,10 +48,12 @@ def _weave_period(weave: Any) -> float:
 MAX_TURN_PER_SAMPLE_DEG = 3.0
 
 
-def _turn_limited_period(cart: Any, period: float, label: str) -> float:
+def _turn_limited_period(cart: Any, period: float, label: str,
+                         longest: float = np.inf) -> float:
     """``period`` shortened where the tool frame or the path's direction turns more than
-    :data:`MAX_TURN_PER_SAMPLE_DEG` between samples (the weave left out: it has its own)."""
-    ts = _sample_times(cart.duration, period, np.zeros(0), label)
+    :data:`MAX_TURN_PER_SAMPLE_DEG` between samples (the weave left out: it has its own);
+    ``longest``: as for :func:`_sample_times`."""
+    ts = _sample_times(cart.duration, period, np.zeros(0), label, longest)
     st = cart.at(ts)
     R = st.rotation
     cos_r = (np.einsum("kij,kij->k", R[:-1], R[1:]) - 1.0) / 2.0
@@ -72,10 +75,17 @@ MAX_PHASE_SAMPLES = 1_000_000
 
 
 def _sample_times(duration: float, period: float, extra: NDArray[np.float64],
-                  label: str) -> NDArray[np.float64]:
+                  label: str, longest: float = np.inf) -> NDArray[np.float64]:
     """Sample times over ``[0, duration]``: every ``period`` and at the ``extra`` times (the
     corners of a pattern, phase ends), points closer than a quarter period to one of those
-    dropped."""
+    dropped. A move longer than ``longest`` s (what a run can simulate:
+    :attr:`CartesianContext.max_phase_s`) is refused before it is sampled (a speed typed a
+    thousand times too slow would otherwise be solved for minutes first)."""
+    if duration > longest:
+        raise ScenarioError(
+            f"{label}: the move lasts {duration:.4g} s, longer than a run can simulate "
+            f"({longest:.4g} s: {MAX_STEPS:,} steps of the cell's timestep, "
+            "simulation.timestep_s); raise its speed or split it")
     count = duration / period
     if not np.isfinite(count) or count > MAX_PHASE_SAMPLES:
         raise ScenarioError(
