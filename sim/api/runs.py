@@ -47,6 +47,27 @@ def _options(options: Any, default: RunOptions) -> RunOptions:
     return options
 
 
+def _selecting(options: RunOptions, scenario: Scenario) -> RunOptions:
+    """``options`` with its selection resolved as ``cellsim run`` resolves it: None follows
+    the scenario's ``[sizing] select``; True selects from the scenario's catalogue (or the
+    starter), a path from that catalogue (loaded here: a bad one is one line before anything
+    runs); False never selects."""
+    import dataclasses
+
+    sel = options.selection
+    if sel is None:
+        sel = bool(scenario.sizing.select)
+    if sel is False:
+        loaded = None
+    elif sel is True:
+        loaded = selection_options(scenario)
+    elif isinstance(sel, (str, os.PathLike)):
+        loaded = selection_options(scenario, catalog=sel)
+    else:
+        return options  # the loaded settings
+    return dataclasses.replace(options, selection=loaded)
+
+
 def evaluate(scenario: ScenarioLike, options: RunOptions | None = None) -> RunResult:
     """Simulate, check and size a scenario in memory; nothing is written.
 
@@ -63,7 +84,8 @@ def evaluate(scenario: ScenarioLike, options: RunOptions | None = None) -> RunRe
         CellsimError: A user mistake (bad file, unreachable target, unstable simulation).
     """
     options = _options(options, RunOptions(video=False, plots=False, progress=False))
-    return RunResult.from_evaluation(evaluate_scenario(_scenario(scenario), options))
+    loaded = _scenario(scenario)
+    return RunResult.from_evaluation(evaluate_scenario(loaded, _selecting(options, loaded)))
 
 
 def run(scenario: ScenarioLike, options: RunOptions | None = None, **changes: Any) -> RunResult:
@@ -84,6 +106,7 @@ def run(scenario: ScenarioLike, options: RunOptions | None = None, **changes: An
     """
     options = changed_options(_options(options, RunOptions(progress=False)), changes)
     loaded = _scenario(scenario)
+    options = _selecting(options, loaded)
     if options.video:
         from sim.render.gl import configure_gl
 

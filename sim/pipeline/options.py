@@ -45,6 +45,7 @@ def check_run_options(options: Any) -> None:
     flag_argument(options.feedforward, "RunOptions.feedforward", optional=True)
     optional_path_argument(options.out_dir, "RunOptions.out_dir")
     choice_argument(options.backend, "RunOptions.backend", BACKENDS)
+    _check_selection(options.selection)
     args = options.video_args
     if not isinstance(args, Mapping):
         raise UsageError("RunOptions.video_args: expected a mapping of video settings like "
@@ -55,6 +56,24 @@ def check_run_options(options: Any) -> None:
             if key not in known:
                 raise UsageError(f"RunOptions.video_args: unknown setting {key!r}; known: "
                                  f"{', '.join(known)}", key="video_args")
+
+
+def _check_selection(selection: Any) -> None:
+    """``RunOptions.selection``: None (the scenario's ``[sizing] select`` decides), True or
+    False, a catalogue file's path, or the loaded settings
+    (:class:`~sim.analysis.selection.SelectionOptions`); else one line naming it."""
+    import os
+
+    from sim.analysis.selection import SelectionOptions
+
+    if selection is None or isinstance(selection, (bool, str, os.PathLike, SelectionOptions)):
+        if isinstance(selection, str) and not selection.strip():
+            raise UsageError("RunOptions.selection: an empty catalogue path",
+                             key="selection")
+        return
+    raise UsageError("RunOptions.selection: expected True or False, a catalogue file's path "
+                     f"or None (the scenario's [sizing] select decides), got {got(selection)}",
+                     key="selection")
 
 
 def changed_options(options: Any, changes: Mapping[str, Any]) -> Any:

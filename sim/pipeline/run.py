@@ -72,7 +72,10 @@ class RunOptions:
             per second of cycle at 1 kHz).
         selection: Choose a motor and a reducer per joint from a catalogue
             (:mod:`sim.analysis.selection`; ``selection.json``/``.csv``, a report section and a
-            ``selection`` check per joint), or None.
+            ``selection`` check per joint): the loaded settings (:func:`selection_options`);
+            for :func:`sim.evaluate` and :func:`sim.run` also True (the scenario's
+            catalogue, or the starter), a catalogue file's path, or False; None: the
+            scenario's ``[sizing] select`` decides there, no selection here.
         backend: ``"mujoco"`` (MuJoCo in C) or ``"warp"`` (MuJoCo Warp, float32, on a GPU
             where there is one: :mod:`sim.simulation.warp_batch`).
     """
