@@ -62,7 +62,7 @@ def _selecting(options: RunOptions, scenario: Scenario) -> RunOptions:
     elif sel is True:
         loaded = selection_options(scenario)
     elif isinstance(sel, (str, os.PathLike)):
-        loaded = selection_options(scenario, catalog=sel)
+        loaded = selection_options(scenario, catalog=Path(sel))
     else:
         return options  # the loaded settings
     return dataclasses.replace(options, selection=loaded)
