@@ -288,7 +288,8 @@ def _who(entry: Mapping[str, Any]) -> str:
 def check_line(check: Mapping[str, Any]) -> str:
     """One failed check of ``summary.json`` in words: its name, what it is about, and its value
     against its limit; a drive's saturation as how far the demand went over the drive's limit
-    (its limit is no torque over it), a collision as its depth (none is allowed)."""
+    (its limit is no torque over it), a collision as its depth (none is allowed), a joint's
+    failed actuator selection as its closest pair's least margin (the limit is 0 % margin)."""
     who = check.get("subject") or check.get("joint") or ""
     head = f"{check['name']} {who}".rstrip()
     value, unit = float(check["value"]), check["unit"]
@@ -296,6 +297,8 @@ def check_line(check: Mapping[str, Any]) -> str:
         return f"{head}: demand up to {value:.4g} {unit} over the drive's limit"
     if check["name"] == "collision":
         return f"{head}: {value:.1f} {unit} deep"
+    if check["name"] == "selection":  # no pair passes: the closest pair's least margin
+        return f"{head}; {value:.4g} {unit} at its worst"
     return f"{head}: {value:.4g} {unit} against the limit {float(check['limit']):.4g} {unit}"
 
 

@@ -41,6 +41,16 @@ def test_a_saturation_reads_how_far_over_the_drive_limit(value: float, unit: str
     assert "limit 0" not in line
 
 
+@settings(max_examples=20, deadline=None)
+@given(value=st.floats(-1e4, -1e-3))
+def test_a_failed_selection_reads_its_closest_pairs_margin(value: float) -> None:
+    # it read "-83.43 % margin against the limit 0 % margin" (a new-user trial)
+    subject = "j2: no pair passes; the closest, M + R, fails inertia_ratio (18.34 against 10)"
+    line = check_line(_check("selection", value, 0.0, "% margin", joint="j2", subject=subject))
+    assert line == f"selection {subject}; {value:.4g} % margin at its worst"
+    assert "limit 0" not in line
+
+
 def test_a_collision_reads_its_depth() -> None:
     line = check_line(_check("collision", 2.345, 0.0, "mm", joint="",
                              subject="robot/link_3 / fixture (weld_1)"))
