@@ -122,7 +122,7 @@ def sweep(scenario: ScenarioLike, payloads_kg: Sequence[float] | None = None,
           engine: str = "pool", backend: str = "mujoco", progress: bool = False
           ) -> SweepResult:
     """Evaluate every (payload, speed scale) variant of a scenario and tabulate them, as
-    ``cellsim size`` does: ``sweep.csv``, ``sweep.md``, ``sweep.json`` and ``sweep.png`` in
+    ``cellsim size`` does: ``sweep.csv``, ``sweep.md``, ``sweep.json`` and ``sweep.svg`` in
     ``out_dir`` (default ``runs/<scenario name>_sweep``).
 
     Args:

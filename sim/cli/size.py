@@ -6,7 +6,7 @@ the default) or as Ray tasks on a local Ray instance or an existing cluster (``-
 [--address auto|HOST:PORT]``). A variant computes its arrays, checks and sizing in memory and
 returns a few numbers per joint (metrics only); the sweep folder (``--out``, default
 ``runs/<scenario>_sweep``) gets ``sweep.csv`` (one row per variant and joint), ``sweep.md``
-(tables), ``sweep.json`` and ``sweep.png`` (peak and RMS torque per joint against payload and
+(tables), ``sweep.json`` and ``sweep.svg`` (peak and RMS torque per joint against payload and
 speed), drawn once at the end. ``--keep-runs`` also writes one full run folder per variant
 (arrays, summary, sizing report; ``--plots`` adds each run's charts). A variant that exceeds a
 speed, acceleration or torque limit is kept, with its negative margins and its run's verdict;
@@ -90,7 +90,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "size", help="actuator-sizing sweep over payloads and speed scales",
         description="Simulate SCENARIO for every combination of --payload and --speed-scale "
                     "(in parallel: a process pool, Ray, or one MuJoCo Warp batch), size every "
-                    "joint's actuator, and write sweep.csv, sweep.md, sweep.json and sweep.png "
+                    "joint's actuator, and write sweep.csv, sweep.md, sweep.json and sweep.svg "
                     "(metrics only: nothing per variant unless --keep-runs). Variants are "
                     "simulated even past the robot's speed or acceleration limits (the "
                     "scenario's enforce_* keys are not applied): they stay in the tables with "
@@ -223,7 +223,7 @@ def run(args: argparse.Namespace) -> int:
                        progress=not args.quiet, engine=args.engine, address=args.address,
                        batch=batch)
     print(f"{len(result.outcomes)} variants in {result.wall_s:.1f} s on {result.workers} "
-          f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.png"
+          f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.svg"
           f"{', selection.csv, selection.json' if 'selection_csv' in result.files else ''})")
     for o in result.outcomes:  # simulated and sized, but not physically possible: said here too
         if o.rows and o.rows[0].get("verdict") == "fail":

@@ -201,7 +201,7 @@ def test_size_sweep_payload_raises_j2_j3_torque(tmp_path):
         peaks = [float(r["peak_torque_nm"]) for r in sorted(
             (r for r in rows if r["joint"] == joint), key=lambda r: float(r["payload_kg"]))]
         assert peaks[0] < peaks[1] < peaks[2], (joint, peaks)
-    assert (out / "sweep.md").is_file() and (out / "sweep.png").is_file()
+    assert (out / "sweep.md").is_file() and (out / "sweep.svg").is_file()
 
 
 @pytest.mark.parametrize("args, fragment", [

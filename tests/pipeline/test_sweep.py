@@ -109,10 +109,10 @@ def test_sweep_table_matches_closed_form(tmp_path) -> None:
     assert seen == {(p, s) for p in PAYLOADS for s in SCALES}
     assert res.failures == []
     md = (tmp_path / "sweep.md").read_text()
-    assert "Peak |torque|" in md and "RMS torque" in md and "sweep.png" in md
+    assert "Peak |torque|" in md and "RMS torque" in md and "sweep.svg" in md
     # pivot cell: 5 kg at speed x2, joint j1
     assert f"| 5 | 2 | - | {expected_peak(5, 2):.4g} |" in md  # no verdict: "-"
-    assert (tmp_path / "sweep.png").read_bytes().startswith(b"\x89PNG")
+    assert (tmp_path / "sweep.svg").read_text().startswith("<svg ")
     data = json.loads((tmp_path / "sweep.json").read_text())
     assert len(data["variants"]) == 9
 

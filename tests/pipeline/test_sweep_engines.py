@@ -33,7 +33,7 @@ def test_metrics_only_variants_write_nothing_and_match_kept_runs(tmp_path, capsy
     kept = _sweep(tmp_path / "kept", "--workers", "1", "--keep-runs")
     # the sweep folder holds the sweep's files and its marker, nothing per variant
     assert sorted(p.name for p in (tmp_path / "metrics").iterdir()) == [
-        ".cellsim-files", ".cellsim-run", "sweep.csv", "sweep.json", "sweep.md", "sweep.png"]
+        ".cellsim-files", ".cellsim-run", "sweep.csv", "sweep.json", "sweep.md", "sweep.svg"]
     assert all(r["run_dir"] == "" for r in metrics)
     kept_dirs = {r["run_dir"] for r in kept}
     assert len(kept_dirs) == 4 and all((Path(d) / "trajectory.npz").is_file() for d in kept_dirs)

@@ -18,12 +18,12 @@ gives. A failing variant does not stop the others: the outputs are written for t
 succeeded, then :class:`SweepError` names the failures.
 
 Outputs in ``out_dir``: ``sweep.csv`` (one row per variant and joint), ``sweep.md`` (pivot
-tables of peak and RMS torque, failures), ``sweep.png`` (peak and RMS torque per joint against
+tables of peak and RMS torque, failures), ``sweep.svg`` (peak and RMS torque per joint against
 payload and against speed scale) and ``sweep.json``.
 
 The package, one concept per module, each importing only those before it:
 :mod:`~sim.pipeline.sweep.variants` (the variants, their validation, outcomes and rows) <-
-:mod:`~sim.pipeline.sweep.report` (``sweep.csv``, ``sweep.md``, ``sweep.png``, ``sweep.json``)
+:mod:`~sim.pipeline.sweep.report` (``sweep.csv``, ``sweep.md``, ``sweep.svg``, ``sweep.json``)
 <- :mod:`~sim.pipeline.sweep.engines` (where variants run: a process pool, Ray, a batch) <-
 :mod:`~sim.pipeline.sweep.run` (:func:`run_sweep`: the sweep folder, its lock and its move
 into place). Parsing the command line's value lists is :mod:`sim.cli.size`'s.
@@ -37,8 +37,8 @@ from sim.errors import SweepError
 from sim.pipeline.sweep.engines import ENGINES, run_group, task_groups
 from sim.pipeline.sweep.report import (
     SWEEP_COLUMNS,
-    sweep_chart,
     sweep_markdown,
+    sweep_svg,
     write_sweep,
 )
 from sim.pipeline.sweep.run import run_sweep
@@ -58,5 +58,5 @@ from sim.pipeline.sweep.variants import (
 
 __all__ = ["ENGINES", "MAX_SWEEP_VARIANTS", "SWEEP_COLUMNS", "Outcome", "SweepError",
            "SweepResult", "Variant", "VariantMetrics", "make_variants", "rows_from", "run_group",
-           "run_sweep", "run_variant", "sweep_chart", "sweep_markdown", "task_groups",
+           "run_sweep", "run_variant", "sweep_markdown", "sweep_svg", "task_groups",
            "validate_payloads", "validate_speed_scales", "variant_rows", "write_sweep"]

@@ -1,5 +1,5 @@
 """A sweep's report: ``sweep.csv`` (one row per variant and joint), ``sweep.md`` (pivot tables of
-peak and RMS torque, sizing margins, failures), ``sweep.png`` (torque against payload and
+peak and RMS torque, sizing margins, failures), ``sweep.svg`` (torque against payload and
 against speed scale, each where the sweep varies it) and ``sweep.json``."""
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from sim.analysis.report import csv_text, figure_png, write_atomic
+from sim.analysis.report import csv_text, write_atomic
+from sim.analysis.svg_chart import Panel, Series, grid_svg, viridis
 from sim.pipeline.sweep.selection_report import selection_markdown, write_selection
 from sim.pipeline.sweep.variants import SweepResult
 
@@ -38,7 +39,7 @@ def _pivot(rows: Sequence[dict[str, Any]], key: str, joints: Sequence[str]) -> l
     return out
 
 
-def sweep_markdown(result: SweepResult, chart: str | None = "sweep.png") -> str:
+def sweep_markdown(result: SweepResult, chart: str | None = "sweep.svg") -> str:
     """Text of ``sweep.md``: pivot tables (variant rows, joint columns), failures, chart."""
     rows = result.rows
     joints = list(dict.fromkeys(r["joint"] for r in rows))
@@ -89,7 +90,7 @@ def _verdicts(result: SweepResult) -> list[tuple[str, str]]:
 
 
 def chart_columns(result: SweepResult) -> tuple[str, ...]:
-    """The columns :func:`sweep_figure` draws: ``"payload"`` (torque against payload) and
+    """The columns :func:`sweep_svg` draws: ``"payload"`` (torque against payload) and
     ``"speed"`` (against speed scale), each only where the sweep has more than one value of
     it (against a single value every line would be one point); the payload column alone for
     a sweep of one variant."""
@@ -99,79 +100,51 @@ def chart_columns(result: SweepResult) -> tuple[str, ...]:
     return cols or ("payload",)
 
 
-def sweep_figure(result: SweepResult) -> Any:
-    """The chart as a matplotlib ``Figure``: per joint (rows), peak (solid) and RMS (dashed)
+def sweep_svg(result: SweepResult) -> str:
+    """The chart, SVG text: per joint (rows), peak (solid, circles) and RMS (dashed, squares)
     torque against payload (one line per speed scale) and against speed scale (one line per
     payload), the columns of :func:`chart_columns`; a joint's columns share their torque axis
-    (the same values, seen two ways)."""
-    import matplotlib
-    from matplotlib.figure import Figure
-
+    (the same values, seen two ways). Written directly (:mod:`sim.analysis.svg_chart`), in
+    milliseconds: the sweep's parent draws it after its workers."""
     rows = result.rows
     joints = list(dict.fromkeys(r["joint"] for r in rows))
     payloads = sorted({r["payload_kg"] for r in rows})
     scales = sorted({r["speed_scale"] for r in rows})
     idx = {(r["payload_kg"], r["speed_scale"], r["joint"]): r for r in rows}
-    cols = chart_columns(result)
-    height = 2.3 * len(joints) + 0.8
-    width = 5.0 * len(cols)
-    fig = Figure(figsize=(width, height))
-    # fixed margins, in inches (a constrained layout costs as much as the drawing itself)
-    fig.subplots_adjust(left=0.85 / width, right=1.0 - 0.15 / width, wspace=0.2,
-                        top=1.0 - 0.4 / height, bottom=0.5 / height, hspace=0.45 / 2.3)
-    axes = fig.subplots(len(joints), len(cols), squeeze=False, sharex="col", sharey="row")
-    cmap = matplotlib.colormaps["viridis"]
-
-    def lines(ax, xs, series_keys, label_fmt, make_key):
-        for i, other in enumerate(series_keys):
-            color = cmap(i / max(len(series_keys) - 1, 1))
-            for key, style in (("peak_torque_nm", "-o"), ("rms_torque_nm", "--s")):
-                pts = [(x, idx[make_key(x, other)][key]) for x in xs if make_key(x, other) in idx]
-                if pts:
-                    x, y = zip(*pts, strict=True)
-                    ax.plot(x, y, style, color=color, ms=3.5, lw=1.2,
-                            label=label_fmt(other) if key == "peak_torque_nm" else None)
-
     against = {
         "payload": (payloads, scales, lambda s: f"speed x{s:g}",
-                    lambda j: lambda x, s: (x, s, j), "against payload", "payload (kg)"),
+                    lambda j, x, s: (x, s, j), "against payload", "payload (kg)"),
         "speed": (scales, payloads, lambda p: f"{p:g} kg",
-                  lambda j: lambda x, p: (p, x, j), "against speed scale", "speed scale"),
+                  lambda j, x, p: (p, x, j), "against speed scale", "speed scale"),
     }
+    grid = []
     for k, j in enumerate(joints):
-        for c, col in enumerate(cols):
-            ax = axes[k][c]
-            xs, series, label, key_of, title, xlabel = against[col]
-            lines(ax, xs, series, label, key_of(j))
-            ax.grid(alpha=0.3)
-            if k == 0:
-                ax.set_title(f"{title} (solid: peak, dashed: RMS)", fontsize=9)
-                ax.legend(fontsize=7)
-            if k == len(joints) - 1:
-                ax.set_xlabel(xlabel)
-        axes[k][0].set_ylabel(f"{j} torque (N m)\n(N on a linear axis)", fontsize=9)
-    return fig
-
-
-def sweep_chart(result: SweepResult) -> bytes:
-    """PNG bytes of :func:`sweep_figure`."""
-    return figure_png(sweep_figure(result))
-
-
-def warm_chart() -> None:
-    """Draw a two-variant chart and throw it away: what :func:`sweep_chart` pays the first
-    time in a process (matplotlib's import, fonts, glyphs, tick machinery), paid while the
-    workers run (a sweep calls it in a thread), so the report's own chart costs its drawing
-    only."""
-    import types
-
-    rows = [{"joint": "J1", "payload_kg": p, "speed_scale": 1.0, "peak_torque_nm": 1.0 + p,
-             "rms_torque_nm": 0.5 + p} for p in (0.0, 1.0)]
-    sweep_chart(types.SimpleNamespace(rows=rows))  # type: ignore[arg-type]
+        row = []
+        for c, col in enumerate(chart_columns(result)):
+            xs, others, label, key_of, title, xlabel = against[col]
+            series = []
+            for i, other in enumerate(others):
+                color = viridis(i / max(len(others) - 1, 1))
+                for key, dashed, marker in (("peak_torque_nm", False, "circle"),
+                                            ("rms_torque_nm", True, "square")):
+                    pts = [(x, idx[key_of(j, x, other)][key]) for x in xs
+                           if key_of(j, x, other) in idx]
+                    if pts:
+                        series.append(Series(
+                            x=[p[0] for p in pts], y=[p[1] for p in pts], color=color,
+                            dashed=dashed, marker=marker,
+                            label=label(other) if not dashed else None))
+            row.append(Panel(series=series,
+                             title=f"{title} (solid: peak, dashed: RMS)" if k == 0 else None,
+                             xlabel=xlabel, legend=k == 0,
+                             ylabel=f"{j} torque (N m)\n(N on a linear axis)" if c == 0
+                             else None))
+        grid.append(row)
+    return grid_svg(grid)
 
 
 def write_sweep(out_dir: str | Path, result: SweepResult) -> dict[str, Path]:
-    """Write ``sweep.csv``, ``sweep.json``, ``sweep.png`` (when any variant succeeded),
+    """Write ``sweep.csv``, ``sweep.json``, ``sweep.svg`` (when any variant succeeded),
     ``selection.csv`` and ``selection.json`` (when the variants made an actuator selection) and
     ``sweep.md`` into ``out_dir`` (atomically). Returns the paths by name."""
     out = Path(out_dir)
@@ -189,12 +162,11 @@ def write_sweep(out_dir: str | Path, result: SweepResult) -> dict[str, Path]:
     files["json"] = write_atomic(out / "sweep.json", json.dumps(payload, indent=2) + "\n")
     chart = None
     if rows:
-        files["png"] = write_atomic(out / "sweep.png", sweep_chart(result))
-        chart = "sweep.png"
+        files["svg"] = write_atomic(out / "sweep.svg", sweep_svg(result))
+        chart = "sweep.svg"
     files.update(write_selection(out, result))
     files["md"] = write_atomic(out / "sweep.md", sweep_markdown(result, chart))
     return files
 
 
-__all__ = ["SWEEP_COLUMNS", "chart_columns", "sweep_chart", "sweep_figure", "sweep_markdown",
-           "warm_chart", "write_sweep"]
+__all__ = ["SWEEP_COLUMNS", "chart_columns", "sweep_markdown", "sweep_svg", "write_sweep"]

@@ -10,7 +10,6 @@ import multiprocessing
 import os
 import shutil
 import tempfile
-import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -22,7 +21,7 @@ from sim.pipeline.sweep.engines import (
     import_ray,
     run_variants,
 )
-from sim.pipeline.sweep.report import warm_chart, write_sweep
+from sim.pipeline.sweep.report import write_sweep
 from sim.pipeline.sweep.variants import SweepResult, Variant, make_variants
 from sim.simulation import runfolder
 
@@ -51,7 +50,7 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
         mp_context: Start method of the worker processes (``"spawn"``, ``"forkserver"``,
             ``"fork"``).
         progress: Show a progress bar (tqdm; silent when not a terminal).
-        write: Write ``sweep.csv``, ``sweep.md``, ``sweep.json``, ``sweep.png``.
+        write: Write ``sweep.csv``, ``sweep.md``, ``sweep.json``, ``sweep.svg``.
         raise_on_failure: Raise :class:`SweepError` after writing when a variant failed.
         engine: ``"pool"`` (a process pool on this machine) or ``"ray"`` (Ray tasks: a local
             Ray instance, or the cluster at ``address``); see :data:`ENGINES`.
@@ -107,14 +106,8 @@ def run_sweep(base_scenario: Any, payloads: Sequence[float], speed_scales: Seque
             runfolder.write_marker(tmp, state="writing")
             variants = make_variants(base_scenario, payloads, speed_scales, tmp)
             n_workers = min(workers or os.cpu_count() or 1, len(variants))
-            # the chart's first-time costs are paid while the workers run (the parent waits)
-            charts = threading.Thread(target=warm_chart, daemon=True)
-            if write and n_workers > 1:
-                charts.start()
             result = run_variants(runner, variants, n_workers, mp_context, engine, address,
                                    batch, progress, closing)
-            if charts.is_alive():
-                charts.join()
             result = moved(result, tmp, out_dir)
             failures = result.failures
             every_failed = bool(failures) and len(failures) == len(result.outcomes)
