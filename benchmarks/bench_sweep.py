@@ -28,7 +28,7 @@ By default (issue 29's acceptance) it prints instead, for the weld plate:
   over two workers: a plan and its reference scan per task that has it, four in all), each
   with and without the reuse; the tables with and without the reuse must be identical. Each
   sweep runs ``--repeat`` times, each time in a new Python process as ``cellsim size`` runs
-  it (its report's chart imports matplotlib every time); every run's ratio is printed and the
+  it (a fresh interpreter each time, its report written); every run's ratio is printed and the
   figures are of the median run. Below each sweep's line: how much of its wall the pool took
   (the rest: loading the scenario and writing the report), the variants' own wall times and
   their stages, summed.
@@ -263,7 +263,7 @@ def acceptance(scenario: str, workers: int, repeat: int = 3) -> dict:
         for label, runner in (("with reuse", evaluate_variant),
                               ("without reuse", evaluate_without_reuse)):
             # `repeat` sweeps, each in a new Python process as `cellsim size` runs one (its
-            # report's chart imports matplotlib each time); the figures below are of the
+            # report written each time); the figures below are of the
             # median one by its ratio to its own bound
             runs = []
             for _ in range(repeat):

@@ -91,11 +91,19 @@ def nice_ticks(lo: float, hi: float, n: int = 5) -> list[float]:
 
 
 def tick_text(v: float, ticks: Sequence[float]) -> str:
-    """A tick's label with as many decimals as the ticks' step needs."""
+    """A tick's label with as many decimals as the ticks' step needs; in scientific notation
+    (``1.5e-8``) where a fixed-point label of these ticks would be longer than 7 characters
+    (a motionless joint's torque of 1e-8 N m, a track's force of 1e6 N)."""
     step = abs(ticks[1] - ticks[0]) if len(ticks) > 1 else 1.0
     decimals = max(0, -math.floor(math.log10(step) + 1e-9))
-    text = f"{v:.{decimals}f}"
-    return "0" if float(text) == 0.0 else text
+    if max(len(f"{t:.{decimals}f}") for t in ticks) <= 7:
+        text = f"{v:.{decimals}f}"
+        return "0" if float(text) == 0.0 else text
+    big = max(abs(t) for t in ticks)
+    e = math.floor(math.log10(big) + 1e-9)
+    digits = max(0, e - math.floor(math.log10(step) + 1e-9))
+    mantissa = f"{v / 10.0**e:.{digits}f}"
+    return "0" if float(mantissa) == 0.0 else f"{mantissa}e{e}"
 
 
 def _finite(s: Series) -> list[tuple[float, float]]:
