@@ -376,6 +376,10 @@ BAD = {
                                'shape = "ring"\nradius_mm = 50\ninner_radius_mm = 20\n'
                                'length_mm = 40\nrole = "part"\nmass_kg = 1'),
                               "objects[1].shape: a part cannot be a ring"),
+    "seam points typed in metres": (("[[40.0, 70.0, 10.0], [160.0, 70.0, 10.0]]",
+                                     "[[0.04, 0.07, 0.01], [0.16, 0.07, 0.01]]"),
+                                    "seams[0].points_mm: the seam is 0.12 mm long through its "
+                                    "points (at least 1 mm); points_mm are millimetres"),
     "a polyline whose normal runs along a later segment": (
         ('kind = "line"\npoints_mm = [[40.0, 70.0, 10.0], [160.0, 70.0, 10.0]]',
          'kind = "polyline"\npoints_mm = [[40.0, 70.0, 10.0], [100.0, 70.0, 10.0], '

@@ -28,8 +28,13 @@ from sim.cells.seam import Seam
 from sim.cells.tools import ToolSpec
 from sim.errors import CellError, CellsimError
 
+#: The shortest seam, mm, through its points: anything shorter was typed in metres.
+MIN_SEAM_MM = 1.0
+
 
 def seam_points(sb: SeamBlock, key: str) -> NDArray[np.float64]:
+    """A seam block's points, m (N, 3), checked: as many as its kind takes, three values
+    each, finite, and at least :data:`MIN_SEAM_MM` long through them."""
     want = {"line": "2", "arc": "3 (start, via, end)", "polyline": "at least 2"}[sb.kind]
     ok = {"line": len(sb.points_mm) == 2, "arc": len(sb.points_mm) == 3,
           "polyline": len(sb.points_mm) >= 2}[sb.kind]
@@ -42,6 +47,15 @@ def seam_points(sb: SeamBlock, key: str) -> NDArray[np.float64]:
     pts = np.asarray(sb.points_mm, dtype=float) * 1e-3
     if not np.all(np.isfinite(pts)):
         raise CellError(f"{key}.points_mm: must be finite numbers")
+    # the length through the given points (an arc's through its via point): no weld seam is
+    # shorter than a millimetre, and one that is was typed in metres (0.4 for 400 mm)
+    length_mm = float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1))) * 1e3
+    if length_mm < MIN_SEAM_MM:
+        first = np.asarray(sb.points_mm[0], dtype=float)
+        raise CellError(f"{key}.points_mm: the seam is {length_mm:.3g} mm long through its "
+                        f"points (at least {MIN_SEAM_MM:g} mm); points_mm are millimetres in "
+                        f"the object's frame: typed in metres? ({first.tolist()} would be "
+                        f"{(first * 1e3).tolist()} mm)")
     return pts
 
 
@@ -90,4 +104,4 @@ def seam_in_world(sb: SeamBlock, T_obj: NDArray[np.float64], pts: NDArray[np.flo
                 standoff_m=standoff)
 
 
-__all__ = ["ctwd_key", "seam_in_world", "seam_points", "seam_standoff"]
+__all__ = ["MIN_SEAM_MM", "ctwd_key", "seam_in_world", "seam_points", "seam_standoff"]
