@@ -114,6 +114,18 @@ class RobotSpec:
             partners=self.partners + tuple(partners))
 
     @property
+    def without_partners(self) -> RobotSpec:
+        """The arm and its cell's axes, without the cell's other robots (what the first
+        robot's phases move); itself when there are none."""
+        if not self.partners:
+            return self
+        n = self.n_joints - sum(r.n_joints for _, r in self.partners)
+        return dataclasses.replace(
+            self, joint_names=self.joints[:n], max_speed=self.max_speed[:n],
+            max_accel=self.max_accel[:n] if np.all(np.isfinite(self.max_accel[:n])) else (),
+            drives=self.drives[:n], estimated_links=self.estimated_links[:n], partners=())
+
+    @property
     def n_arm(self) -> int:
         """The arm's joints (without external axes and other robots)."""
         return self.n_joints - len(self.external) - sum(r.n_joints for _, r in self.partners)

@@ -51,7 +51,8 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
     phases: list[PhaseMotion] = []
     t = 0.0
     q = None
-    system = scenario.system
+    # the first robot's joints and the cell's axes (the other robots' lanes are built apart)
+    system = scenario.system.without_partners
     joints = system.joints
     # a cell with external axes: the joint vector is the robot's joints, then the axes
     # (sim.simulation.motion.axes); n is the robot's share of it
@@ -66,6 +67,8 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
         while todo:
             phase = todo.pop(0)
             label = phase_label(where, phase)
+            if not n_axes:
+                _no_axes_to_move(phase, label)
             if isinstance(phase, CartesianPhase):
                 _check_seam_blends(phase, todo[0] if todo else None, context, label)
             if isinstance(phase, CartesianPhase) and (_blends(phase)
@@ -162,15 +165,13 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
         # a phase that cannot be planned from where an earlier one left a joint past its
         # range: the range is the mistake to name (the later phase's IK or branch error
         # only follows from it)
-        _earlier_limit(scenario, phases, system.n_joints - sum(
-            w.robot.n_joints for w in scenario.partners))
+        _earlier_limit(scenario, phases, system.n_joints)
         raise
-    n_lead = system.n_joints - sum(w.robot.n_joints for w in scenario.partners)
-    motion = Motion(phases=phases, actions=[], n_joints=n_lead)
+    motion = Motion(phases=phases, actions=[], n_joints=system.n_joints)
     motion.actions = _resolve_actions(scenario, motion)
     if scenario.partners:
         motion.lanes = _plan_partners(scenario, context, motion.t0)
-        motion.n_joints = system.n_joints
+        motion.n_joints = scenario.system.n_joints  # the other robots' joints after
     return motion
 
 
@@ -218,6 +219,20 @@ def _robot_part(pm: PhaseMotion, n: int) -> PhaseMotion:
     traj = pm.trajectory
     return dataclasses.replace(pm, trajectory=traj.robot) if isinstance(traj, axes.HeldAxes) \
         else pm
+
+
+def _no_axes_to_move(phase: object, label: str) -> None:
+    """Refuse what only a cell's axes can do (``downhand``, ``follow``, ``axes``) in a cell
+    without them: silently ignored, the user would believe the weld turned downhand."""
+    if getattr(phase, "downhand", False):
+        raise ScenarioError(f"{label}.downhand: the cell has no positioner or turntable to turn "
+                            "the seam downhand (leave downhand out)")
+    if getattr(phase, "follow", None) is not None:
+        raise ScenarioError(f"{label}.follow: the cell has no track to follow the weld with "
+                            "(leave follow out)")
+    if getattr(phase, "axes", None):
+        raise ScenarioError(f"{label}.axes: the cell has no external axes to move (leave axes "
+                            "out)")
 
 
 def _no_coordination(group: list, labels: list[str]) -> None:
