@@ -125,15 +125,20 @@ def run(args: argparse.Namespace) -> int:
     summary = run_scenario(scenario, options)
     out = (args.out or default_out_dir(scenario))
     units = summary.get("joint_units") or ["deg"] * len(summary["max_tracking_error_deg"])
-    track = max(e for e, u in zip(summary["max_tracking_error_deg"], units, strict=True)
-                if u == "deg")
+    track, worst = max((e, j) for j, e, u in zip(summary["joints"],
+                                                 summary["max_tracking_error_deg"], units,
+                                                 strict=True) if u == "deg")
+    robots = list(summary.get("robots", {}))
+    # in a cell with other robots: whose joint, and that the headline's tcp is the first's
+    whose = f" ({worst})" if len(robots) > 1 else ""
+    first = f" ({robots[0]})" if len(robots) > 1 else ""
     linear = "".join(f", {j} {e:.4f} mm" for j, e, u in zip(
         summary["joints"], summary["max_tracking_error_deg"], units, strict=True) if u == "mm")
     # the MuJoCo steps' own time (the simulate stage's line adds the reference and feed-forward)
     line = (f"{scenario.name}: {summary['duration_s']:.3f} s simulated in "
             f"{summary['wall_s']:.3g} s of MuJoCo steps (x{summary['realtime_factor']:.1f} real time); max tracking error "
-            f"{track:.4f} deg"
-            f"{linear}; max tcp deviation {summary['max_tcp_deviation_mm']:.3f} mm")
+            f"{track:.4f} deg{whose}"
+            f"{linear}; max tcp deviation {summary['max_tcp_deviation_mm']:.3f} mm{first}")
     print(line)
     for line in summary.get("program_warnings", []):
         print(f"  program: {line}")

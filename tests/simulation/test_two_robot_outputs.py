@@ -366,6 +366,13 @@ def test_cellsim_run_prints_each_robots_weld(tmp_path: Path, capsys):
     assert (out_dir / "plots" / "tool_path_r2.png").is_file()
     assert "## Robot r2 (lrmate200ic5l)" in (out_dir / "sizing.md").read_text()
     summary = json.loads((out_dir / "summary.json").read_text())
+    # the headline names whose joint tracks worst and that its tcp deviation is the first
+    # robot's (r2's has its own line)
+    errs = dict(zip(summary["joints"], summary["max_tracking_error_deg"], strict=True))
+    worst = max(errs, key=lambda j: errs[j])
+    head = text.splitlines()[0]
+    assert f"max tracking error {errs[worst]:.4f} deg ({worst})" in head, head
+    assert head.endswith(f"max tcp deviation {summary['max_tcp_deviation_mm']:.3f} mm (robot)")
     from sim.api.results import RunResult
 
     res = RunResult.load(out_dir)
