@@ -8,6 +8,10 @@ is per joint:
   ``simulation.tracking_tolerance_deg``;
 * ``saturation``: the worst excess of the servo's demand over the drive's limit, N m, against
   0 (any saturation fails; the intervals are in ``summary["saturation"]``);
+* ``range``: how far the simulated joint goes past its position range (the robot's MJCF, a
+  mechanism's file), deg (mm for a linear axis), against the tracking tolerance (a reference at
+  its limit may overshoot it by the servo's allowed error; beyond that the joint is on its hard
+  stop: a drive too weak to hold the arm lets it fall there);
 * ``speed``: the largest simulated joint speed, deg/s, against the robot's speed limit;
 * ``acceleration``: the largest reference joint acceleration, deg/s^2, against the robot's
   acceleration limit (derived from its drive train, :mod:`sim.robots.accel_limits`);
@@ -64,7 +68,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.analysis.sizing import SizingResult
-from sim.robots.registry import RobotSpec
+from sim.robots.registry import RobotSpec, joint_ranges
 
 #: Largest deviation of a measured weave amplitude / frequency from the set value (warning), %.
 WEAVE_AMPLITUDE_PCT = 2.0
@@ -131,6 +135,10 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
     scale = np.where(linear, 1e3, np.degrees(1.0))
     track = scale * np.max(np.abs(np.asarray(arrays["q"]) - arrays["q_ref"]), axis=0)
     speed = scale * np.max(np.abs(np.asarray(arrays["qd"])), axis=0)
+    q = np.asarray(arrays["q"])
+    rng = joint_ranges(spec)
+    past = scale * np.maximum(np.max(q - rng[:, 1], axis=0), np.max(rng[:, 0] - q, axis=0))
+    past = np.maximum(past, 0.0)
     accel = scale * np.max(np.abs(np.asarray(arrays["qdd_ref"])), axis=0)
     excess = {j: 0.0 for j in spec.joints}
     for s in summary.get("saturation", ()):
@@ -140,6 +148,8 @@ def run_checks(arrays: Mapping[str, NDArray[Any]], summary: Mapping[str, Any], s
         tol = float(tracking_tolerance_mm if linear[k] else tracking_tolerance_deg)
         checks.append(RunCheck("tracking", joint, float(track[k]), tol, unit,
                                bool(track[k] <= tol)))
+        checks.append(RunCheck("range", joint, float(past[k]), tol, unit,
+                               bool(past[k] <= tol)))
         checks.append(RunCheck("saturation", joint, excess[joint], 0.0,
                                "N" if linear[k] else "N m", excess[joint] <= 0.0))
         vmax = float(scale[k] * spec.max_speed[k])
@@ -297,6 +307,9 @@ def check_line(check: Mapping[str, Any]) -> str:
         return f"{head}: demand up to {value:.4g} {unit} over the drive's limit"
     if check["name"] == "collision":
         return f"{head}: {value:.1f} {unit} deep"
+    if check["name"] == "range":
+        return (f"{head}: {value:.4g} {unit} past the joint's position range (at most "
+                f"{float(check['limit']):.4g} {unit})")
     if check["name"] == "selection":  # no pair passes: the closest pair's least margin
         return f"{head}; {value:.4g} {unit} at its worst"
     return f"{head}: {value:.4g} {unit} against the limit {float(check['limit']):.4g} {unit}"

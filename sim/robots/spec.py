@@ -202,12 +202,15 @@ def joint_ranges(spec: RobotSpec) -> NDArray[np.float64]:
     Returns:
         Array of shape (n_joints, 2): lower and upper limit of joints ``j1..jN``, rad, in the
         seed's convention (MuJoCo qpos equals the seed's joint value), then those of the
-        external axes (rad or m, from their mechanism files).
+        external axes (rad or m, from their mechanism files), then those of the cell's other
+        robots (:meth:`RobotSpec.with_partners`).
     """
     arm = spec.arm
     ranges = np.array(_mjcf_ranges(str(arm.robot_path), arm.joints), dtype=float)
     if spec.external:
         ranges = np.vstack([ranges, [a.range for _, a in spec.external]])
+    for _, other in spec.partners:
+        ranges = np.vstack([ranges, joint_ranges(other)])
     return ranges
 
 

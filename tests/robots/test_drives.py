@@ -253,6 +253,19 @@ def test_an_arm_its_drives_cannot_move_is_a_failed_result_not_an_error(tmp_path,
     a = np.load(tmp_path / "r" / "trajectory.npz")
     # the arm really fell: J2's tracking error, from the recorded joint states, passes 10 deg
     assert np.degrees(np.max(np.abs(a["q"][:, 1] - a["q_ref"][:, 1]))) > 10.0
+    # each joint's range check is how far the recorded q went past the range MuJoCo compiles
+    # from the robot's MJCF (a fallen arm lies on a hard stop)
+    import mujoco
+
+    from sim.robots.registry import get_robot
+
+    model = mujoco.MjModel.from_xml_path(str(get_robot("lrmate200ic5l").robot_path))
+    ranges = {c["joint"]: c for c in summary["checks"] if c["name"] == "range"}
+    for k, j in enumerate(summary["joints"]):
+        lo, hi = model.joint(j).range
+        past = max(0.0, np.degrees(max(a["q"][:, k].max() - hi, lo - a["q"][:, k].min())))
+        assert ranges[j]["value"] == pytest.approx(past, abs=1e-9)
+        assert ranges[j]["pass"] == (past <= ranges[j]["limit"])
     (tmp_path / "s.toml").write_text(OVERLOADED.format(payload=1e308))
     assert main(["check", str(tmp_path / "s.toml")]) == 2
     assert capsys.readouterr().err.strip().endswith(
