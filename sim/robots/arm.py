@@ -286,6 +286,7 @@ def chain_from_robot_file(spec: RobotFolderSpec, path: Path) -> Chain:
         rows[:, 1] = np.deg2rad(rows[:, 1])
         rows[:, 3] = np.deg2rad(rows[:, 3])
         n = len(rows)
+        _check_row_counts(spec, n, where)
         lo = np.full(n, -np.inf)
         hi = np.full(n, np.inf)
         j = spec.joints
@@ -305,6 +306,23 @@ def chain_from_robot_file(spec: RobotFolderSpec, path: Path) -> Chain:
                 raise KinematicsError(f"{where}: joints.range_deg: {bad}")
         chain = chain_from_dh(rows, k.convention, name=spec.name, lower=lo, upper=hi)
     return dataclasses.replace(chain, name=spec.name)
+
+
+def _check_row_counts(spec: RobotFolderSpec, n: int, where: str) -> None:
+    """The DH table is the one to blame when the robot file's other per-joint keys agree on
+    another number of joints than its rows (a row left out of ``kinematics.dh`` read as
+    "joints.range_deg: 6 rows for 5 joints", sending the user to the one key that was right)."""
+    j = spec.joints
+    counts = {key: len(v) for key, v in (
+        ("joints.range_deg", j.range_deg), ("joints.home_deg", j.home_deg),
+        ("joints.max_speed_deg_s", j.max_speed_deg_s),
+        ("joints.max_accel_deg_s2", j.max_accel_deg_s2),
+        ("[[drives]]", spec.drives or None), ("[[links]]", spec.links or None)) if v is not None}
+    others = set(counts.values())
+    if len(counts) >= 2 and len(others) == 1 and n not in others:
+        m = others.pop()
+        raise KinematicsError(f"{where}: kinematics.dh: {n} rows, while "
+                              f"{', '.join(counts)} give {m} joints: one DH row per joint")
 
 
 def load_arm(path: str | Path) -> Arm:
