@@ -10,7 +10,8 @@ returns a few numbers per joint (metrics only); the sweep folder (``--out``, def
 speed), drawn once at the end. ``--keep-runs`` also writes one full run folder per variant
 (arrays, summary, sizing report; ``--plots`` adds each run's charts). A variant that exceeds a
 speed, acceleration or torque limit is kept, with its negative margins and its run's verdict;
-the command exits 0 when it could evaluate every variant.
+the command exits 0 when it could evaluate every variant (``--strict``: 1 when a variant's
+verdict failed, a gate for a CI job).
 """
 
 from __future__ import annotations
@@ -95,7 +96,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "simulated even past the robot's speed or acceleration limits (the "
                     "scenario's enforce_* keys are not applied): they stay in the tables with "
                     "negative margins and their run's verdict. Exit 0 when every variant was "
-                    "evaluated.")
+                    "evaluated (with --strict: 1 when a variant's verdict failed).")
     p.add_argument("scenario", metavar="SCENARIO",
                    help="a scenario file, or a shipped scenario's name (see `cellsim list`)")
     p.add_argument("--payload", default=None, metavar="KG,..",
@@ -125,6 +126,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--plots", action="store_true",
                    help="with --keep-runs: draw each variant's plots too")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--strict", action="store_true",
+                   help="exit with 1 when a variant's verdict is fail (a collision, a saturated "
+                        "drive, a joint past a limit, a payload over a rating, a sizing limit "
+                        "exceeded, no actuator pair found): a gate for a CI job")
     add_selection_args(p)
     p.set_defaults(func=run)
 
@@ -225,12 +230,14 @@ def run(args: argparse.Namespace) -> int:
     print(f"{len(result.outcomes)} variants in {result.wall_s:.1f} s on {result.workers} "
           f"worker(s); results in {out}/ (sweep.csv, sweep.md, sweep.svg"
           f"{', selection.csv, selection.json' if 'selection_csv' in result.files else ''})")
+    failed = 0
     for o in result.outcomes:  # simulated and sized, but not physically possible: said here too
         if o.rows and o.rows[0].get("verdict") == "fail":
+            failed += 1
             print(f"  verdict fail, {o.variant.label}: {o.rows[0].get('failed_checks') or 'fail'}")
     if selection is not None:
         _print_selections(result)
-    return 0
+    return 1 if args.strict and failed else 0
 
 
 def _print_selections(result) -> None:

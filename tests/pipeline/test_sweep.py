@@ -341,3 +341,8 @@ def test_a_variant_whose_verdict_fails_says_why_in_the_table_and_the_report(tmp_
     assert f"- payload 2.5 kg, speed x1: {why}" in md
     assert f"  verdict fail, payload 2.5 kg, speed x1: {why}" in out.splitlines()  # console
     assert "payload 0 kg" not in out
+    # --strict: a CI job's gate, 1 when a variant's verdict failed, 0 when none did
+    assert main(["size", "lrmate200ic_pick_place", "--payload", "0,2.5", "--workers", "1",
+                 "--quiet", "--strict", "--out", str(tmp_path / "s")]) == 1
+    assert main(["size", "lrmate200ic_pick_place", "--payload", "0", "--workers", "1",
+                 "--quiet", "--strict", "--out", str(tmp_path / "s")]) == 0
