@@ -71,6 +71,10 @@ def resolve_robot(ref: str, base: Path | None = None) -> RobotSpec:
         if not (path.is_dir() and (path / "robot.toml").is_file()) and not path.is_file():
             raise KinematicsError(f"{path}: no robot folder (a folder with a robot.toml)")
         return _own_name(load_robot_folder(path), path / "robot.toml" if path.is_dir() else path)
+    if ref not in ROBOTS and base is not None and (base / ref / "robot.toml").is_file():
+        # a folder of one's own beside the scenario, named as a shipped robot is named
+        raise KinematicsError(f"unknown robot {ref!r}; {base / ref} is a robot folder: give "
+                              f"it as a path, robot = \"./{ref}\"")
     return ROBOTS.get(ref)
 
 
