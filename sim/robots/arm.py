@@ -281,6 +281,7 @@ def chain_from_robot_file(spec: RobotFolderSpec, path: Path) -> Chain:
                 quantity.read(value, f"{where}: kinematics.dh[{i}][{j}] ({names[j]})",
                               KinematicsError)
         rows = np.array(k.dh, dtype=float)
+        _check_angles_in_degrees(rows, where)
         rows[:, 0] /= 1000.0
         rows[:, 2] /= 1000.0
         rows[:, 1] = np.deg2rad(rows[:, 1])
@@ -306,6 +307,25 @@ def chain_from_robot_file(spec: RobotFolderSpec, path: Path) -> Chain:
                 raise KinematicsError(f"{where}: joints.range_deg: {bad}")
         chain = chain_from_dh(rows, k.convention, name=spec.name, lower=lo, upper=hi)
     return dataclasses.replace(chain, name=spec.name)
+
+
+#: Angles in radians that a DH table's degrees are never: +-pi/2, +-pi (to 1e-3).
+_RADIAN_ANGLES = (math.pi / 2, math.pi)
+
+
+def _check_angles_in_degrees(rows: NDArray[np.float64], where: str) -> None:
+    """Refuse a DH angle (``alpha_deg``, ``theta_offset_deg``) that is a right or straight
+    angle in radians (1.5708, 3.1416): typed in radians, the arm is another arm, and the
+    mistake surfaced far away ("no inverse-kinematics solution" on a scenario's path)."""
+    for i, row in enumerate(rows):
+        for j, name in ((1, "alpha_deg"), (3, "theta_offset_deg")):
+            v = float(row[j])
+            hit = next((a for a in _RADIAN_ANGLES if abs(abs(v) - a) < 1e-3), None)
+            if hit is not None:
+                deg = math.copysign(math.degrees(hit), v)
+                raise KinematicsError(f"{where}: kinematics.dh[{i}][{j}] ({name}): {v:g} is "
+                                      f"{deg:+g} deg in radians; the DH angles are degrees "
+                                      f"(give {deg:g})")
 
 
 def _check_row_counts(spec: RobotFolderSpec, n: int, where: str) -> None:
