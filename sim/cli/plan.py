@@ -52,8 +52,8 @@ def planned_motion(scenario: Scenario) -> Motion:
     context = None
     # the cell is built where a phase needs it: a Cartesian move or a pose target (its IK), a
     # joint move that starts from the cell's home (a TP program's first move, a phase with
-    # durations_s and no start), or other robots
-    if scenario.partners or any(
+    # durations_s and no start), other robots, or the cell's axes (mechanisms)
+    if scenario.partners or scenario.system.external or any(
             isinstance(p, CartesianPhase) or (isinstance(p, JointPhase) and (
                 p.target is not None or bool(np.isnan(p.q[0]).any())))
             for p in scenario.phases):

@@ -309,7 +309,7 @@ def chain_from_robot_file(spec: RobotFolderSpec, path: Path) -> Chain:
     return dataclasses.replace(chain, name=spec.name)
 
 
-#: Angles in radians that a DH table's degrees are never: +-pi/2, +-pi (to 1e-3).
+#: Angles in radians that a DH table's degrees are never: +-pi/2, +-pi (to 2e-3: 1.57, 3.14).
 _RADIAN_ANGLES = (math.pi / 2, math.pi)
 
 
@@ -320,7 +320,7 @@ def _check_angles_in_degrees(rows: NDArray[np.float64], where: str) -> None:
     for i, row in enumerate(rows):
         for j, name in ((1, "alpha_deg"), (3, "theta_offset_deg")):
             v = float(row[j])
-            hit = next((a for a in _RADIAN_ANGLES if abs(abs(v) - a) < 1e-3), None)
+            hit = next((a for a in _RADIAN_ANGLES if abs(abs(v) - a) < 2e-3), None)
             if hit is not None:
                 deg = math.copysign(math.degrees(hit), v)
                 raise KinematicsError(f"{where}: kinematics.dh[{i}][{j}] ({name}): {v:g} is "

@@ -74,7 +74,7 @@ def resolve_robot(ref: str, base: Path | None = None) -> RobotSpec:
     if ref not in ROBOTS and base is not None and (base / ref / "robot.toml").is_file():
         # a folder of one's own beside the scenario, named as a shipped robot is named
         raise KinematicsError(f"unknown robot {ref!r}; {base / ref} is a robot folder: give "
-                              f"it as a path, robot = \"./{ref}\"")
+                              f"it as a path, \"./{ref}\"")
     return ROBOTS.get(ref)
 
 

@@ -49,7 +49,9 @@ def test_a_joint_past_its_range_fails_by_how_far(name, data):
     n = len(spec.joints)
     k = data.draw(st.integers(0, n - 1), label="joint")
     side = data.draw(st.sampled_from([0, 1]), label="side")
-    past_deg = data.draw(st.one_of(st.just(0.0), st.floats(-5.0, 5.0)), label="past_deg")
+    # (clear of the tolerance itself: 0.1 deg past a bound reads 0.1 only to rounding)
+    past_deg = data.draw(st.one_of(st.just(0.0), st.floats(-5.0, 5.0).filter(
+        lambda x: abs(x - TOL_DEG) > 1e-6)), label="past_deg")
     samples = data.draw(st.integers(2, 50), label="samples")
     at = data.draw(st.integers(0, samples - 1), label="at")
     q = np.tile(rng.mean(axis=1), (samples, 1))
@@ -81,6 +83,35 @@ def test_other_robots_joints_are_checked_against_their_own_ranges():
     got = _range_checks(system, q)
     assert got["r2_j2"].value == pytest.approx(2.0) and not got["r2_j2"].passed
     assert all(c.passed for j, c in got.items() if j != "r2_j2")
+
+
+def test_a_track_axis_is_checked_in_mm_and_an_unlimited_joint_never_fails():
+    import dataclasses
+
+    from sim.robots.mechanisms.registry import MECHANISMS
+
+    arm = get_robot("lrmate200ic5l")
+    track = MECHANISMS.get("floor_track_4m")
+    system = arm.with_axes([("track_travel", a) for a in track.axes])
+    lo, hi = track.axes[0].range  # m
+    q = np.tile(np.r_[_mjcf_ranges(arm).mean(axis=1), 0.5 * (lo + hi)], (3, 1))
+    q[2, -1] = hi + 0.0003  # 0.3 mm past
+    checks = run_checks(_arrays(q), {}, system, TOL_DEG, torch_angle_tolerance_deg=1.0,
+                        tracking_tolerance_mm=0.5)
+    got = {c.joint: c for c in checks if c.name == "range"}["track_travel"]
+    assert got.unit == "mm" and got.value == pytest.approx(0.3) and got.passed
+    q[2, -1] = hi + 0.0008
+    checks = run_checks(_arrays(q), {}, system, TOL_DEG, torch_angle_tolerance_deg=1.0,
+                        tracking_tolerance_mm=0.5)
+    got = {c.joint: c for c in checks if c.name == "range"}["track_travel"]
+    assert got.value == pytest.approx(0.8) and not got.passed
+    # an axis without limits (its range -inf..inf) is never past it
+    free = dataclasses.replace(track.axes[0], range=(-np.inf, np.inf))
+    system = arm.with_axes([("track_travel", free)])
+    q[2, -1] = 1e6
+    checks = run_checks(_arrays(q), {}, system, TOL_DEG, torch_angle_tolerance_deg=1.0)
+    got = {c.joint: c for c in checks if c.name == "range"}["track_travel"]
+    assert got.value == 0.0 and got.passed
 
 
 def test_planted_fault_ranges_one_joint_off_are_caught(monkeypatch):

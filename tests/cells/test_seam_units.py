@@ -66,6 +66,15 @@ def test_a_seam_shorter_than_a_millimetre_names_its_points_in_mm():
         seams.seam_points(_block("line", [[0.1, 0.0, 0.0], [0.1, 0.5, 0.0]]), "c.toml: seams[0]")
 
 
+def test_a_short_seam_in_clear_millimetres_is_not_told_it_is_in_metres():
+    with pytest.raises(CellError, match=r"the seam is 0\.5 mm long .*object's frame$"):
+        seams.seam_points(_block("line", [[100.0, 50.0, 0.0], [100.0, 50.5, 0.0]]), "seams[0]")
+
+
+def test_coinciding_points_are_left_to_the_seams_own_message():
+    assert _verdict("line", [[100.0, 50.0, 0.0], [100.0, 50.0, 0.0]]) == "read"
+
+
 def test_planted_fault_the_check_skipped_is_caught():
     with mock.patch.object(seams, "MIN_SEAM_MM", 0.0):
         assert _verdict("line", [[0.04, 0.07, 0.01], [0.16, 0.07, 0.01]]) == "read"

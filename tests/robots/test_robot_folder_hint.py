@@ -3,7 +3,7 @@ as a shipped robot is named), is looked up among the shipped robots; the refusal
 folder is there and how to name it (a new user's trial read only "unknown robot").
 
 Specification, on generated folder names: ``robot = "<name>"`` exits 2 with one line naming
-the folder and ``robot = "./<name>"``; ``robot = "./<name>"`` checks; a name with no such
+the folder and the path to give, ``"./<name>"``; ``robot = "./<name>"`` checks; a name with no such
 folder keeps the shipped robots' list.
 """
 
@@ -19,9 +19,10 @@ from hypothesis import strategies as st
 from support.robots import DH_ROBOT, DH_SCENARIO
 
 from sim.cli import main
+from sim.robots.registry import ROBOTS
 
 NAMES = st.from_regex(r"[a-z][a-z0-9_]{2,12}", fullmatch=True).filter(
-    lambda n: n not in {"lrmate100ib", "robot_5r"})
+    lambda n: n not in set(ROBOTS.names()))
 
 
 def _check(name: str, ref: str, make: bool = True) -> tuple[int, str]:
@@ -43,7 +44,7 @@ def test_a_folder_named_without_a_path_is_pointed_to(name):
     code, err = _check(name, name)
     lines = err.strip().splitlines()
     assert code == 2 and len(lines) == 1, err
-    assert f"unknown robot {name!r}" in lines[0] and f'robot = "./{name}"' in lines[0], err
+    assert f"unknown robot {name!r}" in lines[0] and f'give it as a path, "./{name}"' in lines[0]
     code, err = _check(name, f"./{name}")
     assert code in (0, 1), err
 

@@ -16,6 +16,7 @@ import re
 import tempfile
 from pathlib import Path
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from support.cell_files import SCENARIO, make_cell
@@ -52,3 +53,26 @@ def test_a_coordination_key_in_a_cell_without_axes_is_one_line_naming_it(phase, 
 def test_without_the_key_the_scenario_checks():
     code, out = _check(SCENARIO)
     assert code in (0, 1), out
+
+
+def test_a_cell_with_axes_plans_them_where_plan_builds_no_cell(tmp_path):
+    """``cellsim plan`` builds the cell only where a phase needs it; a cell with a track whose
+    phases are all joint moves still has its axes (the reviewer's case: the shipped track cell's
+    "ready" phase alone was told "the cell has no external axes to move")."""
+    import tomllib
+
+    from sim.cli.plan import planned_motion
+    from sim.scenario import load_scenario
+
+    text = (Path(__file__).parents[2] / "scenarios" / "track_beam_weld.toml").read_text()
+    first = text[:text.index("[[phases]]", text.index("[[phases]]") + 1)]
+    first = first[:first.index("[[actions]]")] + first[first.index("[[phases]]"):] \
+        if "[[actions]]" in first else first  # the arc's actions name later phases
+    travel_mm = tomllib.loads(first)["phases"][0]["axes"]["track_travel_mm"]
+    (tmp_path / "ready.toml").write_text(first)
+    motion = planned_motion(load_scenario(tmp_path / "ready.toml"))
+    end = motion.at(motion.phases[-1].t1).q[0]
+    assert end[-1] * 1e3 == pytest.approx(travel_mm, abs=1e-9)
+    err = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+        assert main(["plan", str(tmp_path / "ready.toml")]) == 0, err.getvalue()

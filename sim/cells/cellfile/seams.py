@@ -28,8 +28,11 @@ from sim.cells.seam import Seam
 from sim.cells.tools import ToolSpec
 from sim.errors import CellError, CellsimError
 
-#: The shortest seam, mm, through its points: anything shorter was typed in metres.
+#: The shortest seam, mm, through its points: anything shorter is a mistake.
 MIN_SEAM_MM = 1.0
+
+#: A seam too short whose every coordinate is at most this (mm) was typed in metres.
+METRES_LOOK_MM = 5.0
 
 
 def seam_points(sb: SeamBlock, key: str) -> NDArray[np.float64]:
@@ -50,12 +53,15 @@ def seam_points(sb: SeamBlock, key: str) -> NDArray[np.float64]:
     # the length through the given points (an arc's through its via point): no weld seam is
     # shorter than a millimetre, and one that is was typed in metres (0.4 for 400 mm)
     length_mm = float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1))) * 1e3
-    if length_mm < MIN_SEAM_MM:
-        first = np.asarray(sb.points_mm[0], dtype=float)
+    if 0.0 < length_mm < MIN_SEAM_MM:  # (coinciding points are named by the seam itself)
+        mm = np.asarray(sb.points_mm, dtype=float)
+        hint = ""
+        if np.max(np.abs(mm)) <= METRES_LOOK_MM:  # every coordinate a few "mm": metres
+            hint = (f": typed in metres? ({mm[0].tolist()} would be {(mm[0] * 1e3).tolist()} "
+                    "mm)")
         raise CellError(f"{key}.points_mm: the seam is {length_mm:.3g} mm long through its "
                         f"points (at least {MIN_SEAM_MM:g} mm); points_mm are millimetres in "
-                        f"the object's frame: typed in metres? ({first.tolist()} would be "
-                        f"{(first * 1e3).tolist()} mm)")
+                        f"the object's frame{hint}")
     return pts
 
 
@@ -104,4 +110,4 @@ def seam_in_world(sb: SeamBlock, T_obj: NDArray[np.float64], pts: NDArray[np.flo
                 standoff_m=standoff)
 
 
-__all__ = ["MIN_SEAM_MM", "ctwd_key", "seam_in_world", "seam_points", "seam_standoff"]
+__all__ = ["METRES_LOOK_MM", "MIN_SEAM_MM", "ctwd_key", "seam_in_world", "seam_points", "seam_standoff"]

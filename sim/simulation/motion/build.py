@@ -67,7 +67,7 @@ def build_motion(scenario: Scenario, context: CartesianContext | None = None) ->
         while todo:
             phase = todo.pop(0)
             label = phase_label(where, phase)
-            if not n_axes:
+            if not system.external:  # the cell's own axes, whether or not it was built
                 _no_axes_to_move(phase, label)
             if isinstance(phase, CartesianPhase):
                 _check_seam_blends(phase, todo[0] if todo else None, context, label)
