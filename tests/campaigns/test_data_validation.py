@@ -490,7 +490,7 @@ RANGES = ("range_deg = [[-170, 170], [-100, 140], [-150, 150], [-190, 190], [-12
 @pytest.mark.parametrize("edit, needle", [
     # the campaign's cases, each by name
     (("[300, 0, 0, -90]", "[300, 0, 0, -90, 1]"), "kinematics.dh[1]: 5 values"),
-    (("[0, 0, 80, 0]]", "[0, 0, 80, 0], [0, 0, 10, 0]]"), "joints.range_deg: 6 rows for 7"),
+    (("[0, 0, 80, 0]]", "[0, 0, 80, 0], [0, 0, 10, 0]]"), "kinematics.dh: 7 rows, while joints.range_deg"),
     (("[-170, 170], [-100", "[10, 10], [-100"), "joints.range_deg[0]: lower 10 = upper 10"),
     (("[-170, 170], [-100", "[20, 10], [-100"), "joints.range_deg[0]: lower 20 > upper 10"),
     (("max_speed_deg_s = [270,", "max_speed_deg_s = [-270,"), "joints.max_speed_deg_s[0]"),
